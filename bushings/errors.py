@@ -1,0 +1,13 @@
+"""Errors raised on bad user input: they name the file, the key, the value and what was expected."""
+
+from __future__ import annotations
+
+
+class InputError(ValueError):
+    """Bad input from a file or the command line, with a message a user can act on."""
+
+    def __init__(self, message: str, *, source: str | None = None, key: str | None = None):
+        where = ": ".join(part for part in (source, key) if part)
+        super().__init__(f"{where}: {message}" if where else message)
+        self.source = source
+        self.key = key

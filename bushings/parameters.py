@@ -1,0 +1,245 @@
+"""Bushing channel parameters: the model catalogue, named parameter sets, and unit conversion.
+
+Parameter sets are written in the thesis's units (N, mm, s for translations; N·m, deg, s for
+rotations) and converted to SI exactly once, here, when a :class:`ChannelParams` is built.
+Everything downstream (kernels, bank, vehicle) is SI: N, m, s or N·m, rad, s.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any, Mapping
+
+import yaml
+
+from bushings.errors import InputError
+
+#: The folder holding the named parameter sets shipped with the project.
+PARAMETER_SET_DIR = Path(__file__).resolve().parent.parent / "models" / "bushings"
+
+#: Number of ladder cells when a set does not say (the thesis's choice for 0.05–2 mm).
+DEFAULT_CELLS = 15
+
+# Each parameter's dimension as (power of length) so that value_SI = value_user * L**power, where
+# L is the length unit in SI (1e-3 m per mm, pi/180 rad per deg). Force units need no conversion
+# (N, or N·m for rotations). Co has dimension force/(length/s)**pw, handled in to_si().
+_LENGTH_POWER = {
+    "K0": -1, "C": -1, "Kpa": -1, "Kr": -1, "Ff": 0, "Co": None, "pw": 0, "N": 0,
+    "N_sup": 1, "N_inf": 1, "S_sup": 1, "S_inf": 1, "P_sup": 0, "P_inf": 0,
+    "Ct": -1, "n": 0, "maxwell_k": -1, "maxwell_c": -1,
+}
+
+_ELASTIC_KEYS = ("N_sup", "N_inf", "S_sup", "S_inf", "P_sup", "P_inf")
+
+#: model name -> (required keys, optional keys) in the user-facing parameter mapping.
+MODELS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
+    "linear": (("K0",), ("C",) + _ELASTIC_KEYS),
+    "elastic": (("K0",) + _ELASTIC_KEYS, ("C",)),
+    "sts": (("K0", "Kpa", "Kr", "Ff"), ("N", "C") + _ELASTIC_KEYS),
+    "sts_continuous": (("K0", "Kpa", "Ct"), ("C",) + _ELASTIC_KEYS),
+    "stsn": (("K0", "Kpa", "Ct", "n"), ("C",) + _ELASTIC_KEYS),
+    "rt": (("K0", "Kpa", "Kr", "Co", "pw"), ("N", "C") + _ELASTIC_KEYS),
+    "stvs": (("K0", "Kpa", "Kr", "Ff", "Co", "pw"), ("N", "C") + _ELASTIC_KEYS),
+    "tvs": (("K0", "Kpa", "Kr", "Ff", "maxwell_k", "maxwell_c"), ("N", "C") + _ELASTIC_KEYS),
+}
+
+#: Length unit of user-facing parameter values, per quantity, in SI.
+LENGTH_UNIT_SI = {"translation": 1e-3, "rotation": math.pi / 180.0}
+UNIT_LABELS = {"translation": ("N", "mm"), "rotation": ("N·m", "deg")}
+
+
+@dataclass(frozen=True)
+class ChannelParams:
+    """One bushing direction's force law, in SI (N, m, s; or N·m, rad, s for rotations).
+
+    The force is ``F = F_el(e) + C·de/dt + ladder(e) + Σ maxwell_j(e)`` (or the continuous
+    STS hysteresis instead of the ladder). ``n_cells = 0`` means no ladder.
+    """
+
+    model: str
+    quantity: str = "translation"
+    K0: float = 0.0                 #: linear (large-amplitude) stiffness [N/m]
+    C: float = 0.0                  #: parallel linear damping [N·s/m]
+    N_sup: float = math.inf         #: end of the linear zone in tension [m]
+    N_inf: float = -math.inf        #: end of the linear zone in compression [m] (negative)
+    S_sup: float = math.inf         #: saturation (vertical asymptote) in tension [m]
+    S_inf: float = -math.inf        #: saturation in compression [m] (negative)
+    P_sup: float = 0.0              #: progressivity in tension [N]
+    P_inf: float = 0.0              #: progressivity in compression [N]
+    n_cells: int = 0                #: ladder cells N
+    Kpa: float = 0.0                #: small-amplitude additional stiffness [N/m]
+    Kr: float = 0.0                 #: ladder spring stiffness [N/m]
+    Ff: float = 0.0                 #: slider threshold [N]
+    Co: float = 0.0                 #: power-law damper coefficient [N/(m/s)^pw]
+    pw: float = 1.0                 #: power-law exponent, 0 < pw <= 1
+    Ct: float = 0.0                 #: continuous STS constant [N^n/m] (n = 2: Ct = 2·Ff·Kr)
+    n_root: float = 2.0             #: root of the continuous STS (2 = Coveney; STSn+ otherwise)
+    maxwell_k: tuple[float, ...] = field(default_factory=tuple)  #: Maxwell spring stiffnesses [N/m]
+    maxwell_c: tuple[float, ...] = field(default_factory=tuple)  #: Maxwell damper rates [N·s/m]
+
+    @property
+    def continuous(self) -> bool:
+        """True for the continuous (Coveney) STS family, which uses a turning-point memory."""
+        return self.model in ("sts_continuous", "stsn")
+
+    def replace(self, **changes: Any) -> "ChannelParams":
+        """A copy with some SI fields changed."""
+        return replace(self, **changes)
+
+
+def _number(value: Any, source: str, key: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise InputError(f"expected a number, got {value!r}", source=source, key=key)
+    if not math.isfinite(value):
+        raise InputError(f"expected a finite number, got {value!r}", source=source, key=key)
+    return float(value)
+
+
+def to_si(model: str, values: Mapping[str, Any], quantity: str = "translation",
+          source: str = "<parameters>") -> ChannelParams:
+    """Validate a user-facing parameter mapping (thesis units) and convert it to SI.
+
+    ``values`` uses the thesis's names: K0, Kpa, Kr [N/mm], Ff [N], Co [N/(mm/s)^pw], pw, N,
+    C [N·s/mm], N_sup/N_inf/S_sup/S_inf [mm], P_sup/P_inf [N], Ct [N^n/mm], n, maxwell_k [N/mm],
+    maxwell_c [N·s/mm] (N·m and deg in place of N and mm for ``quantity: rotation``).
+    """
+    if model not in MODELS:
+        raise InputError(f"unknown model {model!r}; expected one of {', '.join(MODELS)}",
+                         source=source, key="model")
+    if quantity not in LENGTH_UNIT_SI:
+        raise InputError(f"unknown quantity {quantity!r}; expected translation or rotation",
+                         source=source, key="quantity")
+    required, optional = MODELS[model]
+    unknown = sorted(set(values) - set(required) - set(optional))
+    if unknown:
+        raise InputError(f"unknown parameter(s) {', '.join(unknown)} for model {model!r}; "
+                         f"expected {', '.join(required + optional)}", source=source, key=unknown[0])
+    missing = [k for k in required if k not in values]
+    if missing:
+        raise InputError(f"missing parameter(s) {', '.join(missing)} for model {model!r}",
+                         source=source, key=missing[0])
+    length = LENGTH_UNIT_SI[quantity]
+    si: dict[str, Any] = {}
+    for key, raw in values.items():
+        if key in ("maxwell_k", "maxwell_c"):
+            if not isinstance(raw, (list, tuple)) or not raw:
+                raise InputError(f"expected a non-empty list of numbers, got {raw!r}", source=source, key=key)
+            nums = [_number(v, source, key) for v in raw]
+            if any(v <= 0 for v in nums):
+                raise InputError(f"expected positive values, got {raw!r}", source=source, key=key)
+            si[key] = tuple(v / length for v in nums)
+            continue
+        value = _number(raw, source, key)
+        if key == "N":
+            if value != int(value) or not 1 <= value <= 200:
+                raise InputError(f"expected a whole number of cells in 1..200, got {raw!r}",
+                                 source=source, key=key)
+            si["n_cells"] = int(value)
+            continue
+        if key == "pw" and not 0.0 < value <= 1.0:
+            raise InputError(f"expected 0 < pw <= 1, got {raw!r}", source=source, key=key)
+        if key == "n" and not value > 1.0:
+            raise InputError(f"expected a root n > 1, got {raw!r}", source=source, key=key)
+        if key in ("K0", "C", "Kpa", "Kr", "Ff", "Co", "Ct", "P_sup", "P_inf") and value < 0:
+            raise InputError(f"expected a non-negative value, got {raw!r}", source=source, key=key)
+        if key in ("Kpa", "Kr", "Ct") and value == 0:
+            raise InputError(f"expected a positive value, got {raw!r}", source=source, key=key)
+        si[key] = value if key == "Co" else value * length ** _LENGTH_POWER[key]
+    if "Co" in si:  # force/(length/s)^pw: dividing by length**pw
+        si["Co"] = si["Co"] / length ** si.get("pw", 1.0)
+    if "n" in si:
+        si["n_root"] = si.pop("n")
+    if "maxwell_k" in si and len(si["maxwell_k"]) != len(si.get("maxwell_c", ())):
+        raise InputError("maxwell_k and maxwell_c must have the same length", source=source, key="maxwell_c")
+    _check_elastic(si, source)
+    if model in ("sts", "rt", "stvs", "tvs"):
+        si.setdefault("n_cells", DEFAULT_CELLS)
+    if model == "rt":
+        si["Ff"] = 0.0
+    return ChannelParams(model=model, quantity=quantity, **si)
+
+
+def _check_elastic(si: dict[str, Any], source: str) -> None:
+    present = [k for k in _ELASTIC_KEYS if k in si]
+    if present and len(present) != len(_ELASTIC_KEYS):
+        missing = [k for k in _ELASTIC_KEYS if k not in si]
+        raise InputError(f"the nonlinear elastic law needs all of {', '.join(_ELASTIC_KEYS)}",
+                         source=source, key=missing[0])
+    if present and not (si["S_inf"] < si["N_inf"] <= 0.0 <= si["N_sup"] < si["S_sup"]):
+        raise InputError("expected S_inf < N_inf <= 0 <= N_sup < S_sup", source=source, key="N_sup")
+
+
+@dataclass(frozen=True)
+class ParameterSet:
+    """A named, cited parameter set for one bushing direction, as written in its YAML file."""
+
+    name: str
+    model: str
+    quantity: str
+    values: Mapping[str, Any]  #: user-facing values in the thesis's units
+    source: str                #: provenance (publication, figure, measurement, assumption)
+    path: Path | None = None
+
+    def channel(self, model: str | None = None) -> ChannelParams:
+        """SI parameters of this set, optionally read as another model.
+
+        Reading as another model keeps the parameters that model uses (e.g. an STVS set read as
+        ``sts`` drops Co and pw; read as ``sts_continuous`` it takes Ct = 2·Ff·Kr, Coveney's
+        limit of the discrete ladder); a parameter the other model needs and the set lacks is an
+        error naming this set.
+        """
+        target = model or self.model
+        values = dict(self.values)
+        if target != self.model:
+            if target in ("sts_continuous", "stsn") and "Ct" not in values and {"Ff", "Kr"} <= set(values):
+                values["Ct"] = 2.0 * values["Ff"] * values["Kr"]
+            if target not in MODELS:
+                raise InputError(f"unknown model {target!r}; expected one of {', '.join(MODELS)}",
+                                 source=str(self.path or self.name), key="model")
+            required, optional = MODELS[target]
+            values = {k: v for k, v in values.items() if k in required + optional}
+        return to_si(target, values, self.quantity, str(self.path or self.name))
+
+
+def parse_parameter_set(data: Any, source: str, name: str | None = None) -> ParameterSet:
+    """Validate the mapping of a parameter-set file (keys: model, quantity, source, params)."""
+    if not isinstance(data, Mapping):
+        raise InputError("expected a mapping with keys model, params, source", source=source)
+    allowed = {"name", "model", "quantity", "source", "description", "params"}
+    unknown = sorted(set(data) - allowed)
+    if unknown:
+        raise InputError(f"unknown key {unknown[0]!r}; expected {', '.join(sorted(allowed))}",
+                         source=source, key=unknown[0])
+    for key in ("model", "params"):
+        if key not in data:
+            raise InputError("missing key", source=source, key=key)
+    if not isinstance(data["params"], Mapping):
+        raise InputError(f"expected a mapping of parameters, got {data['params']!r}", source=source, key="params")
+    pset = ParameterSet(name=str(data.get("name", name or source)), model=str(data["model"]),
+                        quantity=str(data.get("quantity", "translation")), values=dict(data["params"]),
+                        source=str(data.get("source", "unspecified")),
+                        path=Path(source) if source.endswith((".yaml", ".yml")) else None)
+    pset.channel()  # validate now, so errors name this file
+    return pset
+
+
+def load_parameter_set(name_or_path: str | Path) -> ParameterSet:
+    """Load a parameter set by name (a file in ``models/bushings/``) or by path."""
+    path = Path(name_or_path)
+    if path.suffix not in (".yaml", ".yml"):
+        path = PARAMETER_SET_DIR / f"{name_or_path}.yaml"
+    if not path.is_file():
+        known = ", ".join(sorted(p.stem for p in PARAMETER_SET_DIR.glob("*.yaml")))
+        raise InputError(f"no parameter set {str(name_or_path)!r}; known sets: {known}", source=str(path))
+    try:
+        data = yaml.safe_load(path.read_text())
+    except yaml.YAMLError as exc:
+        raise InputError(f"not valid YAML: {exc}", source=str(path)) from exc
+    return parse_parameter_set(data, str(path), name=path.stem)
+
+
+def available_parameter_sets() -> list[str]:
+    """Names of the parameter sets shipped in ``models/bushings/``."""
+    return sorted(p.stem for p in PARAMETER_SET_DIR.glob("*.yaml"))
