@@ -110,10 +110,11 @@ def _ladder_step(e, h, n, Kpa, Kr, Ff, Co, pw, u, wprev, wprev2, w, st, dflat, s
     """Advance one ladder of n nodes to deflection e; returns (F_ladder, dF/de, energy dissipated, ok)."""
     tol = 1e-13 * (Kpa + 2.0 * Kr)
     for i in range(n):
-        # Predictor: the increment extrapolated from the last two steps when it keeps its sign.
-        w[i] = 2.0 * wprev[i] - wprev2[i]
-        if w[i] * wprev[i] <= 0.0:
-            w[i] = wprev[i]
+        # Predictor: the increment extrapolated geometrically from the last two steps (slip rates
+        # of a power-law node change by factors, not by differences), the ratio kept moderate.
+        w[i] = wprev[i]
+        if wprev[i] * wprev2[i] > 0.0:
+            w[i] *= min(max(wprev[i] / wprev2[i], 0.05), 20.0)
         st[i] = 0 if w[i] == 0.0 else (1 if w[i] > 0.0 else -1)
     ok = False
     for _ in range(_MAX_NEWTON):
