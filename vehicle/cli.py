@@ -16,6 +16,7 @@ from vehicle.errors import InputError
 COMMAND_MODULES = (
     "bushings.cli",
     "vehicle.view_cli",
+    "vehicle.model_cli",
 )
 
 

@@ -1,0 +1,66 @@
+"""Vehicle YAML loading: the default car, and errors that name file, key and value."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from bushings.errors import InputError
+from vehicle.builder import mirror_axes
+from vehicle.definition import DEFAULT_VEHICLE, load_vehicle
+from vehicle.statics import axle_loads, resolve_preloads
+
+
+def test_default_car_is_plausible():
+    v = load_vehicle()
+    assert v.rear.hardpoints["wheel_centre"][0] == pytest.approx(-2.608)  # public 307 wheelbase
+    assert 2 * v.front.hardpoints["wheel_centre"][1] == pytest.approx(1.49, abs=0.02)
+    assert {b.name for b in v.bushings} == {"e1_front", "e2_front", "e1_rear"}
+    weight, front, rear = axle_loads(v)
+    assert front / weight == pytest.approx(0.60, abs=0.01)  # spec §1: ≈ 60 % front
+    r = resolve_preloads(v)
+    assert 2000.0 < r.front.spring.preload < 5000.0 and 1500.0 < r.rear.spring.preload < 5000.0
+    for b in v.bushings:
+        for sign in (1.0, -1.0):
+            axes = mirror_axes(b.axes, sign)
+            assert np.allclose(axes @ axes.T, np.eye(3), atol=1e-9)
+            assert np.linalg.det(axes) == pytest.approx(1.0)
+
+
+def _write(tmp_path: Path, edit) -> Path:
+    data = yaml.safe_load(DEFAULT_VEHICLE.read_text())
+    edit(data)
+    path = tmp_path / "car.yaml"
+    path.write_text(yaml.safe_dump(data))
+    return path
+
+
+@pytest.mark.parametrize("edit, key, words", [
+    (lambda d: d["body"].update(colour="red"), "body.colour", "unknown key"),
+    (lambda d: d["tyre"].update(radius=-0.3), "tyre.radius", "positive"),
+    (lambda d: d["front"]["hardpoints"].update(strut_top=[0, 0.5]), "front.hardpoints.strut_top", "3 numbers"),
+    (lambda d: d["bushings"][0]["directions"].update(y={"set": "nope"}), "bushings[0].directions.y", "nope"),
+    (lambda d: d["bushings"][0]["directions"].update(rx={"set": "fig5_9"}), "bushings[0].directions.rx", "rotation"),
+    (lambda d: d["bushings"][1]["directions"]["x"].update(model="magic"), "bushings[1].directions.x", "magic"),
+    (lambda d: d["front"]["damper"].update(curve=[[1, 0], [0, 1]]), "front.damper.curve", "increasing"),
+])
+def test_bad_input_names_file_key_and_value(tmp_path, edit, key, words):
+    path = _write(tmp_path, edit)
+    with pytest.raises(InputError) as err:
+        load_vehicle(path)
+    assert str(path) in str(err.value)
+    assert key in str(err.value)
+    assert words in str(err.value)
+
+
+def test_bushing_model_override_reads_sets_as_another_model():
+    v = load_vehicle()
+    e2 = next(b for b in v.bushings if b.name == "e2_front")
+    assert e2.directions["x"].channel().model == "stvs"
+    assert e2.directions["x"].channel("sts").model == "sts"
+    assert e2.directions["rx"].channel("sts").model == "linear"  # inline linear stays linear
+    assert e2.directions["rx"].channel().K0 == pytest.approx(1.0 * 180 / math.pi)  # N·m/deg -> N·m/rad

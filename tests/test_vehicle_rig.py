@@ -1,0 +1,126 @@
+"""The default car on the K&C rig: statics, kinematics, conventions, symmetry, loop closure."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from vehicle.builder import CORNERS, BuildOptions
+from vehicle.definition import load_vehicle
+from vehicle.kinematics import front_corner, rear_heave
+from vehicle.rig import KCRig
+from vehicle.statics import axle_loads
+
+
+@pytest.fixture(scope="module")
+def vehicle():
+    return load_vehicle()
+
+
+@pytest.fixture(scope="module")
+def rig(vehicle):
+    r = KCRig(vehicle)
+    r.settle(1.0)
+    return r
+
+
+def test_static_equilibrium_pad_forces_sum_to_weight(rig):
+    weight, front, rear = axle_loads(rig.vehicle)
+    o = rig.measure()
+    fz = {c: w.pad_force[2] for c, w in o.wheels.items()}
+    total = sum(fz.values())
+    assert abs(total - weight) / weight < 0.005, (total, weight)
+    assert abs(fz["front_left"] + fz["front_right"] - front) / front < 0.01
+    assert abs(fz["rear_left"] + fz["rear_right"] - rear) / rear < 0.01
+
+
+def test_left_right_symmetry_in_pumping(vehicle):
+    r = KCRig(vehicle)
+    r.settle(0.5)
+    for o in [r.measure()] + r.pad_ramp([0] * 4, [0.04] * 4, 1.0, samples=2):
+        for axle in ("front", "rear"):
+            left, right = o.wheels[f"{axle}_left"], o.wheels[f"{axle}_right"]
+            assert math.degrees(abs(left.camber - right.camber)) < 1e-3
+            assert math.degrees(abs(left.toe - right.toe)) < 1e-3
+            assert abs(left.half_track - right.half_track) < 1e-6
+            assert abs(left.pad_force[2] - right.pad_force[2]) < 0.5
+
+
+def test_loop_closure_below_0_1_mm_at_300_daN_lateral(vehicle):
+    r = KCRig(vehicle)
+    r.settle(0.3)
+    r.set_pad_loads(fy=[3000.0] * 4)
+    r.settle(1.0)
+    o = r.measure()
+    assert o.closure_error < 1e-4, o.closure_error
+    # the load really went through: the lateral bushing directions deflect by tenths of a mm
+    names = list(o.bushing_names)
+    assert abs(o.bushing_deflection[names.index("e1_front_left.y")]) > 5e-5
+
+
+def test_rigid_kinematics_match_hardpoint_solution(vehicle):
+    """Rigid bushings: camber and toe against travel (±60 mm) vs scipy root finding on the links."""
+    r = KCRig(vehicle, BuildOptions(rigid_bushings=True))
+    r.settle(0.3)
+    samples = r.pad_ramp([0] * 4, [0.06] * 4, 1.0, samples=6) + r.pad_ramp([0.06] * 4, [-0.06] * 4, 2.0, samples=12)
+    guess = None
+    worst = 0.0
+    for o in samples:
+        for corner in ("front_left", "rear_left"):
+            w = o.wheels[corner]
+            if corner == "front_left":
+                ref, guess = front_corner(r.vehicle, w.pad_height, 0.0, guess)
+            else:
+                ref = rear_heave(r.vehicle, w.pad_height)
+            worst = max(worst, abs(w.camber - ref.camber), abs(w.toe - ref.toe))
+    assert math.degrees(worst) < 0.02, math.degrees(worst)
+    # the sweep covered the travel and camber really changed (the check is not vacuous)
+    heights = [o.wheels["front_left"].pad_height for o in samples]
+    assert max(heights) > 0.055 and min(heights) < -0.055
+    cambers = [o.wheels["front_left"].camber for o in samples]
+    assert math.degrees(max(cambers) - min(cambers)) > 1.0
+
+
+def test_sign_conventions(vehicle):
+    """Toe-in, camber top-out, bump and left steer are positive (ISO 8855)."""
+    front = dataclasses.replace(vehicle.front, static_toe=math.radians(2.0), static_camber=math.radians(3.0))
+    r = KCRig(dataclasses.replace(vehicle, front=front))
+    r.settle(0.3)
+    o = r.measure()
+    m, d = r.model, r.data
+    for corner, sign in (("front_left", 1.0), ("front_right", -1.0)):
+        w = o.wheels[corner]
+        assert math.degrees(w.toe) == pytest.approx(2.0, abs=0.3)
+        assert math.degrees(w.camber) == pytest.approx(3.0, abs=0.3)
+        k = CORNERS.index(corner)
+        rot = d.xmat[r.wheel_body[k]].reshape(3, 3)
+        spin_left = rot[:, 1]
+        heading = np.cross(spin_left, [0, 0, 1.0])
+        top = np.cross(heading, spin_left)  # up in the wheel plane
+        assert heading[0] > 0.99
+        assert sign * heading[1] < 0, "toe-in: the wheel's front points towards the centre plane"
+        assert sign * top[1] > 0, "positive camber: the wheel top leans outward"
+        assert w.steer == pytest.approx(-sign * w.toe, abs=1e-9)
+    # bump: raising the pads moves the wheel centres up and compresses the springs
+    springs0 = o.spring_force["front_left_spring"]
+    z0 = o.wheels["front_left"].wheel_centre[2]
+    r.pad_ramp([0] * 4, [0.02] * 4, 0.5)
+    r.settle(0.3)
+    o = r.measure()
+    assert o.wheels["front_left"].pad_height == pytest.approx(0.02, abs=5e-4)
+    assert o.wheels["front_left"].wheel_centre[2] - z0 == pytest.approx(0.02, abs=2e-3)
+    assert o.spring_force["front_left_spring"] > springs0 + 400.0
+    # left steer: the rack (behind the axle) moves right, both wheels head left, steer > 0
+    r.set_pads([0] * 4)
+    r.set_rack(-0.01)
+    r.settle(0.5)
+    o = r.measure()
+    for corner in ("front_left", "front_right"):
+        k = CORNERS.index(corner)
+        heading = np.cross(d.xmat[r.wheel_body[k]].reshape(3, 3)[:, 1], [0, 0, 1.0])
+        steer = math.atan2(heading[1], heading[0])
+        assert o.wheels[corner].steer == pytest.approx(steer, abs=1e-12)
+        assert math.degrees(o.wheels[corner].steer) > 1.0

@@ -1,0 +1,213 @@
+"""Per-step forces computed outside MuJoCo: bushing laws, spring and damper characteristics.
+
+Scheme (stable at any step, see the engineering notes): MuJoCo's ``discrete`` integrator treats
+joint stiffness and damping implicitly, forces written to ``qfrc_applied`` explicitly. So
+
+* a linear bushing direction lives entirely in its joint (stiffness K0, damping C);
+* any other direction keeps a reference stiffness K_ref = K0 + Kpa (its tangent at small
+  amplitude, the largest tangent of the ladder family) and its damping C in the joint; before each
+  step ONE vectorised call of the bushing bank gives F(e) at the current deflections and only
+  F(e) − K_ref·e is applied explicitly. That remainder's stiffness lies in [−Kpa, 0] ⊂ (−K_ref, 0],
+  so the explicit part can never destabilise the implicit one (laws that stiffen beyond K_ref, the
+  nonlinear elastic saturation, get K_ref raised to their current tangent each step);
+* springs: rate and preload in the joint or tendon; a curve's departure from its rate explicit;
+* dampers: the slope of the active curve segment set as the joint/tendon damping each step
+  (implicit), the segment's intercept applied explicitly.
+"""
+
+from __future__ import annotations
+
+import math
+
+import mujoco
+import numpy as np
+
+from vehicle.builder import CarModel
+
+
+def _pad_curves(curves) -> tuple[np.ndarray, np.ndarray]:
+    """Curves as (E, P) arrays, padded by extending each last segment (for a batched lookup)."""
+    n = max(len(c.x) for c in curves)
+    xs, ys = np.zeros((len(curves), n)), np.zeros((len(curves), n))
+    for i, c in enumerate(curves):
+        x, y = list(c.x), list(c.y)
+        slope = (y[-1] - y[-2]) / (x[-1] - x[-2])
+        while len(x) < n:
+            x.append(x[-1] + 1e3)
+            y.append(y[-1] + 1e3 * slope)
+        xs[i], ys[i] = x, y
+    return xs, ys
+
+
+def _segments(xq: np.ndarray, xs: np.ndarray, ys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Slope and intercept of each curve's segment at ``xq`` (linear extrapolation at the ends)."""
+    rows = np.arange(len(xq))
+    i = np.clip((xs <= xq[:, None]).sum(axis=1) - 1, 0, xs.shape[1] - 2)
+    slope = (ys[rows, i + 1] - ys[rows, i]) / (xs[rows, i + 1] - xs[rows, i])
+    return slope, ys[rows, i] - slope * xs[rows, i]
+
+
+class BushingForces:
+    """The bushing directions of a model: one bank call per step, remainder into ``qfrc_applied``.
+
+    Each channel's joint must carry its reference stiffness (K0 for linear laws, K0 + Kpa
+    otherwise, see :func:`vehicle.builder.joint_stiffness`). The parallel damping C is taken where
+    the model put it: in the joint if the joint has damping (implicit), else in the bank (explicit).
+    """
+
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, channels):
+        self.model, self.data = model, data
+        ids = np.array([mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, c.joint) for c in channels])
+        self.qpos = model.jnt_qposadr[ids]
+        self.dof = model.jnt_dofadr[ids]
+        self.K = model.jnt_stiffness[ids].copy()
+        self.C = model.dof_damping[self.dof].copy()
+        self.bank_idx = np.flatnonzero([not c.linear for c in channels])
+        self.bank = None
+        self.bank_force = np.zeros(self.bank_idx.size)
+        if self.bank_idx.size:
+            from bushings import BushingBank
+            params = [channels[i].params for i in self.bank_idx]
+            params = [p.replace(C=0.0) if self.C[i] > 0 else p for p, i in zip(params, self.bank_idx)]
+            self.bank = BushingBank(params)
+            self.bank_jnt, self.bank_qpos = ids[self.bank_idx], self.qpos[self.bank_idx]
+            self.bank_dof = self.dof[self.bank_idx]
+            self.K_ref = self.K[self.bank_idx].copy()
+            self.saturating = np.array([math.isfinite(p.S_sup) or math.isfinite(p.S_inf) for p in params])
+
+    def apply(self, dt: float) -> None:
+        """Step the bank to the current deflections and add F(e) − K_ref·e to ``qfrc_applied``."""
+        if self.bank is None:
+            return
+        d = self.data
+        e = d.qpos[self.bank_qpos]
+        force, tangent = self.bank.step(e, dt)
+        self.bank_force = force
+        if self.saturating.any():
+            self.K_ref = np.where(self.saturating, np.maximum(self.K[self.bank_idx], tangent), self.K_ref)
+            self.model.jnt_stiffness[self.bank_jnt] = self.K_ref
+        d.qfrc_applied[self.bank_dof] += self.K_ref * e - force
+
+    def deflections(self) -> np.ndarray:
+        """Deflection of every direction [m or rad], in the bushing's frame."""
+        return self.data.qpos[self.qpos].copy()
+
+    def forces(self) -> np.ndarray:
+        """Force of every direction [N or N·m], resisting its deflection (joint damping included)."""
+        d = self.data
+        force = self.K * d.qpos[self.qpos] + self.C * d.qvel[self.dof]
+        if self.bank is not None:
+            force[self.bank_idx] = self.bank_force + self.C[self.bank_idx] * d.qvel[self.bank_dof]
+        return force
+
+    def reset(self) -> None:
+        """Forget the bushings' history (virgin state)."""
+        if self.bank is not None:
+            self.bank.reset()
+            self.bank_force = np.zeros(self.bank_idx.size)
+
+
+class ForceCoupling:
+    """Writes the non-implicit forces of a :class:`CarModel` into ``MjData`` before every step.
+
+    It owns ``qfrc_applied`` (rewritten every step); inputs from outside go to ``xfrc_applied``.
+    """
+
+    def __init__(self, car: CarModel, data: mujoco.MjData):
+        self.model, self.car, self.data = car.model, car, data
+        self.bushings = BushingForces(car.model, data, car.channels)
+        self._init_elements()
+
+    def _init_elements(self) -> None:
+        m, d = self.model, self.data
+        springs = [e for e in self.car.elements if e.spring is not None]
+        dampers = [e for e in self.car.elements if e.damper_curve is not None]
+        jid = lambda n: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, n)
+        tid = lambda n: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_TENDON, n)
+        d0 = mujoco.MjData(m)
+        mujoco.mj_forward(m, d0)
+
+        def coords(elements):
+            joint = np.array([e.kind == "joint" for e in elements])
+            index = np.array([m.jnt_dofadr[jid(e.target)] if e.kind == "joint" else tid(e.target)
+                              for e in elements])
+            qadr = np.array([m.jnt_qposadr[jid(e.target)] if e.kind == "joint" else -1 for e in elements])
+            design = np.array([0.0 if e.kind == "joint" else d0.ten_length[tid(e.target)] for e in elements])
+            return joint, index, qadr, design, np.array([e.sign for e in elements])
+
+        self.springs = springs
+        self.sp_joint, self.sp_index, self.sp_qadr, self.sp_design, self.sp_sign = coords(springs)
+        self.sp_xs, self.sp_ys = _pad_curves([e.spring.curve for e in springs])
+        self.sp_rate = np.array([e.spring.rate for e in springs])
+        self.sp_preload = np.array([e.preload for e in springs])
+        self.sp_y0 = np.array([e.spring.curve(0.0) for e in springs])
+        self.sp_nonlinear = any(len(e.spring.curve.x) > 2 for e in springs)
+        self.dampers = dampers
+        self.dp_joint, self.dp_index, self.dp_qadr, _, self.dp_sign = coords(dampers)
+        self.dp_xs, self.dp_ys = _pad_curves([e.damper_curve for e in dampers])
+        self.dp_tendons = self.dp_index[~self.dp_joint]
+        self.dp_offset = np.zeros(len(dampers))
+
+    # -- every step --------------------------------------------------------------------------
+    def apply(self, dt: float) -> None:
+        """Compute and write the forces for the next step of length ``dt`` [s]."""
+        self.data.qfrc_applied[:] = 0.0
+        self.bushings.apply(dt)
+        self._dampers()
+        if self.sp_nonlinear:
+            self._spring_curves()
+
+    def _dampers(self) -> None:
+        m, d = self.model, self.data
+        velocity = np.where(self.dp_joint, d.qvel[np.where(self.dp_joint, self.dp_index, 0)],
+                            d.ten_velocity[np.where(self.dp_joint, 0, self.dp_index)])
+        speed = self.dp_sign * velocity  # compression speed
+        slope, offset = _segments(speed, self.dp_xs, self.dp_ys)
+        m.dof_damping[self.dp_index[self.dp_joint]] = slope[self.dp_joint]
+        m.tendon_damping[self.dp_tendons] = slope[~self.dp_joint]
+        self.dp_offset = offset
+        self._push(self.dp_joint, self.dp_index, self.dp_sign, offset)
+
+    def _spring_curves(self) -> None:
+        compression = self.spring_compression()
+        slope, offset = _segments(compression, self.sp_xs, self.sp_ys)
+        value = slope * compression + offset
+        remainder = value - self.sp_y0 - self.sp_rate * compression
+        self._push(self.sp_joint, self.sp_index, self.sp_sign, remainder)
+
+    def _push(self, joint: np.ndarray, index: np.ndarray, sign: np.ndarray, force: np.ndarray) -> None:
+        """Apply forces pushing apart [N] along joint or tendon coordinates (compression = sign·Δq)."""
+        d = self.data
+        gen = -sign * force
+        if joint.any():
+            np.add.at(d.qfrc_applied, index[joint], gen[joint])
+        if (~joint).any() and np.any(gen[~joint]):
+            jac = d.ten_J.reshape(self.model.ntendon, self.model.nv)[index[~joint]]
+            d.qfrc_applied += jac.T @ gen[~joint]
+
+    # -- outputs -----------------------------------------------------------------------------
+    def spring_compression(self) -> np.ndarray:
+        """Compression of every spring from design [m], bump positive."""
+        d = self.data
+        coord = np.where(self.sp_joint, d.qpos[np.where(self.sp_joint, self.sp_qadr, 0)],
+                         d.ten_length[np.where(self.sp_joint, 0, self.sp_index)])
+        return self.sp_sign * (coord - self.sp_design)
+
+    def spring_forces(self) -> np.ndarray:
+        """Force of every spring [N], pushing apart."""
+        x = self.spring_compression()
+        slope, offset = _segments(x, self.sp_xs, self.sp_ys)
+        return self.sp_preload + slope * x + offset - self.sp_y0
+
+    def damper_forces(self) -> np.ndarray:
+        """Force of every damper [N], pushing apart (positive in compression)."""
+        d = self.data
+        velocity = np.where(self.dp_joint, d.qvel[np.where(self.dp_joint, self.dp_index, 0)],
+                            d.ten_velocity[np.where(self.dp_joint, 0, self.dp_index)])
+        speed = self.dp_sign * velocity
+        slope, offset = _segments(speed, self.dp_xs, self.dp_ys)
+        return slope * speed + offset
+
+    def reset(self) -> None:
+        """Forget the bushings' history (virgin state)."""
+        self.bushings.reset()

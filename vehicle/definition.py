@@ -1,0 +1,403 @@
+"""Vehicle definition: load and validate a vehicle YAML file (format: models/vehicles/README.md).
+
+Everything returned is SI (m, kg, N, s, rad) and ISO 8855 (x forward, y left, z up); hardpoints
+are the left side's, the right side being their mirror image. Bushing directions keep their
+parameters in the bushing library's user-facing form and are converted by
+:meth:`DirectionDef.channel`. Bad input raises :class:`InputError` naming file, key and value.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Mapping
+
+import numpy as np
+import yaml
+
+from bushings.errors import InputError
+
+#: Folder of the vehicle files shipped with the project.
+VEHICLE_DIR = Path(__file__).resolve().parent.parent / "models" / "vehicles"
+DEFAULT_VEHICLE = VEHICLE_DIR / "c_segment.yaml"
+
+FRONT_POINTS = ("wheel_centre", "lower_ball_joint", "wishbone_front_pivot", "wishbone_rear_pivot",
+                "strut_top", "strut_lower", "tie_rod_outer", "tie_rod_inner")
+REAR_POINTS = ("wheel_centre", "arm_pivot", "beam_centre", "spring_lower", "spring_upper",
+               "damper_lower", "damper_upper")
+FRONT_MASSES = ("wishbone", "knuckle", "strut_rod", "rack")
+REAR_MASSES = ("arm", "hub")
+#: Bushing directions: translations along, then rotations about, the bushing's own x, y, z axes.
+DIRECTIONS = ("x", "y", "z", "rx", "ry", "rz")
+#: Parts a bushing may connect (`child`); the parent is always the body.
+BUSHING_PARTS = ("front.wishbone", "rear.arm")
+Vec3 = tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class Curve:
+    """A piecewise-linear characteristic, extrapolated linearly beyond its end points."""
+
+    x: tuple[float, ...]
+    y: tuple[float, ...]
+
+    def __call__(self, x: float) -> float:
+        xs, ys = np.asarray(self.x), np.asarray(self.y)
+        i = int(np.clip(np.searchsorted(xs, x) - 1, 0, len(xs) - 2))
+        return float(ys[i] + (ys[i + 1] - ys[i]) / (xs[i + 1] - xs[i]) * (x - xs[i]))
+
+
+@dataclass(frozen=True)
+class Spring:
+    """Coil spring: force pushing apart [N] = preload + curve(compression) − curve(0).
+
+    ``curve`` maps compression from design [m] (positive in bump) to force [N]; a linear spring
+    is the two-point curve of its rate. ``preload`` is None when it is to be computed so that
+    the spring carries the static load at design height.
+    """
+
+    curve: Curve
+    preload: float | None
+
+    @property
+    def rate(self) -> float:
+        """Stiffness at design [N/m] (slope of the curve at zero compression)."""
+        eps = 1e-6
+        return (self.curve(eps) - self.curve(-eps)) / (2 * eps)
+
+
+@dataclass(frozen=True)
+class Damper:
+    """Damper: ``curve`` maps compression speed [m/s] to the force pushing apart [N]."""
+
+    curve: Curve
+
+
+@dataclass(frozen=True)
+class DirectionDef:
+    """The force law of one bushing direction, as written in the vehicle file."""
+
+    quantity: str                       #: "translation" or "rotation"
+    set_name: str | None                #: named parameter set in models/bushings/, or None
+    model: str | None                   #: model to read the set as, or the inline model
+    params: Mapping[str, Any] | None    #: inline parameters (thesis units), or None
+    source: str                         #: file and key, for error messages
+
+    def channel(self, override_model: str | None = None):
+        """SI :class:`bushings.ChannelParams` of this direction, optionally read as another model.
+
+        ``override_model`` replaces the model of every named set (run-time ``--bushings``);
+        inline linear directions (rotational stiffnesses mostly) stay linear.
+        """
+        from bushings.parameters import load_parameter_set, to_si
+
+        if self.set_name is not None:
+            pset = load_parameter_set(self.set_name)
+            if pset.quantity != self.quantity:
+                raise InputError(f"parameter set {self.set_name!r} is a {pset.quantity} set; this "
+                                 f"direction needs a {self.quantity} set", source=self.source, key="set")
+            return pset.channel(override_model or self.model)
+        model = self.model if override_model is None or self.model == "linear" else override_model
+        return to_si(model, dict(self.params), self.quantity, source=self.source)
+
+
+@dataclass(frozen=True)
+class BushingDef:
+    """A 6-direction bushing between the body and a suspension part (left side)."""
+
+    name: str
+    parent: str                          #: always "body"
+    child: str                           #: one of BUSHING_PARTS
+    location: Vec3                       #: centre [m]
+    axes: tuple[Vec3, Vec3, Vec3]        #: the bushing's x, y, z axes (orthonormal, right-handed)
+    directions: Mapping[str, DirectionDef]
+
+
+@dataclass(frozen=True)
+class Tyre:
+    radius: float                        #: loaded radius [m]
+    wheel_mass: float                    #: [kg]
+    wheel_inertia: tuple[float, float]   #: about the spin axis and a diameter [kg·m²]
+
+
+@dataclass(frozen=True)
+class Body:
+    mass: float                          #: sprung mass [kg]
+    cg: Vec3                             #: [m]
+    inertia: Vec3                        #: principal inertias about the CG [kg·m²]
+    ride_height_point: Vec3              #: reference point on the body [m]
+    design_ride_height: float            #: its height above ground at design [m]
+
+
+@dataclass(frozen=True)
+class FrontAxle:
+    hardpoints: Mapping[str, Vec3]       #: left side [m]
+    static_toe: float                    #: toe-in [rad]
+    static_camber: float                 #: top outward positive [rad]
+    masses: Mapping[str, float]          #: [kg]
+    spring: Spring
+    damper: Damper
+    anti_roll_rate: float                #: [N/m] of left-minus-right strut length
+    rack_travel_per_rev: float           #: [m] per steering-wheel revolution
+
+
+@dataclass(frozen=True)
+class RearAxle:
+    hardpoints: Mapping[str, Vec3]
+    static_toe: float                    #: [rad]
+    static_camber: float                 #: [rad]
+    masses: Mapping[str, float]
+    beam_torsional_stiffness: float      #: [N·m/rad]
+    spring: Spring
+    damper: Damper
+
+
+@dataclass(frozen=True)
+class VehicleDefinition:
+    """A validated vehicle file, SI and ISO 8855."""
+
+    name: str
+    description: str
+    path: Path
+    tyre: Tyre
+    body: Body
+    front: FrontAxle
+    rear: RearAxle
+    bushings: tuple[BushingDef, ...]
+
+    def point(self, ref: str) -> np.ndarray:
+        """A left-side hardpoint by its dotted name (``front.strut_top``) [m]."""
+        axle, _, name = ref.partition(".")
+        return np.array(getattr(self, axle).hardpoints[name])
+
+
+class _Reader:
+    """Checks one mapping of the file: typed getters that name the dotted key on error."""
+
+    def __init__(self, data: Any, source: str, key: str, allowed: tuple[str, ...]):
+        self.source, self.key = source, key
+        if not isinstance(data, Mapping):
+            raise InputError(f"expected a mapping, got {data!r}", source=source, key=key or None)
+        unknown = sorted(set(data) - set(allowed))
+        if unknown:
+            raise InputError(f"unknown key {unknown[0]!r}; expected one of {', '.join(allowed)}",
+                             source=source, key=self.sub(unknown[0]))
+        self.data = data
+
+    def sub(self, name: str) -> str:
+        return f"{self.key}.{name}" if self.key else name
+
+    def raw(self, name: str, default: Any = ...) -> Any:
+        if name not in self.data:
+            if default is ...:
+                raise InputError("missing key", source=self.source, key=self.sub(name))
+            return default
+        return self.data[name]
+
+    def number(self, name: str, *, positive: bool = False, nonneg: bool = False, default: Any = ...) -> float:
+        value = self.raw(name, default)
+        return _number(value, self.source, self.sub(name), positive=positive, nonneg=nonneg)
+
+    def vector(self, name: str, n: int = 3) -> tuple[float, ...]:
+        return _vector(self.raw(name), self.source, self.sub(name), n)
+
+    def reader(self, name: str, allowed: tuple[str, ...]) -> "_Reader":
+        return _Reader(self.raw(name), self.source, self.sub(name), allowed)
+
+
+def _number(value: Any, source: str, key: str, *, positive: bool = False, nonneg: bool = False) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise InputError(f"expected a finite number, got {value!r}", source=source, key=key)
+    if positive and value <= 0:
+        raise InputError(f"expected a positive number, got {value!r}", source=source, key=key)
+    if nonneg and value < 0:
+        raise InputError(f"expected a non-negative number, got {value!r}", source=source, key=key)
+    return float(value)
+
+
+def _vector(value: Any, source: str, key: str, n: int) -> tuple[float, ...]:
+    if not isinstance(value, (list, tuple)) or len(value) != n:
+        raise InputError(f"expected a list of {n} numbers, got {value!r}", source=source, key=key)
+    return tuple(_number(v, source, f"{key}[{i}]") for i, v in enumerate(value))
+
+
+def _curve(value: Any, source: str, key: str) -> Curve:
+    if not isinstance(value, (list, tuple)) or len(value) < 2:
+        raise InputError(f"expected a list of at least two [x, F] points, got {value!r}", source=source, key=key)
+    pts = [_vector(p, source, f"{key}[{i}]", 2) for i, p in enumerate(value)]
+    xs = [p[0] for p in pts]
+    if any(b <= a for a, b in zip(xs, xs[1:])):
+        raise InputError(f"expected strictly increasing x values, got {xs}", source=source, key=key)
+    return Curve(tuple(xs), tuple(p[1] for p in pts))
+
+
+def _spring(r: _Reader) -> Spring:
+    if ("rate" in r.data) == ("curve" in r.data):
+        raise InputError("give exactly one of `rate` [N/m] or `curve` [[compression m, force N], ...]",
+                         source=r.source, key=r.key)
+    if "rate" in r.data:
+        k = r.number("rate", positive=True)
+        curve = Curve((-1.0, 1.0), (-k, k))
+    else:
+        curve = _curve(r.raw("curve"), r.source, r.sub("curve"))
+    preload = r.raw("preload", "auto")
+    if preload == "auto":
+        return Spring(curve, None)
+    return Spring(curve, _number(preload, r.source, r.sub("preload")))
+
+
+def _points(r: _Reader, names: tuple[str, ...]) -> dict[str, Vec3]:
+    points = {name: r.vector(name) for name in names}
+    for name, p in points.items():
+        if p[1] <= 0 and name != "beam_centre":
+            raise InputError(f"expected a left-side point (y > 0), got {list(p)}", source=r.source, key=r.sub(name))
+    return points
+
+
+def _masses(r: _Reader, names: tuple[str, ...]) -> dict[str, float]:
+    return {name: r.number(name, positive=True) for name in names}
+
+
+def _direction(value: Any, source: str, key: str, quantity: str) -> DirectionDef:
+    r = _Reader(value, source, key, ("set", "model", "params"))
+    if ("set" in r.data) == ("params" in r.data):
+        raise InputError("give either `set` (a parameter set of models/bushings/) or `model` with `params`",
+                         source=source, key=key)
+    model = r.raw("model", None)
+    if model is not None and not isinstance(model, str):
+        raise InputError(f"expected a model name, got {model!r}", source=source, key=r.sub("model"))
+    if "set" in r.data:
+        name = r.raw("set")
+        if not isinstance(name, str):
+            raise InputError(f"expected a parameter-set name, got {name!r}", source=source, key=r.sub("set"))
+        d = DirectionDef(quantity, name, model, None, f"{source}: {key}")
+    else:
+        if model is None:
+            raise InputError("missing key (inline parameters need a model)", source=source, key=r.sub("model"))
+        if not isinstance(r.raw("params"), Mapping):
+            raise InputError(f"expected a mapping of parameters, got {r.raw('params')!r}",
+                             source=source, key=r.sub("params"))
+        d = DirectionDef(quantity, None, model, dict(r.raw("params")), f"{source}: {key}")
+    try:
+        d.channel()  # validate now so that errors name the vehicle file and key
+    except InputError as exc:
+        if exc.source and exc.source.startswith(source):
+            raise
+        raise InputError(str(exc), source=source, key=key) from exc
+    return d
+
+
+def _axis(value: Any, source: str, key: str, points: Mapping[str, np.ndarray]) -> np.ndarray:
+    if isinstance(value, Mapping):
+        r = _Reader(value, source, key, ("from", "to"))
+        ends = []
+        for end in ("from", "to"):
+            ref = r.raw(end)
+            if ref not in points:
+                raise InputError(f"unknown hardpoint {ref!r}; expected one of {', '.join(sorted(points))}",
+                                 source=source, key=r.sub(end))
+            ends.append(points[ref])
+        v = ends[1] - ends[0]
+    else:
+        v = np.array(_vector(value, source, key, 3))
+    if np.linalg.norm(v) < 1e-9:
+        raise InputError(f"expected a non-zero direction, got {value!r}", source=source, key=key)
+    return v / np.linalg.norm(v)
+
+
+def _bushing(value: Any, source: str, key: str, points: Mapping[str, np.ndarray]) -> BushingDef:
+    r = _Reader(value, source, key, ("name", "parent", "child", "location", "axes", "directions"))
+    name = r.raw("name")
+    if not isinstance(name, str) or not name.isidentifier():
+        raise InputError(f"expected an identifier, got {name!r}", source=source, key=r.sub("name"))
+    if r.raw("parent") != "body":
+        raise InputError(f"expected 'body', got {r.raw('parent')!r}", source=source, key=r.sub("parent"))
+    child = r.raw("child")
+    if child not in BUSHING_PARTS:
+        raise InputError(f"expected one of {', '.join(BUSHING_PARTS)}, got {child!r}", source=source,
+                         key=r.sub("child"))
+    loc = r.raw("location")
+    if isinstance(loc, str):
+        if loc not in points:
+            raise InputError(f"unknown hardpoint {loc!r}; expected one of {', '.join(sorted(points))}",
+                             source=source, key=r.sub("location"))
+        location = tuple(float(v) for v in points[loc])
+    else:
+        location = _vector(loc, source, r.sub("location"), 3)
+    ax = r.reader("axes", ("x", "y"))
+    x = _axis(ax.raw("x"), source, ax.sub("x"), points)
+    y = _axis(ax.raw("y"), source, ax.sub("y"), points)
+    y = y - x * float(x @ y)
+    if np.linalg.norm(y) < 1e-6:
+        raise InputError("axes.y is parallel to axes.x", source=source, key=ax.sub("y"))
+    y /= np.linalg.norm(y)
+    z = np.cross(x, y)
+    dr = r.reader("directions", DIRECTIONS)
+    directions = {}
+    for d in DIRECTIONS:
+        quantity = "translation" if len(d) == 1 else "rotation"
+        directions[d] = _direction(dr.raw(d), source, dr.sub(d), quantity)
+    return BushingDef(name, "body", child, location,
+                      (tuple(x.tolist()), tuple(y.tolist()), tuple(z.tolist())), directions)
+
+
+def load_vehicle(path: str | Path = DEFAULT_VEHICLE) -> VehicleDefinition:
+    """Load and validate a vehicle file; raises :class:`InputError` naming file, key and value."""
+    path = Path(path)
+    source = str(path)
+    if not path.is_file():
+        raise InputError("no such vehicle file", source=source)
+    try:
+        data = yaml.safe_load(path.read_text())
+    except yaml.YAMLError as exc:
+        raise InputError(f"not valid YAML: {exc}", source=source) from exc
+    top = _Reader(data, source, "", ("name", "description", "tyre", "body", "front", "rear", "bushings"))
+
+    t = top.reader("tyre", ("radius", "wheel_mass", "wheel_inertia"))
+    inertia = t.vector("wheel_inertia", 2)
+    if min(inertia) <= 0:
+        raise InputError(f"expected positive inertias, got {list(inertia)}", source=source, key=t.sub("wheel_inertia"))
+    tyre = Tyre(t.number("radius", positive=True), t.number("wheel_mass", positive=True), inertia)
+
+    b = top.reader("body", ("mass", "cg", "inertia", "ride_height_point", "design_ride_height"))
+    body = Body(b.number("mass", positive=True), b.vector("cg"), b.vector("inertia"),
+                b.vector("ride_height_point"), b.number("design_ride_height"))
+
+    f = top.reader("front", ("hardpoints", "static_toe", "static_camber", "masses", "spring", "damper",
+                             "anti_roll_bar", "steering"))
+    front = FrontAxle(
+        hardpoints=_points(f.reader("hardpoints", FRONT_POINTS), FRONT_POINTS),
+        static_toe=math.radians(f.number("static_toe")), static_camber=math.radians(f.number("static_camber")),
+        masses=_masses(f.reader("masses", FRONT_MASSES), FRONT_MASSES),
+        spring=_spring(f.reader("spring", ("rate", "curve", "preload"))),
+        damper=Damper(_curve(f.reader("damper", ("curve",)).raw("curve"), source, "front.damper.curve")),
+        anti_roll_rate=f.reader("anti_roll_bar", ("rate",)).number("rate", nonneg=True),
+        rack_travel_per_rev=f.reader("steering", ("rack_travel_per_rev",)).number("rack_travel_per_rev",
+                                                                                  positive=True))
+    rr = top.reader("rear", ("hardpoints", "static_toe", "static_camber", "masses", "beam_torsional_stiffness",
+                             "spring", "damper"))
+    rear = RearAxle(
+        hardpoints=_points(rr.reader("hardpoints", REAR_POINTS), REAR_POINTS),
+        static_toe=math.radians(rr.number("static_toe")), static_camber=math.radians(rr.number("static_camber")),
+        masses=_masses(rr.reader("masses", REAR_MASSES), REAR_MASSES),
+        beam_torsional_stiffness=rr.number("beam_torsional_stiffness", positive=True),
+        spring=_spring(rr.reader("spring", ("rate", "curve", "preload"))),
+        damper=Damper(_curve(rr.reader("damper", ("curve",)).raw("curve"), source, "rear.damper.curve")))
+
+    points = {f"front.{k}": np.array(v) for k, v in front.hardpoints.items()}
+    points |= {f"rear.{k}": np.array(v) for k, v in rear.hardpoints.items()}
+    raw = top.raw("bushings")
+    if not isinstance(raw, list) or not raw:
+        raise InputError(f"expected a non-empty list of bushings, got {raw!r}", source=source, key="bushings")
+    bushings = tuple(_bushing(v, source, f"bushings[{i}]", points) for i, v in enumerate(raw))
+    names = [bu.name for bu in bushings]
+    if len(set(names)) != len(names):
+        raise InputError(f"duplicate bushing names in {names}", source=source, key="bushings")
+    for part in BUSHING_PARTS:
+        if not any(bu.child == part for bu in bushings):
+            raise InputError(f"no bushing connects {part} to the body", source=source, key="bushings")
+    name = top.raw("name")
+    if not isinstance(name, str):
+        raise InputError(f"expected a name, got {name!r}", source=source, key="name")
+    return VehicleDefinition(name, str(top.raw("description", "")), path, tyre, body, front, rear, bushings)

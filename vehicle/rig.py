@@ -1,0 +1,161 @@
+"""The virtual K&C rig: body clamped, each wheel on a pad, rack displacement input.
+
+Pads impose the vertical displacement of each wheel's contact point (bump positive) and apply
+longitudinal and lateral forces at it and an aligning torque about the vertical; the wheels are
+braked. Outputs follow ISO 8855: toe-in positive, camber positive when the wheel top leans
+outward, steer angle positive to the left, half-track = |y| of the wheel centre.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from vehicle.builder import CORNERS, BuildOptions, CarModel, build
+from vehicle.coupling import ForceCoupling
+from vehicle.definition import VehicleDefinition
+from vehicle.kinematics import wheel_angles
+from vehicle.statics import resolve_preloads
+
+_SIGN = {"front_left": 1.0, "front_right": -1.0, "rear_left": 1.0, "rear_right": -1.0}
+
+
+@dataclass(frozen=True)
+class WheelOutputs:
+    """What the rig measures at one wheel."""
+
+    camber: float               #: [rad], top outward positive
+    toe: float                  #: [rad], toe-in positive
+    steer: float                #: yaw of the wheel heading [rad], to the left positive
+    half_track: float           #: |y| of the wheel centre [m]
+    wheel_centre: np.ndarray    #: [m], world (= body, clamped) frame
+    pad_force: np.ndarray       #: force of the pad on the wheel (Fx, Fy, Fz) [N]
+    pad_height: float           #: measured pad (contact-point) displacement [m], bump positive
+
+
+@dataclass(frozen=True)
+class RigOutputs:
+    """One sample of the rig."""
+
+    time: float                              #: [s]
+    wheels: dict[str, WheelOutputs]
+    bushing_names: tuple[str, ...]           #: ``bushing_side.direction``
+    bushing_deflection: np.ndarray           #: [m or rad] in each bushing's frame
+    bushing_force: np.ndarray                #: [N or N·m], resisting the deflection
+    spring_force: dict[str, float]           #: [N], pushing apart
+    damper_force: dict[str, float]           #: [N], pushing apart
+    closure_error: float                     #: largest loop-closure position error [m]
+
+
+class KCRig:
+    """A vehicle on the K&C rig, stepped with its bushing coupling."""
+
+    def __init__(self, vehicle: VehicleDefinition, options: BuildOptions = BuildOptions()):
+        options = dataclasses.replace(options, rig=True)
+        self.vehicle = resolve_preloads(vehicle)
+        self.car: CarModel = build(self.vehicle, options)
+        m = self.model = self.car.model
+        self.data = mujoco.MjData(m)
+        self.coupling = ForceCoupling(self.car, self.data)
+        eq = lambda n: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_EQUALITY, n)
+        body = lambda n: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, n)
+        self.pad_eq = np.array([eq(self.car.corners[c]["pad_drive"]) for c in CORNERS])
+        self.rack_eq = eq("rack_drive")
+        self.wheel_body = np.array([body(self.car.corners[c]["wheel"]) for c in CORNERS])
+        self.pad_qpos = m.jnt_qposadr[[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, self.car.corners[c]["pad_z"])
+                                       for c in CORNERS]]
+        self.carriage_body = np.array([body(f"carriage_{c}") for c in CORNERS])
+        self.centre_site = np.array([mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, self.car.corners[c]["centre_site"])
+                                     for c in CORNERS])
+        self.closure_eq = np.array([eq(n) for n in self.car.closures])
+        self.closure_rows = np.array([3 if m.eq_type[i] != mujoco.mjtEq.mjEQ_TENDON else 1 for i in self.closure_eq])
+
+    # -- inputs ------------------------------------------------------------------------------
+    def set_pads(self, heights) -> None:
+        """Contact-point displacements [m] of the four pads (order of ``CORNERS``), bump positive."""
+        self.model.eq_data[self.pad_eq, 0] = np.asarray(heights, float)
+
+    def set_rack(self, displacement: float) -> None:
+        """Rack displacement [m], positive to the left (+y)."""
+        self.model.eq_data[self.rack_eq, 0] = displacement
+
+    def set_pad_loads(self, fx=(0, 0, 0, 0), fy=(0, 0, 0, 0), mz=(0, 0, 0, 0)) -> None:
+        """Longitudinal and lateral forces [N] at the contact points and aligning torques [N·m]."""
+        d = self.data
+        d.xfrc_applied[self.carriage_body, 0] = fx
+        d.xfrc_applied[self.carriage_body, 1] = fy
+        d.xfrc_applied[self.wheel_body, 5] = mz
+
+    # -- running -----------------------------------------------------------------------------
+    def step(self, n: int = 1) -> None:
+        """Advance ``n`` time steps with the coupling called before each."""
+        m, d = self.model, self.data
+        for _ in range(n):
+            self.coupling.apply(m.opt.timestep)
+            mujoco.mj_step(m, d)
+
+    def settle(self, duration: float = 1.0) -> None:
+        """Run ``duration`` [s] with the inputs held."""
+        self.step(int(round(duration / self.model.opt.timestep)))
+
+    def pad_ramp(self, start, end, duration: float, samples: int = 0) -> list[RigOutputs]:
+        """Move the pads linearly from ``start`` to ``end`` [m] in ``duration`` [s], sampling."""
+        h = self.model.opt.timestep
+        n = max(1, int(round(duration / h)))
+        every = max(1, n // samples) if samples else n + 1
+        start, end = np.asarray(start, float), np.asarray(end, float)
+        out = []
+        for i in range(1, n + 1):
+            self.set_pads(start + (end - start) * i / n)
+            self.step()
+            if i % every == 0:
+                out.append(self.measure())
+        return out
+
+    # -- outputs -----------------------------------------------------------------------------
+    def _eq_forces(self, ids: np.ndarray, rows: int) -> np.ndarray:
+        d = self.data
+        eqrows = d.efc_type[: d.nefc] == mujoco.mjtConstraint.mjCNSTR_EQUALITY
+        out = np.zeros((len(ids), rows))
+        for k, i in enumerate(ids):
+            sel = np.flatnonzero(eqrows & (d.efc_id[: d.nefc] == i))
+            out[k] = d.efc_force[sel[:rows]]
+        return out
+
+    def closure_error(self) -> float:
+        """Largest position error of the loop closures [m] (connect, weld position, tie-rod length)."""
+        d = self.data
+        eqrows = d.efc_type[: d.nefc] == mujoco.mjtConstraint.mjCNSTR_EQUALITY
+        worst = 0.0
+        for i, n in zip(self.closure_eq, self.closure_rows):
+            sel = np.flatnonzero(eqrows & (d.efc_id[: d.nefc] == i))[:n]
+            worst = max(worst, float(np.linalg.norm(d.efc_pos[sel])))
+        return worst
+
+    def measure(self) -> RigOutputs:
+        """The rig's outputs at the current state."""
+        m, d = self.model, self.data
+        mujoco.mj_forward(m, d)
+        fz = self._eq_forces(self.pad_eq, 1)[:, 0]
+        wheels = {}
+        for k, corner in enumerate(CORNERS):
+            sign = _SIGN[corner]
+            rot = d.xmat[self.wheel_body[k]].reshape(3, 3)
+            spin_left = rot[:, 1]
+            toe, camber = wheel_angles(sign * spin_left, sign)
+            heading = np.cross(spin_left, [0.0, 0.0, 1.0])
+            centre = d.site_xpos[self.centre_site[k]].copy()
+            force = np.array([d.xfrc_applied[self.carriage_body[k], 0], d.xfrc_applied[self.carriage_body[k], 1], fz[k]])
+            wheels[corner] = WheelOutputs(camber, toe, math.atan2(heading[1], heading[0]), abs(centre[1]), centre,
+                                          force, float(d.qpos[self.pad_qpos[k]]))
+        c = self.coupling
+        return RigOutputs(
+            time=float(d.time), wheels=wheels, bushing_names=tuple(ch.name for ch in self.car.channels),
+            bushing_deflection=c.bushings.deflections(), bushing_force=c.bushings.forces(),
+            spring_force=dict(zip((e.name for e in c.springs), c.spring_forces().tolist())),
+            damper_force=dict(zip((e.name for e in c.dampers), c.damper_forces().tolist())),
+            closure_error=self.closure_error())
