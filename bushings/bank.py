@@ -29,7 +29,9 @@ class BushingBank:
 
     _STATE = ("u", "wprev", "wprev2", "q", "eprev", "cs", "ck", "stack", "diss", "nfail")
 
-    def __init__(self, channels: Sequence[ChannelParams]):
+    def __init__(self, channels: Sequence[ChannelParams], tolerance: float = 1e-9):
+        """``tolerance`` [m or rad]: the implicit ladder solve stops when every node's force
+        residual is below tolerance·(Kpa + 2·Kr), i.e. nodes are placed to about this distance."""
         self.channels: tuple[ChannelParams, ...] = tuple(channels)
         M = len(self.channels)
         self.P = np.zeros((M, kn.N_PCOLS))
@@ -49,6 +51,7 @@ class BushingBank:
             self.P[c, kn.P_PW] = ch.pw
             self.P[c, kn.P_CT] = ch.Ct
             self.P[c, kn.P_NROOT] = ch.n_root
+            self.P[c, kn.P_TOL] = tolerance
             if ch.continuous:
                 self.I[c, kn.I_KIND] = kn.KIND_CONTINUOUS
                 # Micro-reversal filter: 1e-3 of the length over which the branch slope halves.
@@ -63,7 +66,7 @@ class BushingBank:
                 self.MX[mx] = (k, cc)
                 mx += 1
         max_cells = max([ch.n_cells for ch in self.channels] + [1])
-        self._work = np.zeros((7, max_cells))
+        self._work = np.zeros((8, max_cells))
         self._iwork = np.zeros(max_cells, dtype=np.int64)
         self._shapes = {"u": (max(n_nodes, 1),), "wprev": (max(n_nodes, 1),), "wprev2": (max(n_nodes, 1),), "q": (max(n_mx, 1),),
                         "eprev": (M,), "cs": (M, 2), "ck": (M,), "stack": (M, kn.STACK_SIZE, 2),

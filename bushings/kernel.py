@@ -24,8 +24,8 @@ import numpy as np
 
 # Columns of the float parameter matrix P (one row per channel, SI).
 P_K0, P_C, P_NSUP, P_NINF, P_SSUP, P_SINF, P_PSUP, P_PINF, P_KPA, P_KR, P_FF, P_CO, P_PW, P_CT, P_NROOT, \
-    P_EPS = range(16)
-N_PCOLS = 16
+    P_EPS, P_TOL = range(17)
+N_PCOLS = 17
 # Columns of the int parameter matrix I.
 I_KIND, I_NCELL, I_NODE_OFF, I_MX_N, I_MX_OFF = range(5)
 N_ICOLS = 5
@@ -36,9 +36,11 @@ STACK_SIZE = 64
 # so that an overshoot in a simulation gives a large finite force instead of an infinite one.
 _THETA_MAX = 0.49 * math.pi
 _MAX_NEWTON = 80
+# Fast-math without 'nnan'/'ninf', so the solver's NaN checks keep working.
+_FAST = {"nsz", "arcp", "contract", "afn", "reassoc"}
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True, inline="always", fastmath=_FAST)
 def _elastic(x, K0, nsup, ninf, ssup, sinf, psup, pinf):
     """Nonlinear elastic force and tangent (spec eq. 3.10 corrected)."""
     if x > nsup:
@@ -62,17 +64,17 @@ def _elastic(x, K0, nsup, ninf, ssup, sinf, psup, pinf):
     return K0 * x, K0
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True, inline="always", fastmath=_FAST)
 def _damper(w, h, Ff, Co, pw):
     """Dissipative force magnitude Ff + Co·|w/h|^pw for |w| > 0 and its derivative d/d|w|."""
     aw = abs(w)
     if Co == 0.0:
         return Ff, 0.0
-    f = Co * (aw / h) ** pw
+    f = Co * math.exp(pw * math.log(aw / h))  # cheaper than ** here (~14 ns against 20-30 ns)
     return Ff + f, pw * f / aw
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, fastmath=_FAST)
 def _release(a, ks, h, Ff, Co, pw):
     """Slip magnitude of one node with its neighbours held: |a| − ks·w = Ff + Co(w/h)^pw.
 
@@ -105,10 +107,17 @@ def _release(a, ks, h, Ff, Co, pw):
     return w
 
 
-@nb.njit(cache=True)
-def _ladder_step(e, h, n, Kpa, Kr, Ff, Co, pw, u, wprev, wprev2, w, st, dflat, sub, rhs, cp, dp, a0):
-    """Advance one ladder of n nodes to deflection e; returns (F_ladder, dF/de, energy dissipated, ok)."""
-    tol = 1e-13 * (Kpa + 2.0 * Kr)
+@nb.njit(cache=True, fastmath=_FAST)
+def _ladder_step(e, h, n, Kpa, Kr, Ff, Co, pw, tol_x, u, wprev, wprev2, w, st, dflat, sub, rhs, cp, dp, a0, dval):
+    """Advance one ladder of n nodes to deflection e; returns (F_ladder, dF/de, energy dissipated, ok).
+
+    Converged when every node's force residual is below tol_x·(Kpa + 2·Kr), i.e. the nodes are
+    placed to about tol_x [m or rad].
+    """
+    # Sliders are released at their threshold to round-off, whatever tol_x: the stick–slip pattern
+    # is exact, and a Coulomb ladder (one linear solve per active set) is solved to round-off.
+    tol_stick = 1e-13 * (Kpa + 2.0 * Kr)
+    tol = tol_x * (Kpa + 2.0 * Kr) if Co > 0.0 else tol_stick
     for i in range(n):
         # Predictor: the increment extrapolated geometrically from the last two steps (slip rates
         # of a power-law node change by factors, not by differences), the ratio kept moderate.
@@ -130,7 +139,7 @@ def _ladder_step(e, h, n, Kpa, Kr, Ff, Co, pw, u, wprev, wprev2, w, st, dflat, s
             a0[i] = df + (kl + Kr) * w[i]  # imbalance this node would have if it did not slip
             if st[i] == 0:
                 rhs[i] = 0.0
-                if abs(df) > Ff + tol:
+                if abs(df) > Ff + tol_stick:
                     done = False
                     # Start slipping: one-node return map as first guess, neighbours held.
                     st[i] = 1 if df > 0.0 else -1
@@ -143,6 +152,7 @@ def _ladder_step(e, h, n, Kpa, Kr, Ff, Co, pw, u, wprev, wprev2, w, st, dflat, s
                 d, dd = _damper(w[i], h, Ff, Co, pw)
                 rhs[i] = df - st[i] * d
                 dflat[i] = dd
+                dval[i] = d
                 if not abs(rhs[i]) <= tol:  # also catches NaN
                     done = False
         if done:
@@ -192,13 +202,13 @@ def _ladder_step(e, h, n, Kpa, Kr, Ff, Co, pw, u, wprev, wprev2, w, st, dflat, s
                 # Shrinking: where the power law dominates the node's stiffness (weight theta),
                 # step in log|w| (w·e^r), which does not overshoot towards zero as the linear step does.
                 theta = dflat[i] / ((Kpa if i == 0 else Kr) + Kr + dflat[i])
-                w[i] *= (1.0 + r) ** (1.0 - theta) * math.exp(theta * r)
+                w[i] *= math.exp((1.0 - theta) * math.log1p(r) + theta * r)
                 continue
             # Newton would reverse the node or overshoot towards zero on the concave power law:
             # replace its step by the one-node return map with its neighbours held, which sticks
             # it, restarts it in the other direction, or gives a slip inside the bracket.
             ks = (Kpa if i == 0 else Kr) + Kr
-            if abs(a0[i]) <= Ff + tol:
+            if abs(a0[i]) <= Ff + tol_stick:
                 w[i] = 0.0
                 st[i] = 0
             else:
@@ -206,14 +216,12 @@ def _ladder_step(e, h, n, Kpa, Kr, Ff, Co, pw, u, wprev, wprev2, w, st, dflat, s
                 w[i] = st[i] * _release(a0[i], ks, h, Ff, Co, pw)
                 if w[i] == 0.0:
                     st[i] = 0
-    # Consistent tangent: du_1/de = Kpa·[A⁻¹]_11 on the final slipping set (A factored above is
-    # stale after the last update, so refactor with the converged ψ').
+    # Consistent tangent: du_1/de = Kpa·[A⁻¹]_11 on the final slipping set, with the damper
+    # slopes of the converged pass (the factorisation above predates the last update).
     diss = 0.0
     for i in range(n):
         if st[i] != 0:
-            d, dd = _damper(w[i], h, Ff, Co, pw)
-            dflat[i] = dd
-            diss += d * abs(w[i])
+            diss += dval[i] * abs(w[i])
         u[i] += w[i]
         wprev2[i] = wprev[i]
         wprev[i] = w[i]
@@ -240,14 +248,14 @@ def _ladder_step(e, h, n, Kpa, Kr, Ff, Co, pw, u, wprev, wprev2, w, st, dflat, s
     return Kpa * (e - u[0]), Kpa * (1.0 - du1), diss, ok
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True, inline="always", fastmath=_FAST)
 def _sts_shape(s, Ct, nroot, A, B):
     """First-loading hysteretic force H0(s) = (Ct(s + A))^(1/n) − B for s ≥ 0, and its slope."""
     v = (Ct * (s + A)) ** (1.0 / nroot)
     return v - B, v / (nroot * (s + A))
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True, inline="always", fastmath=_FAST)
 def _branch(x, xo, ho, d, virgin, Ct, nroot, A, B):
     """Hysteretic force on the branch leaving (xo, ho) in direction d (Masing: 2·H0(s/2)), or on the
     first-loading curve when ``virgin``."""
@@ -261,7 +269,7 @@ def _branch(x, xo, ho, d, virgin, Ct, nroot, A, B):
     return ho + d * 2.0 * f, k
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, fastmath=_FAST)
 def _continuous_step(x, Kpa, Ct, nroot, eps, stack, cs, ck):
     """Continuous STS with turning-point memory; returns (H, dH/dx).
 
@@ -317,7 +325,7 @@ def _continuous_step(x, Kpa, Ct, nroot, eps, stack, cs, ck):
     return 0.0, Kpa  # unreachable: each pass above either returns or shrinks the stack
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, fastmath=_FAST)
 def step_bank(e, h, P, I, MX, u, wprev, wprev2, q, eprev, cs, ck, stack, diss, nfail, F, K, work, iwork):
     """Advance all channels of a bank by one step of h seconds to deflections e (in place)."""
     M = e.shape[0]
@@ -336,9 +344,9 @@ def step_bank(e, h, P, I, MX, u, wprev, wprev2, q, eprev, cs, ck, stack, diss, n
             if n > 0:
                 o = I[c, I_NODE_OFF]
                 fl, kl, dl, ok = _ladder_step(
-                    x, h, n, P[c, P_KPA], P[c, P_KR], P[c, P_FF], P[c, P_CO], P[c, P_PW],
+                    x, h, n, P[c, P_KPA], P[c, P_KR], P[c, P_FF], P[c, P_CO], P[c, P_PW], P[c, P_TOL],
                     u[o:o + n], wprev[o:o + n], wprev2[o:o + n], work[0, :n], iwork[:n], work[1, :n],
-                    work[2, :n], work[3, :n], work[4, :n], work[5, :n], work[6, :n])
+                    work[2, :n], work[3, :n], work[4, :n], work[5, :n], work[6, :n], work[7, :n])
                 f += fl
                 k += kl
                 diss[c] += dl

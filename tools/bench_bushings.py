@@ -1,0 +1,87 @@
+"""Benchmark of the bushing bank as the vehicle calls it: 36 STVS channels (fig5_9, N = 15).
+
+Prints one JSON object (with --json) or a short table. Measured side by side in one run:
+``stvs36_us_per_step``: µs per call of ``BushingBank.step`` for 36 channels at h = 1 ms under
+1 Hz × 1 mm + 10 Hz × 0.2 mm; ``explicit36_us_per_step``: the explicit reference integrator
+(sub-stepped forward Euler, the thesis's scheme) at equal accuracy, scaled to 36 channels.
+Accuracy is measured against a converged explicit solution with 20× smaller sub-steps.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+
+import numpy as np
+
+from bushings import BushingBank, load_parameter_set
+from bushings.reference import explicit_reference
+
+H_S = 1e-3
+DURATION_S = 4.0
+CHANNELS = 36
+
+
+def loading(t_s: np.ndarray, phase: np.ndarray) -> np.ndarray:
+    """The benchmark deflection [m]: 1 Hz × 1 mm + 10 Hz × 0.2 mm, one phase per channel."""
+    return (1e-3 * np.sin(2 * np.pi * t_s[:, None] + phase)
+            + 0.2e-3 * np.sin(2 * np.pi * 10.0 * t_s[:, None] + 3.0 * phase))
+
+
+def time_bank(e: np.ndarray, repeats: int = 3) -> tuple[float, int]:
+    """Best wall time per step [µs] of stepping a 36-channel bank through e, and failed solves."""
+    ch = load_parameter_set("fig5_9").channel()
+    best = np.inf
+    for _ in range(repeats):
+        bank = BushingBank([ch] * e.shape[1])
+        bank.step(e[0], H_S)  # compile / warm up outside the timing
+        t0 = time.perf_counter()
+        for row in e:
+            bank.step(row, H_S)
+        best = min(best, (time.perf_counter() - t0) / e.shape[0])
+    return best * 1e6, int(bank.failed_steps.sum())
+
+
+def accuracy_match(e1: np.ndarray) -> dict[str, float]:
+    """Error of the implicit step at H_S and cost of the explicit reference at equal error (1 channel)."""
+    ch = load_parameter_set("fig5_9").channel()
+    truth, _ = explicit_reference(ch, e1, H_S, safety=0.005)
+    implicit = BushingBank([ch]).run(e1, H_S)[0]
+    err_implicit = float(np.max(np.abs(implicit - truth)))
+    result = {"implicit_max_error_n": err_implicit}
+    for safety in (0.8, 0.4, 0.2, 0.1, 0.05, 0.025):
+        F, n_sub = explicit_reference(ch, e1, H_S, safety=safety)
+        err = float(np.max(np.abs(F - truth)))
+        if err <= err_implicit:
+            t0 = time.perf_counter()
+            explicit_reference(ch, e1, H_S, safety=safety)
+            wall = time.perf_counter() - t0
+            result.update(explicit_max_error_n=err, explicit_safety=safety,
+                          explicit_substeps_per_step=n_sub / (len(e1) - 1),
+                          explicit36_us_per_step=wall / (len(e1) - 1) * CHANNELS * 1e6)
+            break
+    return result
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--json", action="store_true", help="print one JSON object")
+    args = parser.parse_args()
+    t = np.arange(0.0, DURATION_S, H_S)
+    e = loading(t, np.linspace(0.0, 2 * np.pi, CHANNELS, endpoint=False))
+    us, failed = time_bank(e)
+    out = {"stvs36_us_per_step": us, "channels": CHANNELS, "cells": 15, "h_s": H_S,
+           "target_us_per_step": 20.0, "failed_solves": failed}
+    out.update(accuracy_match(e[:, 0]))
+    if "explicit36_us_per_step" in out:
+        out["explicit_to_implicit_cost_ratio"] = out["explicit36_us_per_step"] / us
+    if args.json:
+        print(json.dumps(out))
+    else:
+        for key, value in out.items():
+            print(f"{key:34s} {value}")
+
+
+if __name__ == "__main__":
+    main()
