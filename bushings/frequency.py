@@ -1,0 +1,135 @@
+"""Frequency characterisation (spec §4): first-harmonic dynamic stiffness and loss angle.
+
+Two estimates of K* = F1/E1 under e = A·sin(2πft), for many (A, f) pairs at once:
+
+* :func:`first_harmonic`, the reference: time simulation of the stabilised response.
+* :func:`equivalent_damping`, the fast approximation of eqs 5.16/5.17: every dissipative element
+  becomes the linear damper dissipating the same energy per cycle at its own amplitude, and the
+  ladder is solved as a complex linear system whose node amplitudes are iterated to consistency.
+
+All quantities are SI: amplitudes in m, stiffness in N/m.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.special import gamma
+
+from bushings.bank import BushingBank
+from bushings.errors import InputError
+from bushings.parameters import ChannelParams
+
+
+@dataclass(frozen=True)
+class DynamicStiffness:
+    """First-harmonic complex stiffness K* = F1/E1 per (amplitude, frequency) pair."""
+
+    amplitude_m: np.ndarray        #: sine amplitude A [m]
+    frequency_hz: np.ndarray       #: sine frequency f [Hz]
+    k_complex_n_per_m: np.ndarray  #: F1/E1 [N/m] (complex)
+
+    @property
+    def k_dyn_n_per_m(self) -> np.ndarray:
+        """Dynamic stiffness |K*| [N/m]."""
+        return np.abs(self.k_complex_n_per_m)
+
+    @property
+    def tan_delta(self) -> np.ndarray:
+        """Loss factor tan δ = Im K* / Re K*."""
+        return self.k_complex_n_per_m.imag / self.k_complex_n_per_m.real
+
+
+def harmonic_ratio(e: np.ndarray, force: np.ndarray, samples_per_cycle: int) -> np.ndarray:
+    """F1/E1 of the last ``samples_per_cycle`` rows of e and force, shape (T,) or (T, M).
+
+    The rectangle rule over exactly one period is exact for the first harmonic of a sampled
+    periodic signal, so no window is needed.
+    """
+    phase = np.exp(-2j * math.pi * np.arange(samples_per_cycle) / samples_per_cycle)
+    e1 = np.tensordot(phase, e[-samples_per_cycle:], axes=(0, 0))
+    f1 = np.tensordot(phase, force[-samples_per_cycle:], axes=(0, 0))
+    return f1 / e1
+
+
+def rate_scaled(channel: ChannelParams, factor: float) -> ChannelParams:
+    """The channel seen in a time scaled by ``factor`` (τ = factor·t): every rate-dependent
+    coefficient takes the factor (C, Maxwell dampers: factor; power-law Co: factor**pw), so that
+    stepping the copy in τ is the same backward-Euler scheme as stepping the original in t."""
+    return channel.replace(C=channel.C * factor, Co=channel.Co * factor ** channel.pw,
+                           maxwell_c=tuple(c * factor for c in channel.maxwell_c))
+
+
+def first_harmonic(channel: ChannelParams, amplitudes_m: np.ndarray, frequencies_hz: np.ndarray, *,
+                   cycles: int = 5, points_per_cycle: int = 400, max_dt_s: float | None = None) -> DynamicStiffness:
+    """Dynamic stiffness of the last of ``cycles`` sine cycles from rest, by time simulation.
+
+    ``amplitudes_m`` [m] and ``frequencies_hz`` [Hz] broadcast together; the result has their
+    common shape. Every pair is one channel of a single bank, stepped in time normalised by its
+    own period (see :func:`rate_scaled`), so all pairs share one grid of n samples per cycle with
+    n ≥ ``points_per_cycle`` (and a real step ≤ ``max_dt_s`` at the lowest frequency if given).
+    The ladder laws have no time scale of their own, so n alone sets the accuracy: for ``fig5_9``
+    n = 400 and n = 2000 agree to 0.05 % in |K*| and 0.5 % in tan δ. Backward Euler's phase
+    error makes tan δ of a linear damper low by about (π/n)·tan δ relative.
+    """
+    a, f = np.broadcast_arrays(np.asarray(amplitudes_m, dtype=float), np.asarray(frequencies_hz, dtype=float))
+    n = points_per_cycle if max_dt_s is None else max(points_per_cycle, math.ceil(1.0 / (f.min() * max_dt_s) - 1e-9))
+    bank = BushingBank([rate_scaled(channel, fi) for fi in f.ravel()])
+    phase = 2.0 * math.pi * np.arange(1, cycles * n + 1) / n
+    e = np.sin(phase)[:, None] * a.ravel()[None, :]
+    force, _ = bank.run(e, 1.0 / n)
+    return DynamicStiffness(a, f, harmonic_ratio(e, force, n).reshape(a.shape))
+
+
+def equivalent_damping(channel: ChannelParams, amplitudes_m: np.ndarray, frequencies_hz: np.ndarray, *,
+                       eps_m: float = 1e-10, tol: float = 1e-6, max_iter: int = 2000) -> DynamicStiffness:
+    """Dynamic stiffness by the equivalent-damping approximation (spec eqs 5.16/5.17).
+
+    At node amplitude X each ladder element is replaced by the damper dissipating the same energy
+    per cycle: C_eq = 2·Co·(ωX)^(pw−1)·Γ(1+pw/2)/(√π·Γ((3+pw)/2)) + 4·Ff/(π·ω·X). The node
+    amplitudes are iterated (plain fixed point) until they reproduce themselves to
+    ``tol`` relative to A; |X| is regularised as √(X² + eps_m²) (1e-7 mm by default, so that stuck
+    sliders keep a finite damper). The elastic law is taken as linear (K0); the continuous STS
+    has no ladder and is refused.
+    """
+    if channel.continuous:
+        raise InputError(f"the equivalent-damping approximation needs a ladder model, not {channel.model!r}",
+                         key="model")
+    a, f = np.broadcast_arrays(np.asarray(amplitudes_m, dtype=float), np.asarray(frequencies_hz, dtype=float))
+    w = 2.0 * math.pi * f.ravel()
+    k = channel.K0 + 1j * w * channel.C
+    for km, cm in zip(channel.maxwell_k, channel.maxwell_c):
+        k = k + km * 1j * w * cm / (km + 1j * w * cm)
+    if channel.n_cells:
+        u1 = _ladder_first_node(channel, a.ravel(), w, eps_m, tol, max_iter)
+        k = k + channel.Kpa * (1.0 - u1 / a.ravel())
+    return DynamicStiffness(a, f, np.broadcast_to(k, a.size).reshape(a.shape))
+
+
+def _ladder_first_node(ch: ChannelParams, a: np.ndarray, w: np.ndarray, eps_m: float, tol: float,
+                       max_iter: int) -> np.ndarray:
+    """Complex amplitude of node 1 of the linearised ladder, per pair (P,)."""
+    n = ch.n_cells
+    k_left = np.full(n, ch.Kr)
+    k_left[0] = ch.Kpa
+    stiffness = np.diag(k_left + ch.Kr) - ch.Kr * (np.eye(n, k=1) + np.eye(n, k=-1))
+    rhs = np.zeros((len(a), n), dtype=complex)
+    rhs[:, 0] = ch.Kpa * a
+    viscous = 2.0 * ch.Co * gamma(1.0 + ch.pw / 2.0) / (math.sqrt(math.pi) * gamma((3.0 + ch.pw) / 2.0))
+
+    def regularised_amplitudes(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        wx = w[:, None] * x
+        c_eq = viscous * wx ** (ch.pw - 1.0) + 4.0 * ch.Ff / (math.pi * wx)
+        u = np.linalg.solve(stiffness + (1j * w[:, None] * c_eq)[:, :, None] * np.eye(n), rhs[:, :, None])[:, :, 0]
+        return np.sqrt(np.abs(u) ** 2 + eps_m ** 2), u[:, 0]
+
+    # Start from infinite node amplitudes, where sliders and power-law dampers vanish.
+    x, _ = regularised_amplitudes(np.full((len(a), n), np.inf))
+    for _ in range(max_iter):
+        x_new, u1 = regularised_amplitudes(x)
+        if np.max(np.abs(x_new - x) / a[:, None]) < tol:
+            return u1
+        x = x_new
+    raise RuntimeError(f"equivalent-damping node amplitudes did not converge in {max_iter} iterations")
