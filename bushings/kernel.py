@@ -200,9 +200,10 @@ def _ladder_step(e, h, n, Kpa, Kr, Ff, Co, pw, tol_x, u, wprev, wprev2, w, st, d
                 continue
             if r > -0.9:
                 # Shrinking: where the power law dominates the node's stiffness (weight theta),
-                # step in log|w| (w·e^r), which does not overshoot towards zero as the linear step does.
+                # step towards log|w| (w·e^r, here its Padé form), which does not overshoot
+                # towards zero as the linear step (w·(1 + r)) does.
                 theta = dflat[i] / ((Kpa if i == 0 else Kr) + Kr + dflat[i])
-                w[i] *= math.exp((1.0 - theta) * math.log1p(r) + theta * r)
+                w[i] *= (1.0 + r * (1.0 - 0.5 * theta)) / (1.0 - 0.5 * theta * r)
                 continue
             # Newton would reverse the node or overshoot towards zero on the concave power law:
             # replace its step by the one-node return map with its neighbours held, which sticks
