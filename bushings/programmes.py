@@ -9,7 +9,6 @@ becomes a :class:`Sweep` of (amplitude, frequency) pairs, each analysed by
 
 from __future__ import annotations
 
-import csv
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -18,6 +17,7 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from bushings.errors import InputError
+from bushings.records import read_csv_columns
 
 MM = 1e-3  #: metres per millimetre
 #: Fewest samples per period of the fastest sine component that a bench accepts.
@@ -109,43 +109,11 @@ def firtree(amplitude_m: float, speed_m_s: float, level_step_m: float, hold_s: f
 def read_csv_record(path: Path) -> tuple[np.ndarray, np.ndarray]:
     """Read a ``t_s,e_mm`` record (other columns ignored); returns time [s] and deflection [m].
 
-    Raises InputError naming the file and line for a missing column, a non-number, a NaN, or a
-    time that does not increase strictly.
+    Raises InputError naming the file, line and column for a missing column, a non-number, a
+    NaN, or a time that does not increase strictly.
     """
-    source = str(path)
-    if not path.is_file():
-        raise InputError("no such CSV file", source=source, key="path")
-    with path.open(newline="") as handle:
-        rows = [(n, row) for n, row in enumerate(csv.reader(handle), start=1) if any(c.strip() for c in row)]
-    if not rows:
-        raise InputError("empty file; expected a header t_s,e_mm and data lines", source=source)
-    header = [c.strip() for c in rows[0][1]]
-    missing = [c for c in ("t_s", "e_mm") if c not in header]
-    if missing:
-        raise InputError(f"line {rows[0][0]}: missing column(s) {', '.join(missing)}; expected a header with "
-                         f"t_s and e_mm, got {','.join(header)}", source=source, key=missing[0])
-    cols = {name: header.index(name) for name in ("t_s", "e_mm")}
-    t, e = [], []
-    for line, row in rows[1:]:
-        values = {}
-        for name, col in cols.items():
-            text = row[col].strip() if col < len(row) else ""
-            try:
-                values[name] = float(text)
-            except ValueError:
-                raise InputError(f"line {line}: expected a number in column {name}, got {text!r}",
-                                 source=source, key=name) from None
-            if not math.isfinite(values[name]):
-                raise InputError(f"line {line}: expected a finite number in column {name}, got {text!r}",
-                                 source=source, key=name)
-        if t and not values["t_s"] > t[-1]:
-            raise InputError(f"line {line}: time must increase strictly, got {values['t_s']} s after {t[-1]} s",
-                             source=source, key="t_s")
-        t.append(values["t_s"])
-        e.append(values["e_mm"] * MM)
-    if len(t) < 2:
-        raise InputError("expected at least two data lines", source=source)
-    return np.asarray(t), np.asarray(e)
+    cols = read_csv_columns(path, ("t_s", "e_mm"), min_rows=2)
+    return cols["t_s"], cols["e_mm"] * MM
 
 
 # Accepted keys per programme type and their defaults (None: optional without default).

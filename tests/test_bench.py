@@ -81,11 +81,11 @@ def test_csv_record_is_resampled(tmp_path):
 
 
 @pytest.mark.parametrize("text, message", [
-    ("t_s,e_mm\n0,0\n1,nan\n", "line 3: expected a finite number in column e_mm"),
-    ("t_s,e_mm\n0,0\n1,1\n1,2\n", "line 4: time must increase strictly"),
-    ("t_s,e_mm\n0,0\n1,abc\n", "line 3: expected a number in column e_mm, got 'abc'"),
+    ("t_s,e_mm\n0,0\n1,nan\n", "line 3, column e_mm: expected a finite number"),
+    ("t_s,e_mm\n0,0\n1,1\n1,2\n", "line 4, column t_s: time must increase strictly"),
+    ("t_s,e_mm\n0,0\n1,abc\n", "line 3, column e_mm: expected a number, got 'abc'"),
     ("time,e_mm\n0,0\n1,1\n", "line 1: missing column(s) t_s"),
-    ("t_s,e_mm\n0,0\n", "at least two data lines"),
+    ("t_s,e_mm\n0,0\n", "too short: 1 samples, expected at least 2"),
 ])
 def test_csv_errors_name_file_line_and_column(tmp_path, text, message):
     path = tmp_path / "bad.csv"
