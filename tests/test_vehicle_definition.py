@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 import yaml
 
+from bushings import load_parameter_set
 from bushings.errors import InputError
 from vehicle.builder import mirror_axes
 from vehicle.definition import DEFAULT_VEHICLE, load_vehicle
@@ -62,5 +63,24 @@ def test_bushing_model_override_reads_sets_as_another_model():
     e2 = next(b for b in v.bushings if b.name == "e2_front")
     assert e2.directions["x"].channel().model == "stvs"
     assert e2.directions["x"].channel("sts").model == "sts"
-    assert e2.directions["rx"].channel("sts").model == "linear"  # inline linear stays linear
     assert e2.directions["rx"].channel().K0 == pytest.approx(1.0 * 180 / math.pi)  # N·m/deg -> N·m/rad
+    assert e2.directions["rx"].channel("linear").model == "linear"
+
+
+@pytest.mark.parametrize("model", ["sts", "rt", "stvs"])
+def test_override_uses_the_family_set_scaled_to_the_direction(model):
+    """An STS-only set read as rt/stvs and an inline linear rotation take the vehicle's family set,
+    scaled to their own K0 (models/vehicles/README.md)."""
+    v = load_vehicle()
+    e1 = next(b for b in v.bushings if b.name == "e1_front")
+    for d in ("y", "rx"):
+        own, read = e1.directions[d].channel(), e1.directions[d].channel(model)
+        assert read.model == model and read.quantity == own.quantity
+        assert read.K0 == pytest.approx(own.K0)
+        assert read.n_cells == 15 and read.Kpa > 0
+    ref = load_parameter_set(v.bushings[0].directions["y"].families.sets[model]).channel(model)
+    rot = e1.directions["rx"].channel(model)
+    lever = v.bushings[0].directions["rx"].families.rotation_lever_arm
+    assert rot.Kpa / rot.K0 == pytest.approx(ref.Kpa / ref.K0)
+    # the slider slip angle is the reference's slip deflection over the lever arm
+    assert rot.Ff / rot.Kr == pytest.approx(ref.Ff / ref.Kr / lever)

@@ -113,9 +113,9 @@ def test_sign_conventions(vehicle):
     assert o.wheels["front_left"].pad_height == pytest.approx(0.02, abs=5e-4)
     assert o.wheels["front_left"].wheel_centre[2] - z0 == pytest.approx(0.02, abs=2e-3)
     assert o.spring_force["front_left_spring"] > springs0 + 400.0
-    # left steer: the rack (behind the axle) moves right, both wheels head left, steer > 0
+    # left steer: the rack (ahead of the axle) moves left, both wheels head left, steer > 0
     r.set_pads([0] * 4)
-    r.set_rack(-0.01)
+    r.set_rack(0.01)
     r.settle(0.5)
     o = r.measure()
     for corner in ("front_left", "front_right"):

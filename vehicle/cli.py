@@ -17,6 +17,8 @@ COMMAND_MODULES = (
     "bushings.cli",
     "vehicle.view_cli",
     "vehicle.model_cli",
+    "vehicle.kc_cli",
+    "vehicle.run_cli",
 )
 
 

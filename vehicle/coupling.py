@@ -57,34 +57,35 @@ class BushingForces:
 
     def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, channels):
         self.model, self.data = model, data
-        ids = np.array([mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, c.joint) for c in channels])
+        from bushings import BushingBank
+
+        ids = np.array([mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, c.joint) for c in channels], dtype=np.int64)
+        self.jnt = ids
         self.qpos = model.jnt_qposadr[ids]
         self.dof = model.jnt_dofadr[ids]
         self.K = model.jnt_stiffness[ids].copy()
         self.C = model.dof_damping[self.dof].copy()
         self.bank_idx = np.flatnonzero([not c.linear for c in channels])
-        self.bank = None
+        params = [channels[i].params for i in self.bank_idx]
+        params = [p.replace(C=0.0) if self.C[i] > 0 else p for p, i in zip(params, self.bank_idx)]
+        #: possibly empty (all laws linear, in the joints); None = laws off, joints only (vehicle.runner)
+        self.bank: BushingBank | None = BushingBank(params)
         self.bank_force = np.zeros(self.bank_idx.size)
-        if self.bank_idx.size:
-            from bushings import BushingBank
-            params = [channels[i].params for i in self.bank_idx]
-            params = [p.replace(C=0.0) if self.C[i] > 0 else p for p, i in zip(params, self.bank_idx)]
-            self.bank = BushingBank(params)
-            self.bank_jnt, self.bank_qpos = ids[self.bank_idx], self.qpos[self.bank_idx]
-            self.bank_dof = self.dof[self.bank_idx]
-            self.K_ref = self.K[self.bank_idx].copy()
-            self.saturating = np.array([math.isfinite(p.S_sup) or math.isfinite(p.S_inf) for p in params])
+        self.bank_jnt, self.bank_qpos = ids[self.bank_idx], self.qpos[self.bank_idx]
+        self.bank_dof = self.dof[self.bank_idx]
+        self.K_ref = self.K[self.bank_idx].copy()
+        self.saturating = np.array([math.isfinite(p.S_sup) or math.isfinite(p.S_inf) for p in params], dtype=np.bool_)
 
     def apply(self, dt: float) -> None:
         """Step the bank to the current deflections and add F(e) − K_ref·e to ``qfrc_applied``."""
-        if self.bank is None:
+        if self.bank is None or not self.bank.size:
             return
         d = self.data
         e = d.qpos[self.bank_qpos]
         force, tangent = self.bank.step(e, dt)
         self.bank_force = force
         if self.saturating.any():
-            self.K_ref = np.where(self.saturating, np.maximum(self.K[self.bank_idx], tangent), self.K_ref)
+            self.K_ref[:] = np.where(self.saturating, np.maximum(self.K[self.bank_idx], tangent), self.K_ref)
             self.model.jnt_stiffness[self.bank_jnt] = self.K_ref
         d.qfrc_applied[self.bank_dof] += self.K_ref * e - force
 
@@ -104,7 +105,7 @@ class BushingForces:
         """Forget the bushings' history (virgin state)."""
         if self.bank is not None:
             self.bank.reset()
-            self.bank_force = np.zeros(self.bank_idx.size)
+        self.bank_force = np.zeros(self.bank_idx.size)
 
 
 class ForceCoupling:
@@ -145,45 +146,30 @@ class ForceCoupling:
         self.dampers = dampers
         self.dp_joint, self.dp_index, self.dp_qadr, _, self.dp_sign = coords(dampers)
         self.dp_xs, self.dp_ys = _pad_curves([e.damper_curve for e in dampers])
-        self.dp_tendons = self.dp_index[~self.dp_joint]
         self.dp_offset = np.zeros(len(dampers))
 
     # -- every step --------------------------------------------------------------------------
+    def kernel_arrays(self) -> tuple:
+        """Arguments of :func:`vehicle.stepping.coupling_step` after ``h`` (views of the model and
+        data, and this coupling's tables), rebuilt when the bank is swapped (see BushingForces.bank)."""
+        from vehicle import stepping
+
+        b = self.bushings
+        if getattr(self, "_kernel_bank", False) is not b.bank:
+            self._kernel_bank = b.bank
+            m, d = self.model, self.data
+            self._kernel = (d.qpos, d.qvel, d.qfrc_applied, d.ten_length, d.ten_velocity, d.ten_J.reshape(-1),
+                            m.jnt_stiffness, m.dof_damping, m.tendon_damping) + stepping.coupling_arrays(self)
+        return self._kernel
+
     def apply(self, dt: float) -> None:
-        """Compute and write the forces for the next step of length ``dt`` [s]."""
-        self.data.qfrc_applied[:] = 0.0
-        self.bushings.apply(dt)
-        self._dampers()
-        if self.sp_nonlinear:
-            self._spring_curves()
+        """Compute and write the forces for the next step of length ``dt`` [s] (one compiled call)."""
+        from vehicle import stepping
 
-    def _dampers(self) -> None:
-        m, d = self.model, self.data
-        velocity = np.where(self.dp_joint, d.qvel[np.where(self.dp_joint, self.dp_index, 0)],
-                            d.ten_velocity[np.where(self.dp_joint, 0, self.dp_index)])
-        speed = self.dp_sign * velocity  # compression speed
-        slope, offset = _segments(speed, self.dp_xs, self.dp_ys)
-        m.dof_damping[self.dp_index[self.dp_joint]] = slope[self.dp_joint]
-        m.tendon_damping[self.dp_tendons] = slope[~self.dp_joint]
-        self.dp_offset = offset
-        self._push(self.dp_joint, self.dp_index, self.dp_sign, offset)
-
-    def _spring_curves(self) -> None:
-        compression = self.spring_compression()
-        slope, offset = _segments(compression, self.sp_xs, self.sp_ys)
-        value = slope * compression + offset
-        remainder = value - self.sp_y0 - self.sp_rate * compression
-        self._push(self.sp_joint, self.sp_index, self.sp_sign, remainder)
-
-    def _push(self, joint: np.ndarray, index: np.ndarray, sign: np.ndarray, force: np.ndarray) -> None:
-        """Apply forces pushing apart [N] along joint or tendon coordinates (compression = sign·Δq)."""
-        d = self.data
-        gen = -sign * force
-        if joint.any():
-            np.add.at(d.qfrc_applied, index[joint], gen[joint])
-        if (~joint).any() and np.any(gen[~joint]):
-            jac = d.ten_J.reshape(self.model.ntendon, self.model.nv)[index[~joint]]
-            d.qfrc_applied += jac.T @ gen[~joint]
+        stepping.coupling_step(dt, *self.kernel_arrays())
+        b = self.bushings
+        if b.bank is not None:
+            b.bank_force = b.bank.force
 
     # -- outputs -----------------------------------------------------------------------------
     def spring_compression(self) -> np.ndarray:

@@ -75,6 +75,42 @@ class Damper:
 
 
 @dataclass(frozen=True)
+class Families:
+    """Laws read when ``--bushings`` names a model a direction's own law has no parameters for.
+
+    ``sets`` maps a model to a translation parameter set of models/bushings/ (``stvs: fig5_9``);
+    the set is scaled to the direction's own large-amplitude stiffness K0 (:func:`scaled_like`),
+    a rotation through the lever arm ``rotation_lever_arm`` [m] (θ [rad] ≡ ℓ·θ [m]).
+    """
+
+    sets: Mapping[str, str]
+    rotation_lever_arm: float           #: [m]
+
+
+NO_FAMILIES = Families({}, 1.0)
+
+
+def scaled_like(reference, K0: float, lever_arm: float = 1.0):
+    """``reference`` (SI :class:`bushings.ChannelParams` of a translation) scaled to stiffness ``K0``.
+
+    Forces scale by ``a`` at equal deflections; with ``lever_arm`` ℓ the result is a rotation law
+    T(θ) = ℓ·a·F(ℓ·θ) [N·m, rad]. ``a`` is chosen so that the result's K0 is ``K0``; the shape
+    (Kpa/K0, Kr/K0, deflection at which sliders slip, power-law exponent) is the reference's.
+    """
+    l = lever_arm
+    a = K0 / (l * l * reference.K0)
+    k = l * l * a  # stiffness and viscous factor
+    quantity = "translation" if l == 1.0 else "rotation"
+    return reference.replace(
+        quantity=quantity, K0=K0, C=k * reference.C, Kpa=k * reference.Kpa, Kr=k * reference.Kr,
+        Ff=l * a * reference.Ff, Co=a * reference.Co * l ** (1.0 + reference.pw),
+        Ct=(l * a) ** reference.n_root * l * reference.Ct,
+        N_sup=reference.N_sup / l, N_inf=reference.N_inf / l, S_sup=reference.S_sup / l,
+        S_inf=reference.S_inf / l, P_sup=l * a * reference.P_sup, P_inf=l * a * reference.P_inf,
+        maxwell_k=tuple(k * v for v in reference.maxwell_k), maxwell_c=tuple(k * v for v in reference.maxwell_c))
+
+
+@dataclass(frozen=True)
 class DirectionDef:
     """The force law of one bushing direction, as written in the vehicle file."""
 
@@ -83,23 +119,43 @@ class DirectionDef:
     model: str | None                   #: model to read the set as, or the inline model
     params: Mapping[str, Any] | None    #: inline parameters (thesis units), or None
     source: str                         #: file and key, for error messages
+    families: Families = NO_FAMILIES    #: laws for run-time models this one cannot be read as
 
     def channel(self, override_model: str | None = None):
         """SI :class:`bushings.ChannelParams` of this direction, optionally read as another model.
 
-        ``override_model`` replaces the model of every named set (run-time ``--bushings``);
-        inline linear directions (rotational stiffnesses mostly) stay linear.
+        ``override_model`` (run-time ``--bushings``) reads the direction's own set or inline
+        parameters as that model when they hold its parameters (an STVS set read as ``sts``
+        drops Co and pw; anything read as ``linear`` keeps K0); otherwise the vehicle's family
+        set of that model is scaled to the direction's own K0 (:class:`Families`).
         """
-        from bushings.parameters import load_parameter_set, to_si
+        from bushings.parameters import MODELS, load_parameter_set, to_si
 
-        if self.set_name is not None:
-            pset = load_parameter_set(self.set_name)
-            if pset.quantity != self.quantity:
-                raise InputError(f"parameter set {self.set_name!r} is a {pset.quantity} set; this "
-                                 f"direction needs a {self.quantity} set", source=self.source, key="set")
-            return pset.channel(override_model or self.model)
-        model = self.model if override_model is None or self.model == "linear" else override_model
-        return to_si(model, dict(self.params), self.quantity, source=self.source)
+        pset = load_parameter_set(self.set_name) if self.set_name is not None else None
+        if pset is not None and pset.quantity != self.quantity:
+            raise InputError(f"parameter set {self.set_name!r} is a {pset.quantity} set; this "
+                             f"direction needs a {self.quantity} set", source=self.source, key="set")
+        own = pset.values if pset is not None else self.params
+        target = override_model or self.model
+        if target is not None and target not in MODELS:
+            raise InputError(f"unknown model {target!r}; expected one of {', '.join(MODELS)}",
+                             source=self.source, key="model")
+        if target is None or set(MODELS[target][0]) <= set(own):
+            if pset is not None:
+                return pset.channel(target)
+            values = dict(own)
+            if target != self.model:  # reading inline parameters as another model keeps its own
+                values = {k: v for k, v in values.items() if k in MODELS[target][0] + MODELS[target][1]}
+            return to_si(target, values, self.quantity, source=self.source)
+        family = self.families.sets.get(target)
+        if family is None:
+            raise InputError(f"this direction's law has no {target} parameters and the vehicle names no "
+                             f"`bushing_families.sets.{target}`", source=self.source)
+        reference = load_parameter_set(family).channel(target)
+        if reference.quantity != "translation":
+            raise InputError(f"family set {family!r} must be a translation set", source=self.source)
+        lever = 1.0 if self.quantity == "translation" else self.families.rotation_lever_arm
+        return scaled_like(reference, self.channel().K0, lever)
 
 
 @dataclass(frozen=True)
@@ -259,7 +315,7 @@ def _masses(r: _Reader, names: tuple[str, ...]) -> dict[str, float]:
     return {name: r.number(name, positive=True) for name in names}
 
 
-def _direction(value: Any, source: str, key: str, quantity: str) -> DirectionDef:
+def _direction(value: Any, source: str, key: str, quantity: str, families: Families) -> DirectionDef:
     r = _Reader(value, source, key, ("set", "model", "params"))
     if ("set" in r.data) == ("params" in r.data):
         raise InputError("give either `set` (a parameter set of models/bushings/) or `model` with `params`",
@@ -271,14 +327,14 @@ def _direction(value: Any, source: str, key: str, quantity: str) -> DirectionDef
         name = r.raw("set")
         if not isinstance(name, str):
             raise InputError(f"expected a parameter-set name, got {name!r}", source=source, key=r.sub("set"))
-        d = DirectionDef(quantity, name, model, None, f"{source}: {key}")
+        d = DirectionDef(quantity, name, model, None, f"{source}: {key}", families)
     else:
         if model is None:
             raise InputError("missing key (inline parameters need a model)", source=source, key=r.sub("model"))
         if not isinstance(r.raw("params"), Mapping):
             raise InputError(f"expected a mapping of parameters, got {r.raw('params')!r}",
                              source=source, key=r.sub("params"))
-        d = DirectionDef(quantity, None, model, dict(r.raw("params")), f"{source}: {key}")
+        d = DirectionDef(quantity, None, model, dict(r.raw("params")), f"{source}: {key}", families)
     try:
         d.channel()  # validate now so that errors name the vehicle file and key
     except InputError as exc:
@@ -306,7 +362,7 @@ def _axis(value: Any, source: str, key: str, points: Mapping[str, np.ndarray]) -
     return v / np.linalg.norm(v)
 
 
-def _bushing(value: Any, source: str, key: str, points: Mapping[str, np.ndarray]) -> BushingDef:
+def _bushing(value: Any, source: str, key: str, points: Mapping[str, np.ndarray], families: Families) -> BushingDef:
     r = _Reader(value, source, key, ("name", "parent", "child", "location", "axes", "directions"))
     name = r.raw("name")
     if not isinstance(name, str) or not name.isidentifier():
@@ -337,9 +393,27 @@ def _bushing(value: Any, source: str, key: str, points: Mapping[str, np.ndarray]
     directions = {}
     for d in DIRECTIONS:
         quantity = "translation" if len(d) == 1 else "rotation"
-        directions[d] = _direction(dr.raw(d), source, dr.sub(d), quantity)
+        directions[d] = _direction(dr.raw(d), source, dr.sub(d), quantity, families)
     return BushingDef(name, "body", child, location,
                       (tuple(x.tolist()), tuple(y.tolist()), tuple(z.tolist())), directions)
+
+
+def _families(top: _Reader) -> Families:
+    if "bushing_families" not in top.data:
+        return NO_FAMILIES
+    from bushings.parameters import MODELS, load_parameter_set
+
+    r = top.reader("bushing_families", ("sets", "rotation_lever_arm"))
+    sets = r.raw("sets")
+    if not isinstance(sets, Mapping) or any(m not in MODELS or not isinstance(n, str) for m, n in sets.items()):
+        raise InputError(f"expected a mapping of model ({', '.join(MODELS)}) to parameter-set name, got {sets!r}",
+                         source=r.source, key=r.sub("sets"))
+    for m, n in sets.items():
+        try:
+            load_parameter_set(n).channel(m)
+        except InputError as exc:
+            raise InputError(str(exc), source=r.source, key=r.sub(f"sets.{m}")) from exc
+    return Families(dict(sets), r.number("rotation_lever_arm", positive=True))
 
 
 def load_vehicle(path: str | Path = DEFAULT_VEHICLE) -> VehicleDefinition:
@@ -352,7 +426,8 @@ def load_vehicle(path: str | Path = DEFAULT_VEHICLE) -> VehicleDefinition:
         data = yaml.safe_load(path.read_text())
     except yaml.YAMLError as exc:
         raise InputError(f"not valid YAML: {exc}", source=source) from exc
-    top = _Reader(data, source, "", ("name", "description", "tyre", "body", "front", "rear", "bushings"))
+    top = _Reader(data, source, "", ("name", "description", "tyre", "body", "front", "rear", "bushing_families",
+                                     "bushings"))
 
     t = top.reader("tyre", ("radius", "wheel_mass", "wheel_inertia"))
     inertia = t.vector("wheel_inertia", 2)
@@ -390,7 +465,8 @@ def load_vehicle(path: str | Path = DEFAULT_VEHICLE) -> VehicleDefinition:
     raw = top.raw("bushings")
     if not isinstance(raw, list) or not raw:
         raise InputError(f"expected a non-empty list of bushings, got {raw!r}", source=source, key="bushings")
-    bushings = tuple(_bushing(v, source, f"bushings[{i}]", points) for i, v in enumerate(raw))
+    families = _families(top)
+    bushings = tuple(_bushing(v, source, f"bushings[{i}]", points, families) for i, v in enumerate(raw))
     names = [bu.name for bu in bushings]
     if len(set(names)) != len(names):
         raise InputError(f"duplicate bushing names in {names}", source=source, key="bushings")

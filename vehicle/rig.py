@@ -15,12 +15,15 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from vehicle import stepping
 from vehicle.builder import CORNERS, BuildOptions, CarModel, build
 from vehicle.coupling import ForceCoupling
 from vehicle.definition import VehicleDefinition
 from vehicle.kinematics import wheel_angles
 from vehicle.statics import resolve_preloads
 
+_NO_INPUT = np.zeros(16)
+_INACTIVE = np.zeros(4, dtype=bool)
 _SIGN = {"front_left": 1.0, "front_right": -1.0, "rear_left": 1.0, "rear_right": -1.0}
 
 
@@ -35,6 +38,7 @@ class WheelOutputs:
     wheel_centre: np.ndarray    #: [m], world (= body, clamped) frame
     pad_force: np.ndarray       #: force of the pad on the wheel (Fx, Fy, Fz) [N]
     pad_height: float           #: measured pad (contact-point) displacement [m], bump positive
+    pad_torque: float = 0.0     #: aligning torque applied about the vertical [N·m]
 
 
 @dataclass(frozen=True)
@@ -90,13 +94,26 @@ class KCRig:
         d.xfrc_applied[self.carriage_body, 1] = fy
         d.xfrc_applied[self.wheel_body, 5] = mz
 
+    def reset(self) -> None:
+        """Back to the design pose at rest: virgin bushings, pads and rack at zero, no loads."""
+        mujoco.mj_resetData(self.model, self.data)
+        self.coupling.reset()
+        self.set_pads([0.0] * 4)
+        self.set_rack(0.0)
+
     # -- running -----------------------------------------------------------------------------
     def step(self, n: int = 1) -> None:
-        """Advance ``n`` time steps with the coupling called before each."""
+        """Advance ``n`` time steps with the coupling called before each (compiled loop)."""
+        self._run(n)
+
+    def _run(self, n: int, i0: int = 0, n_ramp: int = 1, start=_NO_INPUT, end=_NO_INPUT, active=_INACTIVE) -> None:
+        """``n`` compiled steps (vehicle.stepping.run), inputs ramped as ``run`` documents."""
         m, d = self.model, self.data
-        for _ in range(n):
-            self.coupling.apply(m.opt.timestep)
-            mujoco.mj_step(m, d)
+        stepping.run(n, i0, n_ramp, start, end, active, m.eq_data, self.pad_eq, d.xfrc_applied, self.carriage_body,
+                     self.wheel_body, m._address, d._address, m.opt.timestep, *self.coupling.kernel_arrays())
+        b = self.coupling.bushings
+        if b.bank is not None:
+            b.bank_force = b.bank.force
 
     def settle(self, duration: float = 1.0) -> None:
         """Run ``duration`` [s] with the inputs held."""
@@ -104,15 +121,29 @@ class KCRig:
 
     def pad_ramp(self, start, end, duration: float, samples: int = 0) -> list[RigOutputs]:
         """Move the pads linearly from ``start`` to ``end`` [m] in ``duration`` [s], sampling."""
+        return self.ramp(duration, samples, pads=(start, end))
+
+    def ramp(self, duration: float, samples: int = 0, pads=None, fx=None, fy=None, mz=None) -> list[RigOutputs]:
+        """Move inputs linearly over ``duration`` [s], measuring every ⌊steps/samples⌋ steps.
+
+        Each input given is a (start, end) pair of four values (order of ``CORNERS``): ``pads``
+        contact-point displacements [m], ``fx``/``fy`` contact-point forces [N], ``mz`` aligning
+        torques [N·m]; inputs not given are held.
+        """
         h = self.model.opt.timestep
         n = max(1, int(round(duration / h)))
         every = max(1, n // samples) if samples else n + 1
-        start, end = np.asarray(start, float), np.asarray(end, float)
+        groups = (pads, fx, fy, mz)
+        active = np.array([g is not None for g in groups])
+        start = np.concatenate([np.zeros(4) if g is None else np.asarray(g[0], float) for g in groups])
+        end = np.concatenate([np.zeros(4) if g is None else np.asarray(g[1], float) for g in groups])
         out = []
-        for i in range(1, n + 1):
-            self.set_pads(start + (end - start) * i / n)
-            self.step()
-            if i % every == 0:
+        done = 0
+        while done < n:
+            k = min(every - done % every, n - done)
+            self._run(k, done, n, start, end, active)
+            done += k
+            if done % every == 0:
                 out.append(self.measure())
         return out
 
@@ -151,7 +182,8 @@ class KCRig:
             centre = d.site_xpos[self.centre_site[k]].copy()
             force = np.array([d.xfrc_applied[self.carriage_body[k], 0], d.xfrc_applied[self.carriage_body[k], 1], fz[k]])
             wheels[corner] = WheelOutputs(camber, toe, math.atan2(heading[1], heading[0]), abs(centre[1]), centre,
-                                          force, float(d.qpos[self.pad_qpos[k]]))
+                                          force, float(d.qpos[self.pad_qpos[k]]),
+                                          float(d.xfrc_applied[self.wheel_body[k], 5]))
         c = self.coupling
         return RigOutputs(
             time=float(d.time), wheels=wheels, bushing_names=tuple(ch.name for ch in self.car.channels),

@@ -1,0 +1,202 @@
+"""`vsim run SCENARIO.yaml`: run a scenario on the K&C rig with a progress bar, record it, summarise it.
+
+The summary is computed from the recorded file (so it also describes an incomplete run): loop
+widths of camber, toe and half-track on each case's last cycle (periodic inputs), the toe drift
+over the final hold (rack steps), and the peak deflection of every bushing during the inputs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+from typing import TextIO
+
+import numpy as np
+
+from vehicle.model_cli import BUSHING_MODELS
+
+#: Loop widths are read over this fraction of each loop's common input range (as vehicle.kc).
+FIT_FRACTION = 0.8
+SUMMARY_CORNERS = {"front": "fl", "rear": "rl"}   #: the left wheel of each axle is summarised
+_DIRECTIONS = ("x", "y", "z", "rx", "ry", "rz")
+
+
+class ProgressBar:
+    """A progress line on ``stream``: rewritten in place on a terminal (at most every
+    ``interval_s``), else one line per case and phase."""
+
+    def __init__(self, stream: TextIO | None = None, interval_s: float = 0.2, width: int = 30):
+        self.stream = stream if stream is not None else sys.stderr
+        self.interval_s, self.width = interval_s, width
+        self.live = self.stream.isatty()
+        self.started = time.perf_counter()
+        self.shown_at = -1.0
+        self.last_stage = None
+        self.dirty = False
+
+    def __call__(self, p) -> None:
+        """Show a :class:`vehicle.runner.Progress`."""
+        from vehicle.runner import PHASES
+
+        now = time.perf_counter()
+        stage = (p.case, p.phase)
+        if not self.live:
+            if stage != self.last_stage:
+                print(f"case {p.case}/{p.cases} {p.label}: {PHASES[p.phase]}", file=self.stream, flush=True)
+            self.last_stage = stage
+            return
+        if now - self.shown_at < self.interval_s and stage == self.last_stage:
+            return
+        self.shown_at, self.last_stage, self.dirty = now, stage, True
+        fraction = min(1.0, p.done_s / p.total_s) if p.total_s > 0 else 1.0
+        filled = int(round(fraction * self.width))
+        elapsed = now - self.started
+        remaining = elapsed * (1.0 - fraction) / fraction if fraction > 0 else float("nan")
+        line = (f"\r[{'#' * filled}{'.' * (self.width - filled)}] {100 * fraction:3.0f}%  "
+                f"case {p.case}/{p.cases} {p.label} ({PHASES[p.phase]})  "
+                f"sim {p.done_s:.1f}/{p.total_s:.1f} s  wall {elapsed:.0f} s, ~{remaining:.0f} s left")
+        self.stream.write(line + "\x1b[K")
+        self.stream.flush()
+
+    def close(self) -> None:
+        """End the progress line."""
+        if self.dirty:
+            self.stream.write("\n")
+            self.stream.flush()
+            self.dirty = False
+
+
+def _case_mask(run, case: dict, last_cycle: bool) -> np.ndarray:
+    """Samples of ``case``'s input phase (or of its last cycle)."""
+    start, end = case["input_start_s"], case["end_s"]
+    if last_cycle:
+        start += (end - start) * (case["cycles"] - 1) / case["cycles"]
+    return (run.signals["case"] == case["case"]) & (run.signals["phase"] == 2) & (run.t_s >= start - 1e-9)
+
+
+def loop_widths(run, case: dict, x: str, y: str, driver: str) -> tuple[float, float]:
+    """(width at x = 0, largest width) of the loop of signal ``y`` against ``x`` on the last cycle of
+    ``case``; branches are split by the direction of the input signal ``driver``. NaN when the
+    recording does not hold both branches."""
+    from vehicle.kc import Branches, loop_width
+
+    mask = _case_mask(run, case, last_cycle=True)
+    xs, ys, drive = run.signals[x][mask], run.signals[y][mask], run.signals[driver][mask]
+    change = np.diff(drive, prepend=drive[:1])
+    down, up = change < 0, change > 0
+    if down.sum() < 2 or up.sum() < 2:
+        return float("nan"), float("nan")
+    window = FIT_FRACTION * min(xs[down].max(), xs[up].max(), -xs[down].min(), -xs[up].min())
+    if not window > 0:
+        return float("nan"), float("nan")
+    return loop_width(Branches(xs[down], ys[down], xs[up], ys[up]), window)
+
+
+def _loop_table(run, extra: dict) -> list[str]:
+    x_quantity = extra["x_quantity"]
+    driver = "pad_z" if x_quantity == "wheel_travel" else x_quantity
+    rows = [f"loop widths on the last cycle, left wheels, at {'design height' if driver == 'pad_z' else 'zero load'}"
+            f" (largest over ±{FIT_FRACTION:.0%} of the range):",
+            f"  {'case':<28} {'wheel':<5} {'camber [deg]':>20} {'toe [deg]':>20} {'half-track [mm]':>20}"]
+    for case in extra["cases"]:
+        if not _case_mask(run, case, last_cycle=True).any():
+            continue  # not reached by an incomplete run
+        for axle in extra["axles"]:
+            tag = SUMMARY_CORNERS[axle]
+            cells = []
+            for quantity in ("camber", "toe", "half_track"):
+                at, most = loop_widths(run, case, f"{x_quantity}_{tag}", f"{quantity}_{tag}", f"{driver}_{tag}")
+                cells.append(f"{at:9.4f} ({most:8.4f})")
+            rows.append(f"  {case['label'][:28]:<28} {tag:<5} {cells[0]:>20} {cells[1]:>20} {cells[2]:>20}")
+    return rows
+
+
+def _drift_table(run, extra: dict) -> list[str]:
+    rows = ["toe over the final hold (relaxation), front wheels [deg]:",
+            f"  {'case':<28} {'wheel':<5} {'hold start':>11} {'end':>11} {'drift':>11}"]
+    for case in extra["cases"]:
+        hold = case.get("hold_from_s")
+        mask = _case_mask(run, case, last_cycle=False)
+        if hold is None or not mask.any():
+            continue
+        held = mask & (run.t_s >= hold - 1e-9)
+        for tag in ("fl", "fr"):
+            toe = run.signals[f"toe_{tag}"][held]
+            if toe.size:
+                rows.append(f"  {case['label'][:28]:<28} {tag:<5} {toe[0]:11.4f} {toe[-1]:11.4f} {toe[-1] - toe[0]:11.4f}")
+    return rows
+
+
+def _peak_table(run) -> list[str]:
+    inputs = run.signals["phase"] == 2
+    bushings = sorted({s.group.removeprefix("bushing_") for s in run.specs if s.group.startswith("bushing_")})
+    rows = ["peak bushing deflections during the inputs (|x|, |y|, |z| [mm]; |rx|, |ry|, |rz| [deg]):",
+            f"  {'bushing':<20}" + "".join(f"{d:>8}" for d in _DIRECTIONS)]
+    for b in bushings:
+        peaks = [np.abs(run.signals[f"{b}_{d}_deflection"][inputs]).max(initial=0.0) for d in _DIRECTIONS]
+        rows.append(f"  {b:<20}" + "".join(f"{v:8.3f}" for v in peaks))
+    return rows
+
+
+def summary(run) -> str:
+    """The text summary of a recorded run (:class:`vehicle.io.Run` written by the runner)."""
+    extra = run.metadata.extra
+    status = "complete" if run.complete else f"INCOMPLETE ({run.reason})"
+    lines = [f"{extra['scenario']} ({extra['type']}, bushings: {extra['bushing_model']}): "
+             f"{len(extra['cases'])} case(s), {run.t_s[-1] if run.t_s.size else 0.0:.1f} s recorded, {status}"]
+    if extra["duration_scale"] != 1.0:
+        lines.append(f"durations scaled by {extra['duration_scale']:g}: rates differ from the scenario's, "
+                     f"and so do rate-dependent loops")
+    if extra["x_quantity"] is not None:
+        lines += _loop_table(run, extra)
+    else:
+        lines += _drift_table(run, extra)
+    return "\n".join(lines + _peak_table(run))
+
+
+def _run(args: argparse.Namespace) -> int:
+    from vehicle.io import load_run
+    from vehicle.runner import DivergenceError, default_output, run_scenario
+    from vehicle.scenarios import load_scenario
+
+    scenario = load_scenario(args.scenario)
+    output = args.output or default_output(scenario)
+    bar = ProgressBar()
+    status, note = 0, ""
+    started = time.perf_counter()
+    try:
+        result = run_scenario(scenario, output, bushing_model=args.bushings, overwrite=args.overwrite,
+                              duration_scale=args.duration_scale, progress=bar)
+        note = f"({result.simulated_s:.1f} s simulated in {result.wall_s:.1f} s, " \
+               f"{result.simulated_s / result.wall_s:.1f}x real time)"
+    except DivergenceError as exc:
+        status, note = 1, f"stopped: {exc}"
+    except KeyboardInterrupt:
+        status, note = 130, f"interrupted after {time.perf_counter() - started:.0f} s"
+    finally:
+        bar.close()
+    if status:
+        kept = f"the incomplete recording is kept in {output}" if output.exists() else "nothing was recorded"
+        print(f"vsim: run {note}; {kept}", file=sys.stderr)
+    if output.exists():
+        print(summary(load_run(output)))
+        print(f"wrote {output} {note if not status else '(incomplete)'}")
+    return status
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add the ``run`` sub-command."""
+    run = subparsers.add_parser(
+        "run", help="run a scenario (.yaml) on the K&C rig and record it (.mcap)",
+        description="Run every case of a scenario file (format: scenarios/README.md) and record them in one "
+                    "MCAP file; print a summary (loop widths, relaxation, peak bushing deflections).")
+    run.add_argument("scenario", type=Path, metavar="SCENARIO.yaml")
+    run.add_argument("-o", "--output", type=Path, metavar="OUT.mcap", help="run file (default: out/<scenario>.mcap)")
+    run.add_argument("--bushings", choices=BUSHING_MODELS, default=None,
+                     help="read every bushing parameter set as this model (overrides the scenario)")
+    run.add_argument("--overwrite", action="store_true", help="replace an existing output file")
+    run.add_argument("--duration-scale", type=float, default=1.0, metavar="X",
+                     help="multiply every duration (settle phases, periods, holds) by X, e.g. 0.1 for a quick run")
+    run.set_defaults(func=_run)

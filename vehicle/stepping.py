@@ -1,0 +1,148 @@
+"""Compiled stepping: the coupling of :mod:`vehicle.coupling` and ``mj_step`` in one numba loop.
+
+Per step the Python path costs a few numpy calls per force group (~150 µs on the rig); here the
+inputs, the bushing bank step, the damper and spring laws and ``mj_step`` (called through
+ctypes on the model's and data's addresses) all run in compiled code, so a step costs
+``mj_step`` plus the bank kernel. Results are identical to the Python path (same operations in
+the same order; see tests/test_vehicle_rig.py).
+
+Arrays of ``MjModel``/``MjData`` are numpy views of MuJoCo's memory, so the loop reads and writes
+them in place.
+"""
+
+from __future__ import annotations
+
+import ctypes
+from pathlib import Path
+
+import mujoco
+import numba as nb
+import numpy as np
+
+from bushings import kernel as _kn
+
+_LIB = ctypes.CDLL(str(next(Path(mujoco.__file__).parent.glob("libmujoco.so*"))))
+_mj_step = _LIB.mj_step
+_mj_step.argtypes = (ctypes.c_size_t, ctypes.c_size_t)  # mjModel*, mjData* as addresses
+_mj_step.restype = None
+
+
+def bank_args(bank) -> tuple:
+    """The state and parameter arrays :func:`bushings.kernel.step_bank` takes after (e, h), in order.
+
+    Mirrors :meth:`bushings.BushingBank.step`; kept in this one place (the bank has no public
+    accessor for them yet).
+    """
+    return (bank.P, bank.I, bank.MX, bank.u, bank.wprev, bank.wprev2, bank.q, bank.eprev, bank.cs, bank.ck,
+            bank.stack, bank.diss, bank.nfail, bank.force, bank.tangent, bank._work, bank._iwork)
+
+
+@nb.njit(cache=True)
+def _segment(x, xs, ys):
+    """Slope and intercept of the padded curve (xs, ys) at x (linear extrapolation at the ends)."""
+    n = xs.shape[0]
+    i = 0
+    while i < n - 2 and xs[i + 1] <= x:
+        i += 1
+    slope = (ys[i + 1] - ys[i]) / (xs[i + 1] - xs[i])
+    return slope, ys[i] - slope * xs[i]
+
+
+@nb.njit(cache=True)
+def _push(qfrc, ten_J, joint, index, gen):
+    """Add generalised forces ``gen`` along joint dofs or tendons (through their Jacobian rows)."""
+    nv = qfrc.shape[0]
+    for k in range(gen.shape[0]):
+        if joint[k]:
+            qfrc[index[k]] += gen[k]
+        elif gen[k] != 0.0:
+            row = index[k] * nv
+            for j in range(nv):
+                qfrc[j] += ten_J[row + j] * gen[k]
+
+
+@nb.njit(cache=True)
+def coupling_step(h, qpos, qvel, qfrc, ten_length, ten_velocity, ten_J, jnt_stiffness, dof_damping,
+                  tendon_damping, bush, bank, damp, spring):
+    """Write the non-implicit forces for the next step of ``h`` [s] (see vehicle.coupling).
+
+    ``bush`` = (qpos adr, dof adr, joint ids, base stiffness, K_ref, saturating, e work) of the
+    bank channels, ``bank`` = :func:`bank_args`, ``damp`` = (is joint, dof or tendon index, sign,
+    xs, ys, intercept out [N], work), ``spring`` = (is joint, index, qpos adr, design, sign, xs, ys, rate, y0,
+    nonlinear?, remainder work).
+    """
+    qfrc[:] = 0.0
+    bq, bd, bj, kbase, kref, sat, e = bush
+    if bq.shape[0]:
+        for c in range(bq.shape[0]):
+            e[c] = qpos[bq[c]]
+        _kn.step_bank(e, h, *bank)
+        force, tangent = bank[13], bank[14]
+        for c in range(bq.shape[0]):
+            if sat[c]:
+                kref[c] = max(kbase[c], tangent[c])
+                jnt_stiffness[bj[c]] = kref[c]
+            qfrc[bd[c]] += kref[c] * e[c] - force[c]
+    joint, index, sign, xs, ys, offset, gen = damp
+    for k in range(joint.shape[0]):
+        v = qvel[index[k]] if joint[k] else ten_velocity[index[k]]
+        slope, offset[k] = _segment(sign[k] * v, xs[k], ys[k])
+        if joint[k]:
+            dof_damping[index[k]] = slope
+        else:
+            tendon_damping[index[k]] = slope
+        gen[k] = -sign[k] * offset[k]  # compression = sign·Δq: a force pushing apart acts along −sign
+    _push(qfrc, ten_J, joint, index, gen)
+    sjoint, sindex, sqadr, design, ssign, sxs, sys_, rate, y0, nonlinear, rem = spring
+    if nonlinear:
+        for k in range(sjoint.shape[0]):
+            coord = qpos[sqadr[k]] if sjoint[k] else ten_length[sindex[k]]
+            x = ssign[k] * (coord - design[k])
+            slope, icpt = _segment(x, sxs[k], sys_[k])
+            rem[k] = -ssign[k] * (slope * x + icpt - y0[k] - rate[k] * x)
+        _push(qfrc, ten_J, sjoint, sindex, rem)
+
+
+@nb.njit
+def run(n, i0, n_ramp, start, end, active, eq_data, pad_eq, xfrc, carriage, wheel, m_addr, d_addr, h,
+        qpos, qvel, qfrc, ten_length, ten_velocity, ten_J, jnt_stiffness, dof_damping, tendon_damping,
+        bush, bank, damp, spring):
+    """Advance ``n`` steps; rig inputs move linearly from ``start`` to ``end`` over ``n_ramp`` steps.
+
+    Inputs (16 values): pad heights [m], Fx, Fy [N] at the carriages, Mz [N·m] at the wheels, four
+    corners each; ``active[g]`` says whether group g is driven (else left as is). Step ``i0 + i``
+    of the ramp (1-based) sets start + (end − start)·(i0 + i)/n_ramp. Not cached: it holds the
+    address of ``mj_step``.
+    """
+    for i in range(1, n + 1):
+        f = (i0 + i) / n_ramp
+        for c in range(4):
+            if active[0]:
+                eq_data[pad_eq[c], 0] = start[c] + (end[c] - start[c]) * f
+            if active[1]:
+                xfrc[carriage[c], 0] = start[4 + c] + (end[4 + c] - start[4 + c]) * f
+            if active[2]:
+                xfrc[carriage[c], 1] = start[8 + c] + (end[8 + c] - start[8 + c]) * f
+            if active[3]:
+                xfrc[wheel[c], 5] = start[12 + c] + (end[12 + c] - start[12 + c]) * f
+        coupling_step(h, qpos, qvel, qfrc, ten_length, ten_velocity, ten_J, jnt_stiffness, dof_damping,
+                      tendon_damping, bush, bank, damp, spring)
+        _mj_step(m_addr, d_addr)
+
+
+def coupling_arrays(coupling) -> tuple:
+    """The (bush, bank, damp, spring) tuples of :func:`coupling_step` for a ForceCoupling."""
+    from bushings import BushingBank
+
+    b = coupling.bushings
+    on = b.bank is not None  # None: laws off, every direction linear in its joint
+    idx = b.bank_idx if on else np.zeros(0, np.int64)
+    bush = (b.qpos[idx].astype(np.int64), b.dof[idx].astype(np.int64), b.jnt[idx].astype(np.int64), b.K[idx].copy(),
+            b.K_ref if on else np.zeros(0), b.saturating if on else np.zeros(0, np.bool_), np.zeros(idx.size))
+    bank = bank_args(b.bank if on else BushingBank([]))
+    c = coupling
+    damp = (c.dp_joint, c.dp_index.astype(np.int64), c.dp_sign.astype(float), c.dp_xs, c.dp_ys, c.dp_offset,
+            np.zeros(len(c.dp_offset)))
+    spring = (c.sp_joint, c.sp_index.astype(np.int64), c.sp_qadr.astype(np.int64), c.sp_design, c.sp_sign.astype(float),
+              c.sp_xs, c.sp_ys, c.sp_rate, c.sp_y0, bool(c.sp_nonlinear), np.zeros(len(c.sp_rate)))
+    return bush, bank, damp, spring
