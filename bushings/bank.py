@@ -27,7 +27,7 @@ class BushingBank:
     forces [N or N·m] and tangent stiffnesses dF/de. One compiled call serves the whole bank.
     """
 
-    _STATE = ("u", "wprev", "wprev2", "q", "eprev", "cs", "ck", "stack", "diss", "nfail")
+    _STATE = ("u", "wprev", "slope", "q", "eprev", "cs", "ck", "stack", "diss", "nfail")
 
     def __init__(self, channels: Sequence[ChannelParams], tolerance: float = 1e-9):
         """``tolerance`` [m or rad]: the implicit ladder solve stops when every node's force
@@ -68,7 +68,7 @@ class BushingBank:
         max_cells = max([ch.n_cells for ch in self.channels] + [1])
         self._work = np.zeros((8, max_cells))
         self._iwork = np.zeros(max_cells, dtype=np.int64)
-        self._shapes = {"u": (max(n_nodes, 1),), "wprev": (max(n_nodes, 1),), "wprev2": (max(n_nodes, 1),), "q": (max(n_mx, 1),),
+        self._shapes = {"u": (max(n_nodes, 1),), "wprev": (max(n_nodes, 1),), "slope": (max(n_nodes, 1),), "q": (max(n_mx, 1),),
                         "eprev": (M,), "cs": (M, 2), "ck": (M,), "stack": (M, kn.STACK_SIZE, 2),
                         "diss": (M,), "nfail": (M,)}
         self.force = np.zeros(M)
@@ -114,7 +114,7 @@ class BushingBank:
         if not dt > 0.0:
             raise ValueError(f"time step must be positive, got {dt!r}")
         kn.step_bank(np.ascontiguousarray(e, dtype=float), float(dt), self.P, self.I, self.MX,
-                     self.u, self.wprev, self.wprev2, self.q, self.eprev, self.cs, self.ck, self.stack,
+                     self.u, self.wprev, self.slope, self.q, self.eprev, self.cs, self.ck, self.stack,
                      self.diss, self.nfail, self.force, self.tangent, self._work, self._iwork)
         return self.force, self.tangent
 

@@ -108,7 +108,7 @@ def _release(a, ks, h, Ff, Co, pw):
 
 
 @nb.njit(cache=True, fastmath=_FAST)
-def _ladder_step(e, h, n, Kpa, Kr, Ff, Co, pw, tol_x, u, wprev, wprev2, w, st, dflat, sub, rhs, cp, dp, a0, dval):
+def _ladder_step(e, de, h, n, Kpa, Kr, Ff, Co, pw, tol_x, u, wprev, slope, w, st, dflat, sub, rhs, cp, dp, a0, dval):
     """Advance one ladder of n nodes to deflection e; returns (F_ladder, dF/de, energy dissipated, ok).
 
     Converged when every node's force residual is below tol_x·(Kpa + 2·Kr), i.e. the nodes are
@@ -118,13 +118,39 @@ def _ladder_step(e, h, n, Kpa, Kr, Ff, Co, pw, tol_x, u, wprev, wprev2, w, st, d
     # is exact, and a Coulomb ladder (one linear solve per active set) is solved to round-off.
     tol_stick = 1e-13 * (Kpa + 2.0 * Kr)
     tol = tol_x * (Kpa + 2.0 * Kr) if Co > 0.0 else tol_stick
+    # Predictor: one Newton step from the last increment with the last converged slopes (no
+    # transcendental calls): the residual of w = wprev at the new step is Kpa·Δe·δ_i1 − (K·wprev)_i.
     for i in range(n):
-        # Predictor: the increment extrapolated geometrically from the last two steps (slip rates
-        # of a power-law node change by factors, not by differences), the ratio kept moderate.
+        st[i] = 0 if wprev[i] == 0.0 else (1 if wprev[i] > 0.0 else -1)
         w[i] = wprev[i]
-        if wprev[i] * wprev2[i] > 0.0:
-            w[i] *= min(max(wprev[i] / wprev2[i], 0.05), 20.0)
-        st[i] = 0 if w[i] == 0.0 else (1 if w[i] > 0.0 else -1)
+    for i in range(n):
+        if st[i] == 0:
+            rhs[i] = 0.0
+            diag = 1.0
+            sub[i] = 0.0
+        else:
+            kl = Kpa if i == 0 else Kr
+            kw = (kl + Kr) * wprev[i]
+            if i > 0:
+                kw -= Kr * wprev[i - 1]
+            if i < n - 1:
+                kw -= Kr * wprev[i + 1]
+            rhs[i] = (Kpa * de if i == 0 else 0.0) - kw
+            diag = kl + Kr + slope[i]
+            sub[i] = -Kr if (i > 0 and st[i - 1] != 0) else 0.0
+        if i == 0:
+            dp[i] = diag
+        else:
+            m = sub[i] / dp[i - 1]
+            dp[i] = diag - m * cp[i - 1]
+            rhs[i] -= m * rhs[i - 1]
+        if i < n - 1:
+            cp[i] = -Kr if (st[i] != 0 and st[i + 1] != 0) else 0.0
+    for i in range(n - 1, -1, -1):
+        nxt = rhs[i + 1] if i < n - 1 else 0.0
+        rhs[i] = (rhs[i] - cp[i] * nxt) / dp[i]
+        if st[i] != 0 and (wprev[i] + rhs[i]) * st[i] > 0.0:
+            w[i] = wprev[i] + rhs[i]
     ok = False
     for _ in range(_MAX_NEWTON):
         # Spring imbalance ΔF_i = k_left(u_{i-1} − u_i) − Kr(u_i − u_{i+1}) at u = u_old + w.
@@ -224,8 +250,8 @@ def _ladder_step(e, h, n, Kpa, Kr, Ff, Co, pw, tol_x, u, wprev, wprev2, w, st, d
         if st[i] != 0:
             diss += dval[i] * abs(w[i])
         u[i] += w[i]
-        wprev2[i] = wprev[i]
         wprev[i] = w[i]
+        slope[i] = dflat[i] if st[i] != 0 else 0.0
     du1 = 0.0
     if st[0] != 0:
         # Solve A x = e_1 restricted to the leading run of slipping nodes (the others are fixed).
@@ -327,7 +353,7 @@ def _continuous_step(x, Kpa, Ct, nroot, eps, stack, cs, ck):
 
 
 @nb.njit(cache=True, fastmath=_FAST)
-def step_bank(e, h, P, I, MX, u, wprev, wprev2, q, eprev, cs, ck, stack, diss, nfail, F, K, work, iwork):
+def step_bank(e, h, P, I, MX, u, wprev, slope, q, eprev, cs, ck, stack, diss, nfail, F, K, work, iwork):
     """Advance all channels of a bank by one step of h seconds to deflections e (in place)."""
     M = e.shape[0]
     for c in range(M):
@@ -345,8 +371,8 @@ def step_bank(e, h, P, I, MX, u, wprev, wprev2, q, eprev, cs, ck, stack, diss, n
             if n > 0:
                 o = I[c, I_NODE_OFF]
                 fl, kl, dl, ok = _ladder_step(
-                    x, h, n, P[c, P_KPA], P[c, P_KR], P[c, P_FF], P[c, P_CO], P[c, P_PW], P[c, P_TOL],
-                    u[o:o + n], wprev[o:o + n], wprev2[o:o + n], work[0, :n], iwork[:n], work[1, :n],
+                    x, de, h, n, P[c, P_KPA], P[c, P_KR], P[c, P_FF], P[c, P_CO], P[c, P_PW], P[c, P_TOL],
+                    u[o:o + n], wprev[o:o + n], slope[o:o + n], work[0, :n], iwork[:n], work[1, :n],
                     work[2, :n], work[3, :n], work[4, :n], work[5, :n], work[6, :n], work[7, :n])
                 f += fl
                 k += kl
