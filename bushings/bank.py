@@ -66,7 +66,7 @@ class BushingBank:
                 self.MX[mx] = (k, cc)
                 mx += 1
         max_cells = max([ch.n_cells for ch in self.channels] + [1])
-        self._work = np.zeros((8, max_cells))
+        self._work = np.zeros((7, max_cells))
         self._iwork = np.zeros(max_cells, dtype=np.int64)
         self._shapes = {"u": (max(n_nodes, 1),), "wprev": (max(n_nodes, 1),), "slope": (max(n_nodes, 1),), "q": (max(n_mx, 1),),
                         "eprev": (M,), "cs": (M, 2), "ck": (M,), "stack": (M, kn.STACK_SIZE, 2),

@@ -107,8 +107,35 @@ def _release(a, ks, h, Ff, Co, pw):
     return w
 
 
+@nb.njit(cache=True, inline="always", fastmath=_FAST)
+def _solve_active(n, st, Kpa, Kr, slope, rhs, cp, dp):
+    """Solve (K + diag(slope)) x = rhs in place on the slipping nodes (st ≠ 0); stuck nodes get x = 0.
+
+    K is the ladder stiffness (diagonal k_left + Kr, off-diagonal −Kr); Thomas algorithm.
+    """
+    for i in range(n):
+        if st[i] == 0:
+            diag = 1.0
+            rhs[i] = 0.0
+            lower = 0.0
+        else:
+            diag = (Kpa if i == 0 else Kr) + Kr + slope[i]
+            lower = -Kr if (i > 0 and st[i - 1] != 0) else 0.0
+        if i == 0:
+            dp[i] = diag
+        else:
+            m = lower / dp[i - 1]
+            dp[i] = diag - m * cp[i - 1]
+            rhs[i] -= m * rhs[i - 1]
+        if i < n - 1:  # the upper diagonal of row i is the lower diagonal of row i+1
+            cp[i] = -Kr if (st[i] != 0 and st[i + 1] != 0) else 0.0
+    for i in range(n - 1, -1, -1):
+        nxt = rhs[i + 1] if i < n - 1 else 0.0
+        rhs[i] = (rhs[i] - cp[i] * nxt) / dp[i]
+
+
 @nb.njit(cache=True, fastmath=_FAST)
-def _ladder_step(e, de, h, n, Kpa, Kr, Ff, Co, pw, tol_x, u, wprev, slope, w, st, dflat, sub, rhs, cp, dp, a0, dval):
+def _ladder_step(e, de, h, n, Kpa, Kr, Ff, Co, pw, tol_x, u, wprev, slope, w, st, dflat, rhs, cp, dp, a0, dval):
     """Advance one ladder of n nodes to deflection e; returns (F_ladder, dF/de, energy dissipated, ok).
 
     Converged when every node's force residual is below tol_x·(Kpa + 2·Kr), i.e. the nodes are
@@ -124,31 +151,15 @@ def _ladder_step(e, de, h, n, Kpa, Kr, Ff, Co, pw, tol_x, u, wprev, slope, w, st
         st[i] = 0 if wprev[i] == 0.0 else (1 if wprev[i] > 0.0 else -1)
         w[i] = wprev[i]
     for i in range(n):
-        if st[i] == 0:
-            rhs[i] = 0.0
-            diag = 1.0
-            sub[i] = 0.0
-        else:
-            kl = Kpa if i == 0 else Kr
-            kw = (kl + Kr) * wprev[i]
+        if st[i] != 0:
+            kw = ((Kpa if i == 0 else Kr) + Kr) * wprev[i]
             if i > 0:
                 kw -= Kr * wprev[i - 1]
             if i < n - 1:
                 kw -= Kr * wprev[i + 1]
             rhs[i] = (Kpa * de if i == 0 else 0.0) - kw
-            diag = kl + Kr + slope[i]
-            sub[i] = -Kr if (i > 0 and st[i - 1] != 0) else 0.0
-        if i == 0:
-            dp[i] = diag
-        else:
-            m = sub[i] / dp[i - 1]
-            dp[i] = diag - m * cp[i - 1]
-            rhs[i] -= m * rhs[i - 1]
-        if i < n - 1:
-            cp[i] = -Kr if (st[i] != 0 and st[i + 1] != 0) else 0.0
-    for i in range(n - 1, -1, -1):
-        nxt = rhs[i + 1] if i < n - 1 else 0.0
-        rhs[i] = (rhs[i] - cp[i] * nxt) / dp[i]
+    _solve_active(n, st, Kpa, Kr, slope, rhs, cp, dp)
+    for i in range(n):
         if st[i] != 0 and (wprev[i] + rhs[i]) * st[i] > 0.0:
             w[i] = wprev[i] + rhs[i]
     ok = False
@@ -186,28 +197,8 @@ def _ladder_step(e, de, h, n, Kpa, Kr, Ff, Co, pw, tol_x, u, wprev, slope, w, st
             break
         if nreleased > 0:
             continue  # re-evaluate residuals with the released nodes' first guesses
-        # Newton: (K + diag ψ') δ = R on slipping nodes, stuck nodes fixed; Thomas algorithm.
-        for i in range(n):
-            if st[i] == 0:
-                diag = 1.0
-                rhs[i] = 0.0
-                sub[i] = 0.0
-            else:
-                diag = (Kpa if i == 0 else Kr) + Kr + dflat[i]
-                sub[i] = -Kr if (i > 0 and st[i - 1] != 0) else 0.0
-            if i == 0:
-                cp[i] = 0.0
-                dp[i] = diag
-            else:
-                m = sub[i] / dp[i - 1]
-                dp[i] = diag - m * cp[i - 1]
-                rhs[i] -= m * rhs[i - 1]
-            # super-diagonal of row i equals the sub-diagonal of row i+1 (symmetric)
-            if i < n - 1:
-                cp[i] = -Kr if (st[i] != 0 and st[i + 1] != 0) else 0.0
-        for i in range(n - 1, -1, -1):
-            nxt = rhs[i + 1] if i < n - 1 else 0.0
-            rhs[i] = (rhs[i] - cp[i] * nxt) / dp[i]
+        # Newton: (K + diag ψ') δ = R on slipping nodes, stuck nodes fixed.
+        _solve_active(n, st, Kpa, Kr, dflat, rhs, cp, dp)
         for i in range(n):
             if st[i] == 0:
                 continue
@@ -254,24 +245,11 @@ def _ladder_step(e, de, h, n, Kpa, Kr, Ff, Co, pw, tol_x, u, wprev, slope, w, st
         slope[i] = dflat[i] if st[i] != 0 else 0.0
     du1 = 0.0
     if st[0] != 0:
-        # Solve A x = e_1 restricted to the leading run of slipping nodes (the others are fixed).
-        m_end = 0
-        while m_end < n and st[m_end] != 0:
-            m_end += 1
-        # Thomas forward sweep with rhs = e_1, then back-substitute for x_1 only.
-        for i in range(m_end):
-            diag = (Kpa if i == 0 else Kr) + Kr + dflat[i]
-            if i == 0:
-                dp[0] = diag
-                rhs[0] = 1.0
-            else:
-                m = -Kr / dp[i - 1]
-                dp[i] = diag - m * (-Kr)
-                rhs[i] = -m * rhs[i - 1]
-        x = rhs[m_end - 1] / dp[m_end - 1]
-        for i in range(m_end - 2, -1, -1):
-            x = (rhs[i] + Kr * x) / dp[i]
-        du1 = Kpa * x
+        for i in range(n):
+            rhs[i] = 0.0
+        rhs[0] = 1.0
+        _solve_active(n, st, Kpa, Kr, dflat, rhs, cp, dp)
+        du1 = Kpa * rhs[0]
     return Kpa * (e - u[0]), Kpa * (1.0 - du1), diss, ok
 
 
@@ -373,7 +351,7 @@ def step_bank(e, h, P, I, MX, u, wprev, slope, q, eprev, cs, ck, stack, diss, nf
                 fl, kl, dl, ok = _ladder_step(
                     x, de, h, n, P[c, P_KPA], P[c, P_KR], P[c, P_FF], P[c, P_CO], P[c, P_PW], P[c, P_TOL],
                     u[o:o + n], wprev[o:o + n], slope[o:o + n], work[0, :n], iwork[:n], work[1, :n],
-                    work[2, :n], work[3, :n], work[4, :n], work[5, :n], work[6, :n], work[7, :n])
+                    work[2, :n], work[3, :n], work[4, :n], work[5, :n], work[6, :n])
                 f += fl
                 k += kl
                 diss[c] += dl
