@@ -64,7 +64,7 @@ def test_shortened_default_scenario_runs_and_records(tmp_path: Path, name: str, 
     for spec in run.specs:
         assert np.all(np.isfinite(run.signals[spec.name])), spec.name
     text = summary(run)
-    assert "peak bushing deflections" in text and ("loop widths" in text or "toe over the final hold" in text)
+    assert "peak bushing deflections" in text and ("gradient = centre-line slope" in text or "toe over the final hold" in text)
 
 
 def test_pumping_records_loops_against_wheel_travel(tmp_path: Path) -> None:
@@ -77,8 +77,11 @@ def test_pumping_records_loops_against_wheel_travel(tmp_path: Path) -> None:
     inputs = run.signals["phase"] == 2
     travel = run.signals["wheel_travel_fl"][inputs]
     assert travel.max() == pytest.approx(20.0, abs=1.5) and travel.min() == pytest.approx(-20.0, abs=1.5)
-    text = summary(run)
-    assert "loop widths" in text and "nan" not in text.split("peak")[0], text
+    rows = [line.split() for line in summary(run).splitlines() if line.startswith("  amplitude_mm=20")]
+    assert [r[1] for r in rows] == ["fl", "rl"]
+    for row in rows:   # gradient, loop width (largest) for camber, toe and half-track
+        values = [float(v.strip("()")) for v in row[2:]]
+        assert len(values) == 9 and np.all(np.isfinite(values)) and values[2] > 0.0, row
 
 
 def test_bushing_laws_are_linear_at_their_reference_stiffness_before_switching_on(tmp_path: Path) -> None:
@@ -163,7 +166,7 @@ def test_vsim_run_command(tmp_path: Path, capsys: pytest.CaptureFixture[str], mo
     assert cli.main(["run", str(scenario), "--duration-scale", "0.5"]) == 0
     out = capsys.readouterr()
     default = tmp_path / "out" / "small.mcap"
-    assert default.is_file() and "loop widths" in out.out and "wrote out/small.mcap" in out.out
+    assert default.is_file() and "gradient = centre-line slope" in out.out and "wrote out/small.mcap" in out.out
     assert "case 1/1" in out.err   # progress lines (not a terminal here)
     before = default.read_bytes()
     assert cli.main(["run", str(scenario)]) == 2
@@ -174,9 +177,46 @@ def test_vsim_run_command(tmp_path: Path, capsys: pytest.CaptureFixture[str], mo
     assert all(p["model"] == "linear" for p in run.metadata.bushing_parameters.values())
 
 
-def test_vsim_run_reports_divergence_with_status_1(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    path = small_scenario(tmp_path, SMALL + "limits: {{translation_mm: 0.05}}\n")
+@pytest.mark.parametrize("limit, words", [
+    ("translation_mm: 0.05", ["bushing ", "direction ", "mm beyond the limit 0.05 mm"]),
+    ("rotation_deg: 0.01", ["bushing ", "direction r", "deg beyond the limit 0.01 deg"]),
+    ("closure_error_mm: 0.000001", ["loop-closure error", "mm beyond the limit 1e-06 mm"]),
+])
+def test_vsim_run_reports_divergence_with_status_1(tmp_path: Path, capsys: pytest.CaptureFixture[str], limit: str,
+                                                   words: list[str]) -> None:
+    path = small_scenario(tmp_path, SMALL + f"limits: {{{{{limit}}}}}\n")
     assert cli.main(["run", str(path), "-o", str(tmp_path / "d.mcap")]) == 1
     err = capsys.readouterr().err
-    assert "vsim: run stopped: diverged at t = " in err and "beyond the limit 0.05 mm" in err
-    assert "incomplete recording is kept in" in err and not load_run(tmp_path / "d.mcap").complete
+    assert "vsim: run stopped: diverged at t = " in err and "incomplete recording is kept in" in err
+    for word in words:
+        assert word in err, err
+    assert not load_run(tmp_path / "d.mcap").complete
+
+
+def test_csv_and_bisine_inputs_reach_the_rig(tmp_path: Path) -> None:
+    (tmp_path / "in.csv").write_text("t_s,pad_z_fl_mm,rack_mm\n0,0,0\n0.2,5,0\n0.4,5,-2\n")
+    csv_run = small_scenario(tmp_path, """\
+        type: csv
+        vehicle: {vehicle}
+        settle: {{before_bushings_s: 0.1, before_input_s: 0.1}}
+        cases: [{{path: in.csv}}]
+    """, "csv.yaml")
+    run = load_run(run_scenario(load_scenario(csv_run), tmp_path / "csv.mcap").path)
+    end = -1
+    assert run.signals["pad_z_fl"][end] == pytest.approx(5.0) and run.signals["rack"][end] == pytest.approx(-2.0)
+    assert run.signals["pad_height_fl"][end] == pytest.approx(5.0, abs=0.1)
+    assert abs(run.signals["steer_fl"][end]) > 0.3 and run.signals["pad_z_fr"][end] == 0.0
+    bisine = small_scenario(tmp_path, """\
+        type: bisine
+        vehicle: {vehicle}
+        axles: [rear]
+        settle: {{before_bushings_s: 0.1, before_input_s: 0.1}}
+        cases:
+          - {{input: roll, duration_s: 0.5, components: [{{amplitude_mm: 4, frequency_hz: 1}}, {{amplitude_mm: 1, frequency_hz: 10}}]}}
+    """, "bisine.yaml")
+    run = load_run(run_scenario(load_scenario(bisine), tmp_path / "bisine.mcap").path)
+    inputs = run.signals["phase"] == 2
+    expected = 4 * np.sin(2 * np.pi * run.signals["input_time"][inputs]) + np.sin(20 * np.pi * run.signals["input_time"][inputs])
+    np.testing.assert_allclose(run.signals["pad_z_rl"][inputs], expected, atol=1e-9)
+    np.testing.assert_allclose(run.signals["pad_z_rr"][inputs], -expected, atol=1e-9)
+    assert ("wheel_travel_rl", "toe_rl") in run.pairs()

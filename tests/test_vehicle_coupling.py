@@ -77,3 +77,27 @@ def test_unbalance_resonance_matches_closed_form(damping_in_joint):
     assert np.max(np.abs(sim / ref - 1)) < 0.02, sim / ref
     assert sim.max() == pytest.approx(0.296e-3, rel=0.02)
     assert freqs[np.argmax(sim)] == pytest.approx(W_N, rel=0.03)
+
+
+def test_tendon_damper_intercept_acts_through_the_tendon_jacobian():
+    """A rear damper curve with a force at zero speed (100 N pushing apart) adds Jᵀ·100 N to
+    qfrc_applied through MuJoCo's sparse tendon Jacobian."""
+    import dataclasses
+
+    from vehicle.builder import BuildOptions
+    from vehicle.definition import Curve, Damper, load_vehicle
+    from vehicle.rig import KCRig
+
+    v = load_vehicle()
+    knee = Damper(Curve((-1.0, 0.0, 1.0), (-2900.0, 100.0, 1300.0)))
+    rig = KCRig(dataclasses.replace(v, rear=dataclasses.replace(v.rear, damper=knee)), BuildOptions(bushing_model="linear"))
+    m, d = rig.model, rig.data
+    mujoco.mj_forward(m, d)
+    rig.coupling.apply(m.opt.timestep)
+    expected = np.zeros(m.nv)
+    for side in ("left", "right"):
+        t = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_TENDON, f"rear_damper_{side}")
+        a, n = m.ten_J_rowadr[t], m.ten_J_rownnz[t]
+        expected[m.ten_J_colind[a:a + n]] += 100.0 * d.ten_J[a:a + n]
+    assert np.abs(expected).max() > 10.0
+    assert np.allclose(d.qfrc_applied, expected, atol=1e-9)

@@ -8,12 +8,12 @@ Ranges, per axle, as (low, high) in the metric's unit and sign convention (vehic
 * the rest: engineering judgement (assumption), wide bands that hold the usual passenger-car
   values and mainly fix the sign: a McPherson loses camber in bump (−40 … −5 deg/m), a twist beam
   in heave hardly changes it (±10 deg/m); both axles roll and comply under lateral force with
-  understeer (front steers away from a lateral force, rear with it; front roll steer ≤ 0); the
+  understeer (front steers away from a lateral force, rear with it; in roll the front steers out
+  of the turn, −0.2 … 0 deg/deg, the rear into it, 0 … 0.15 deg/deg); the
   wheel leans with the body in roll by 0.5 … 1 (McPherson) or 0.2 … 1 (twist beam) deg/deg;
   camber compliance 0 … 0.5 deg/kN (top outward under an inboard force); lateral compliance
   0.1 … 3 mm/kN; braking compliance steer small either way (±0.3 deg/kN); quasi-static loop widths
-  of the default bushings below 0.05 deg. The rear roll steer band (−0.1 … +0.15 deg/deg) admits
-  the slight roll oversteer of the present twist-beam model.
+  of the default bushings below 0.05 deg.
 """
 
 from __future__ import annotations
@@ -40,7 +40,7 @@ RANGES = {
     "rear": {
         "bump_steer_deg_per_m": (0.0, 4.0),
         "bump_camber_deg_per_m": (-10.0, 10.0),
-        "roll_steer_deg_per_deg": (-0.1, 0.15),
+        "roll_steer_deg_per_deg": (0.0, 0.15),
         "roll_camber_deg_per_deg": (0.2, 1.0),
         "lateral_force_compliance_steer_deg_per_kn": (0.0, 0.2),
         "lateral_force_compliance_camber_deg_per_kn": (0.0, 0.5),
@@ -68,3 +68,19 @@ def test_metrics_are_reported_for_both_axles(metrics):
 def test_metric_in_plausible_range(metrics, axle, key):
     low, high = RANGES[axle][key]
     assert low <= metrics[axle][key] <= high, (axle, key, metrics[axle][key])
+
+
+def test_vsim_kc_json_has_the_issue_keys(metrics, monkeypatch, capsys):
+    import json
+
+    from vehicle import kc_cli
+    from vehicle.cli import main
+
+    monkeypatch.setattr(kc_cli, "vehicle_kc", lambda vehicle, options: metrics)
+    assert main(["kc", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert set(out) == {"front", "rear"}
+    for axle in out.values():
+        assert set(RANGES["front"]) <= set(axle)
+    assert main(["kc"]) == 0
+    assert "bump_steer_deg_per_m" in capsys.readouterr().out

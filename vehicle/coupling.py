@@ -13,6 +13,9 @@ joint stiffness and damping implicitly, forces written to ``qfrc_applied`` expli
 * springs: rate and preload in the joint or tendon; a curve's departure from its rate explicit;
 * dampers: the slope of the active curve segment set as the joint/tendon damping each step
   (implicit), the segment's intercept applied explicitly.
+
+:meth:`ForceCoupling.apply` does all of it in one compiled call (:mod:`vehicle.stepping`, which
+also runs whole stretches of steps with ``mj_step`` inside the compiled loop).
 """
 
 from __future__ import annotations
@@ -118,6 +121,8 @@ class ForceCoupling:
         self.model, self.car, self.data = car.model, car, data
         self.bushings = BushingForces(car.model, data, car.channels)
         self._init_elements()
+        self._kernel_bank: object = False  # the bank the compiled-kernel arrays were built for
+        self._kernel: tuple = ()
 
     def _init_elements(self) -> None:
         m, d = self.model, self.data
@@ -155,11 +160,12 @@ class ForceCoupling:
         from vehicle import stepping
 
         b = self.bushings
-        if getattr(self, "_kernel_bank", False) is not b.bank:
+        if self._kernel_bank is not b.bank:
             self._kernel_bank = b.bank
             m, d = self.model, self.data
-            self._kernel = (d.qpos, d.qvel, d.qfrc_applied, d.ten_length, d.ten_velocity, d.ten_J.reshape(-1),
-                            m.jnt_stiffness, m.dof_damping, m.tendon_damping) + stepping.coupling_arrays(self)
+            self._kernel = (d.qpos, d.qvel, d.qfrc_applied, d.ten_length, d.ten_velocity, d.ten_J, m.ten_J_rowadr,
+                            m.ten_J_rownnz, m.ten_J_colind, m.jnt_stiffness, m.dof_damping,
+                            m.tendon_damping) + stepping.coupling_arrays(self)
         return self._kernel
 
     def apply(self, dt: float) -> None:

@@ -2,7 +2,7 @@
 
 Both axles are tested at once (the body is clamped, so the axles do not interact). Each test
 starts from the design pose with virgin bushings, rests :data:`SETTLE` s, then runs the triangle
-0 → +A → −A → +A at a constant rate; the −A ← +A leg is the unloading (down) branch, the
+0 → +A → −A → +A at a constant rate; the +A → −A leg gives the unloading (down) branch, the
 −A → +A leg the loading (up) branch. The centre line is the mean of the two branches; a
 compliance or gradient is its least-squares slope over ±80 % of A around design (±20 mm in bump);
 a loop width is the difference between the branches at design (and its maximum over that range).
@@ -31,6 +31,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import mujoco
 import numpy as np
 
 from vehicle.builder import BuildOptions
@@ -44,7 +45,7 @@ AXLES = ("front", "rear")
 
 
 @dataclass(frozen=True)
-class Test:
+class Triangle:
     """One quasi-static triangle applied to all four wheels."""
 
     name: str
@@ -55,11 +56,11 @@ class Test:
 
 
 TESTS = (
-    Test("bump", "pads", (1, 1, 1, 1), 0.025, 0.025),
-    Test("roll", "pads", (-1, 1, -1, 1), 0.025, 0.025),
-    Test("lateral", "fy", (1, 1, 1, 1), 2000.0, 2000.0),
-    Test("longitudinal", "fx", (-1, -1, -1, -1), 1500.0, 2000.0),
-    Test("aligning", "mz", (1, 1, 1, 1), 150.0, 200.0),
+    Triangle("bump", "pads", (1, 1, 1, 1), 0.025, 0.025),
+    Triangle("roll", "pads", (-1, 1, -1, 1), 0.025, 0.025),
+    Triangle("lateral", "fy", (1, 1, 1, 1), 2000.0, 2000.0),
+    Triangle("longitudinal", "fx", (-1, -1, -1, -1), 1500.0, 2000.0),
+    Triangle("aligning", "mz", (1, 1, 1, 1), 150.0, 200.0),
 )
 
 #: JSON key, unit, and sign convention of each metric.
@@ -110,7 +111,7 @@ def loop_width(b: Branches, window: float) -> tuple[float, float]:
     return float(np.interp(0.0, grid, width)), float(width.max())
 
 
-def run_triangle(rig: KCRig, test: Test) -> tuple[list[RigOutputs], list[RigOutputs]]:
+def run_triangle(rig: KCRig, test: Triangle) -> tuple[list[RigOutputs], list[RigOutputs]]:
     """Run ``test`` from design with virgin bushings; returns the (down, up) legs' samples."""
     rig.reset()
     rig.settle(SETTLE)
@@ -123,16 +124,14 @@ def run_triangle(rig: KCRig, test: Test) -> tuple[list[RigOutputs], list[RigOutp
     return down, up
 
 
-def _branches(down, up, x, y) -> Branches:
-    """Branches of ``y(sample)`` against ``x(sample)``."""
+def branches(down: list[RigOutputs], up: list[RigOutputs], x, y) -> Branches:
+    """Branches of ``y(sample)`` against ``x(sample)`` from the samples of :func:`run_triangle`."""
     return Branches(np.array([x(o) for o in down]), np.array([y(o) for o in down]),
                     np.array([x(o) for o in up]), np.array([y(o) for o in up]))
 
 
 def _design_contact_base(rig: KCRig) -> dict[str, float]:
     """Lateral distance between the left and right contact points of each axle at design [m]."""
-    import mujoco
-
     rig.reset()
     mujoco.mj_forward(rig.model, rig.data)
     site = lambda c: mujoco.mj_name2id(rig.model, mujoco.mjtObj.mjOBJ_SITE, rig.car.corners[c]["contact_site"])
@@ -151,7 +150,7 @@ def kc_metrics(rig: KCRig) -> dict[str, dict[str, float]]:
 
         def slope(test: str, x, y) -> float:
             t, (down, up) = runs[test]
-            return centre_slope(_branches(down, up, x, y), FIT_FRACTION * t.amplitude * _input_scale(test, base[axle]))
+            return centre_slope(branches(down, up, x, y), FIT_FRACTION * t.amplitude * _input_scale(test, base[axle]))
 
         def each(test: str, x, y) -> float:
             """Mean over the axle's two wheels of slope(x(wheel), y(wheel))."""
@@ -177,7 +176,7 @@ def kc_metrics(rig: KCRig) -> dict[str, dict[str, float]]:
         t, (down, up) = runs["bump"]
         window = FIT_FRACTION * t.amplitude
         for name, angle in (("toe", "toe"), ("camber", "camber")):
-            widths = [loop_width(_branches(down, up, lambda o, c=c: o.wheels[c].pad_height,
+            widths = [loop_width(branches(down, up, lambda o, c=c: o.wheels[c].pad_height,
                                            lambda o, c=c: deg(getattr(o.wheels[c], angle))), window) for c in (L, R)]
             m[f"{name}_loop_width_deg"] = float(np.mean([w[0] for w in widths]))
             m[f"{name}_loop_width_max_deg"] = float(np.mean([w[1] for w in widths]))

@@ -148,24 +148,33 @@ class KCRig:
         return out
 
     # -- outputs -----------------------------------------------------------------------------
-    def _eq_forces(self, ids: np.ndarray, rows: int) -> np.ndarray:
+    def _eq_first_rows(self, ids: np.ndarray) -> np.ndarray:
+        """Index in ``efc_*`` of the first row of each equality ``ids`` (its rows are consecutive)."""
         d = self.data
-        eqrows = d.efc_type[: d.nefc] == mujoco.mjtConstraint.mjCNSTR_EQUALITY
-        out = np.zeros((len(ids), rows))
-        for k, i in enumerate(ids):
-            sel = np.flatnonzero(eqrows & (d.efc_id[: d.nefc] == i))
-            out[k] = d.efc_force[sel[:rows]]
-        return out
+        rows = np.flatnonzero(d.efc_type[: d.nefc] == mujoco.mjtConstraint.mjCNSTR_EQUALITY)
+        first = np.full(self.model.neq, -1)
+        eq, at = np.unique(d.efc_id[rows], return_index=True)
+        first[eq] = rows[at]
+        return first[ids]
+
+    def _eq_forces(self, ids: np.ndarray, rows: int) -> np.ndarray:
+        return self.data.efc_force[self._eq_first_rows(ids)[:, None] + np.arange(rows)]
+
+    def ride_height(self) -> float:
+        """Height of the body's ride-height point above the ground (pads at zero) [m]."""
+        m, d = self.model, self.data
+        mujoco.mj_kinematics(m, d)
+        body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "chassis")
+        point = d.xpos[body] + d.xmat[body].reshape(3, 3) @ np.asarray(self.vehicle.body.ride_height_point)
+        return float(point[2])
 
     def closure_error(self) -> float:
         """Largest position error of the loop closures [m] (connect, weld position, tie-rod length)."""
         d = self.data
-        eqrows = d.efc_type[: d.nefc] == mujoco.mjtConstraint.mjCNSTR_EQUALITY
-        worst = 0.0
-        for i, n in zip(self.closure_eq, self.closure_rows):
-            sel = np.flatnonzero(eqrows & (d.efc_id[: d.nefc] == i))[:n]
-            worst = max(worst, float(np.linalg.norm(d.efc_pos[sel])))
-        return worst
+        rows = self._eq_first_rows(self.closure_eq)[:, None] + np.arange(3)
+        used = np.arange(3) < self.closure_rows[:, None]  # 3 position rows, 1 for a tendon length
+        pos = np.where(used, d.efc_pos[np.minimum(rows, d.nefc - 1)], 0.0)
+        return float(np.sqrt((pos * pos).sum(axis=1)).max())
 
     def measure(self) -> RigOutputs:
         """The rig's outputs at the current state."""
@@ -178,7 +187,7 @@ class KCRig:
             rot = d.xmat[self.wheel_body[k]].reshape(3, 3)
             spin_left = rot[:, 1]
             toe, camber = wheel_angles(sign * spin_left, sign)
-            heading = np.cross(spin_left, [0.0, 0.0, 1.0])
+            heading = (spin_left[1], -spin_left[0])  # spin_left × z, in plan
             centre = d.site_xpos[self.centre_site[k]].copy()
             force = np.array([d.xfrc_applied[self.carriage_body[k], 0], d.xfrc_applied[self.carriage_body[k], 1], fz[k]])
             wheels[corner] = WheelOutputs(camber, toe, math.atan2(heading[1], heading[0]), abs(centre[1]), centre,

@@ -1,8 +1,9 @@
 """`vsim run SCENARIO.yaml`: run a scenario on the K&C rig with a progress bar, record it, summarise it.
 
-The summary is computed from the recorded file (so it also describes an incomplete run): loop
-widths of camber, toe and half-track on each case's last cycle (periodic inputs), the toe drift
-over the final hold (rack steps), and the peak deflection of every bushing during the inputs.
+The summary is computed from the recorded file (so it also describes an incomplete run): the
+centre-line gradients and loop widths of camber, toe and half-track on each case's last cycle
+(periodic inputs, with :mod:`vehicle.kc`'s definitions), the toe drift over the final hold (rack
+steps), and the peak deflection of every bushing during the inputs.
 """
 
 from __future__ import annotations
@@ -17,9 +18,8 @@ import numpy as np
 
 from vehicle.model_cli import BUSHING_MODELS
 
-#: Loop widths are read over this fraction of each loop's common input range (as vehicle.kc).
-FIT_FRACTION = 0.8
 SUMMARY_CORNERS = {"front": "fl", "rear": "rl"}   #: the left wheel of each axle is summarised
+BUMP_WINDOW_MM = 20.0   #: gradients against wheel travel at design height over ±20 mm (spec §4)
 _DIRECTIONS = ("x", "y", "z", "rx", "ry", "rz")
 
 
@@ -31,6 +31,9 @@ class ProgressBar:
         self.stream = stream if stream is not None else sys.stderr
         self.interval_s, self.width = interval_s, width
         self.live = self.stream.isatty()
+        from vehicle.runner import PHASES  # here, so that `vsim --help` does not load the runner
+
+        self.phases = PHASES
         self.started = time.perf_counter()
         self.shown_at = -1.0
         self.last_stage = None
@@ -38,13 +41,11 @@ class ProgressBar:
 
     def __call__(self, p) -> None:
         """Show a :class:`vehicle.runner.Progress`."""
-        from vehicle.runner import PHASES
-
         now = time.perf_counter()
         stage = (p.case, p.phase)
         if not self.live:
             if stage != self.last_stage:
-                print(f"case {p.case}/{p.cases} {p.label}: {PHASES[p.phase]}", file=self.stream, flush=True)
+                print(f"case {p.case}/{p.cases} {p.label}: {self.phases[p.phase]}", file=self.stream, flush=True)
             self.last_stage = stage
             return
         if now - self.shown_at < self.interval_s and stage == self.last_stage:
@@ -53,10 +54,10 @@ class ProgressBar:
         fraction = min(1.0, p.done_s / p.total_s) if p.total_s > 0 else 1.0
         filled = int(round(fraction * self.width))
         elapsed = now - self.started
-        remaining = elapsed * (1.0 - fraction) / fraction if fraction > 0 else float("nan")
+        remaining = f"~{elapsed * (1.0 - fraction) / fraction:.0f} s" if fraction > 0.01 else "?"
         line = (f"\r[{'#' * filled}{'.' * (self.width - filled)}] {100 * fraction:3.0f}%  "
-                f"case {p.case}/{p.cases} {p.label} ({PHASES[p.phase]})  "
-                f"sim {p.done_s:.1f}/{p.total_s:.1f} s  wall {elapsed:.0f} s, ~{remaining:.0f} s left")
+                f"case {p.case}/{p.cases} {p.label} ({self.phases[p.phase]})  "
+                f"sim {p.done_s:.1f}/{p.total_s:.1f} s  wall {elapsed:.0f} s, {remaining} left")
         self.stream.write(line + "\x1b[K")
         self.stream.flush()
 
@@ -76,40 +77,54 @@ def _case_mask(run, case: dict, last_cycle: bool) -> np.ndarray:
     return (run.signals["case"] == case["case"]) & (run.signals["phase"] == 2) & (run.t_s >= start - 1e-9)
 
 
-def loop_widths(run, case: dict, x: str, y: str, driver: str) -> tuple[float, float]:
-    """(width at x = 0, largest width) of the loop of signal ``y`` against ``x`` on the last cycle of
-    ``case``; branches are split by the direction of the input signal ``driver``. NaN when the
-    recording does not hold both branches."""
-    from vehicle.kc import Branches, loop_width
+def branches(run, case: dict, x: str, y: str, driver: str):
+    """:class:`vehicle.kc.Branches` of signal ``y`` against ``x`` on the last cycle of ``case``,
+    split by the direction of the input signal ``driver``; None without both branches."""
+    from vehicle.kc import Branches
 
     mask = _case_mask(run, case, last_cycle=True)
     xs, ys, drive = run.signals[x][mask], run.signals[y][mask], run.signals[driver][mask]
     change = np.diff(drive, prepend=drive[:1])
     down, up = change < 0, change > 0
     if down.sum() < 2 or up.sum() < 2:
-        return float("nan"), float("nan")
-    window = FIT_FRACTION * min(xs[down].max(), xs[up].max(), -xs[down].min(), -xs[up].min())
-    if not window > 0:
-        return float("nan"), float("nan")
-    return loop_width(Branches(xs[down], ys[down], xs[up], ys[up]), window)
+        return None
+    return Branches(xs[down], ys[down], xs[up], ys[up])
+
+
+def _common_range(b) -> float:
+    """Half-width of the x range both branches cover on each side of 0."""
+    return float(min(b.x_down.max(), b.x_up.max(), -b.x_down.min(), -b.x_up.min()))
 
 
 def _loop_table(run, extra: dict) -> list[str]:
+    from vehicle.kc import FIT_FRACTION, centre_slope, loop_width
+
     x_quantity = extra["x_quantity"]
-    driver = "pad_z" if x_quantity == "wheel_travel" else x_quantity
-    rows = [f"loop widths on the last cycle, left wheels, at {'design height' if driver == 'pad_z' else 'zero load'}"
-            f" (largest over ±{FIT_FRACTION:.0%} of the range):",
-            f"  {'case':<28} {'wheel':<5} {'camber [deg]':>20} {'toe [deg]':>20} {'half-track [mm]':>20}"]
+    travel = x_quantity == "wheel_travel"
+    driver = "pad_z" if travel else x_quantity
+    per = {"wheel_travel": "m", "pad_mz": "kN·m"}.get(x_quantity, "kN")  # x is in mm, N or N·m: slopes × 1000
+    quantities = (("camber", "deg"), ("toe", "deg"), ("half_track", "mm"))
+    window = f"±{FIT_FRACTION:.0%} of the range"
+    rows = [f"last cycle, left wheels: gradient = centre-line slope at {'design height' if travel else 'zero load'} "
+            f"(over {f'±{BUMP_WINDOW_MM:g} mm or ' if travel else ''}{window}{', the smaller' if travel else ''}); "
+            f"loop = loop width there (largest over {window})",
+            f"  {'case':<24} {'wheel':<5}" + "".join(f" {f'{q} [{u}/{per}]':>20} {f'loop [{u}]':>18}" for q, u in quantities)]
     for case in extra["cases"]:
-        if not _case_mask(run, case, last_cycle=True).any():
-            continue  # not reached by an incomplete run
         for axle in extra["axles"]:
             tag = SUMMARY_CORNERS[axle]
             cells = []
-            for quantity in ("camber", "toe", "half_track"):
-                at, most = loop_widths(run, case, f"{x_quantity}_{tag}", f"{quantity}_{tag}", f"{driver}_{tag}")
-                cells.append(f"{at:9.4f} ({most:8.4f})")
-            rows.append(f"  {case['label'][:28]:<28} {tag:<5} {cells[0]:>20} {cells[1]:>20} {cells[2]:>20}")
+            for quantity, _ in quantities:
+                b = branches(run, case, f"{x_quantity}_{tag}", f"{quantity}_{tag}", f"{driver}_{tag}")
+                reach = _common_range(b) if b is not None else 0.0
+                if not reach > 0:
+                    break  # an incomplete run did not reach this case's last cycle
+                gradient = centre_slope(b, min(FIT_FRACTION * reach, BUMP_WINDOW_MM) if travel else FIT_FRACTION * reach)
+                at, most = loop_width(b, FIT_FRACTION * reach)
+                cells.append(f" {1e3 * gradient:20.4f} {f'{at:.4f} ({most:.4f})':>18}")
+            else:
+                rows.append(f"  {case['label'][:24]:<24} {tag:<5}" + "".join(cells))
+    if any(case["cycles"] == 1 for case in extra["cases"]):
+        rows.append("  (a case of one cycle has the virgin first loading, 0 to +A, in its loading branch)")
     return rows
 
 
@@ -191,11 +206,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     run = subparsers.add_parser(
         "run", help="run a scenario (.yaml) on the K&C rig and record it (.mcap)",
         description="Run every case of a scenario file (format: scenarios/README.md) and record them in one "
-                    "MCAP file; print a summary (loop widths, relaxation, peak bushing deflections).")
+                    "MCAP file; print a summary (gradients and loop widths, relaxation, peak bushing deflections).")
     run.add_argument("scenario", type=Path, metavar="SCENARIO.yaml")
     run.add_argument("-o", "--output", type=Path, metavar="OUT.mcap", help="run file (default: out/<scenario>.mcap)")
     run.add_argument("--bushings", choices=BUSHING_MODELS, default=None,
-                     help="read every bushing parameter set as this model (overrides the scenario)")
+                     help="this bushing model on every bushing direction (overrides the scenario's `bushings`)")
     run.add_argument("--overwrite", action="store_true", help="replace an existing output file")
     run.add_argument("--duration-scale", type=float, default=1.0, metavar="X",
                      help="multiply every duration (settle phases, periods, holds) by X, e.g. 0.1 for a quick run")

@@ -143,18 +143,16 @@ class SignalLayout:
         specs += [SignalSpec("case", "-", "run"), SignalSpec("phase", "-", "run"),
                   SignalSpec("input_time", "s", "run"), SignalSpec("closure_error", "mm", "run")]
         self.specs = specs
-        self.design_z = None
 
-    def values(self, o: RigOutputs, inputs: np.ndarray, case: int, phase: int, input_time_s: float) -> np.ndarray:
-        """One sample: rig outputs ``o`` (the first sample of a case sets the design wheel heights),
-        the rig inputs (SI, INPUT_CHANNELS order), the case number, phase and input time."""
+    def values(self, o: RigOutputs, design_z: np.ndarray, inputs: np.ndarray, case: int, phase: int,
+               input_time_s: float) -> np.ndarray:
+        """One sample from the rig outputs ``o``, the wheel-centre heights at design [m] (order of
+        CORNERS), the rig inputs (SI, INPUT_CHANNELS order), the case number, phase and input time [s]."""
         w = [o.wheels[c] for c in CORNERS]
         centre = np.array([x.wheel_centre for x in w])
-        if self.design_z is None:
-            self.design_z = centre[:, 2].copy()
         bushing = np.column_stack([o.bushing_deflection * self.deflection_scale, o.bushing_force]).ravel()
         return np.concatenate([
-            (centre[:, 2] - self.design_z) * MM,
+            (centre[:, 2] - design_z) * MM,
             [x.camber * DEG for x in w], [x.toe * DEG for x in w], [x.half_track * MM for x in w],
             [x.steer * DEG for x in w],
             centre.ravel() * MM,
@@ -318,14 +316,15 @@ def _run_case(rig: KCRig, scenario: Scenario, case: Case, number: int, when: Cas
     every = output_interval(scenario, dt)
     bodies = np.arange(1, m.nbody)
     rest = np.zeros(len(INPUT_CHANNELS))
-    layout.design_z = None
+    design = rig.measure()
+    design_z = np.array([design.wheels[c].wheel_centre[2] for c in CORNERS])
     name = f"{number} '{case.label}'"
     input_start = sum(when.steps[:2])
 
     def record(step: int, phase: int, inputs: np.ndarray) -> None:
         t = when.start_s + step * dt
         o = rig.measure()
-        values = layout.values(o, inputs, number, phase, (step - input_start) * dt / duration_scale)
+        values = layout.values(o, design_z, inputs, number, phase, (step - input_start) * dt)
         writer.write(t, values, d.xpos[bodies], d.xquat[bodies])
         check_divergence(rig, o, scenario, t, name)
         report(phase, t)

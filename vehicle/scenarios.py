@@ -20,11 +20,13 @@ import numpy as np
 import yaml
 
 from bushings.errors import InputError
+from bushings.records import read_csv_columns
+from vehicle.builder import CORNERS, BuildOptions
 from vehicle.definition import DEFAULT_VEHICLE
 from vehicle.model_cli import BUSHING_MODELS
 
-#: Corner names of the rig (order of ``vehicle.builder.CORNERS``) and their short tags.
-CORNER_TAGS = {"front_left": "fl", "front_right": "fr", "rear_left": "rl", "rear_right": "rr"}
+#: Corner names of the rig (order of ``vehicle.builder.CORNERS``) and their short tags (fl, fr, rl, rr).
+CORNER_TAGS = {corner: "".join(word[0] for word in corner.split("_")) for corner in CORNERS}
 AXLES = ("front", "rear")
 
 #: Rig input channels, in the order of :meth:`Case.inputs` columns: pad vertical displacement
@@ -45,10 +47,10 @@ BISINE_INPUTS = (*SIGNAL_TYPES, "rack")
 TYPES = (*SIGNAL_TYPES, "rack_step", "double_rack_step", "bisine", "csv")
 SHAPES = ("triangle", "sine")
 
-#: Largest sine frequency accepted [Hz]: 20 samples per period at the rig's 1 ms step.
-MAX_FREQUENCY_HZ = 50.0
-#: The rig's time step [s] (vehicle.builder.BuildOptions default); output rates must divide 1/step.
-RIG_TIMESTEP_S = 1e-3
+#: The rig's time step [s]; output rates must divide 1/step.
+RIG_TIMESTEP_S = BuildOptions().timestep
+#: Largest sine frequency accepted [Hz]: 20 rig steps per period.
+MAX_FREQUENCY_HZ = 1.0 / (20 * RIG_TIMESTEP_S)
 
 
 @dataclass(frozen=True)
@@ -151,10 +153,11 @@ class Scenario:
 
 
 # -- reading the document with line numbers ---------------------------------------------------------
-Path_ = tuple[Any, ...]
+#: Where a value sits in the document: mapping keys and list indices from the top.
+KeyPath = tuple[Any, ...]
 
 
-def dotted(path: Path_) -> str:
+def dotted(path: KeyPath) -> str:
     """``("cases", 2, "amplitude_mm")`` → ``"cases[2].amplitude_mm"``."""
     out = ""
     for part in path:
@@ -175,11 +178,11 @@ class _Document:
             raise InputError(f"not valid YAML: {exc}", source=source) from exc
         finally:
             loader.dispose()
-        self.lines: dict[Path_, int] = {}
+        self.lines: dict[KeyPath, int] = {}
         if node is not None:
             self._index(node, ())
 
-    def _index(self, node: yaml.Node, path: Path_) -> None:
+    def _index(self, node: yaml.Node, path: KeyPath) -> None:
         self.lines[path] = node.start_mark.line + 1
         if isinstance(node, yaml.MappingNode):
             seen = set()
@@ -193,7 +196,7 @@ class _Document:
             for i, item in enumerate(node.value):
                 self._index(item, path + (i,))
 
-    def error(self, path: Path_, message: str) -> InputError:
+    def error(self, path: KeyPath, message: str) -> InputError:
         """An InputError at ``path`` (or its closest enclosing node that has a line)."""
         where = path
         while where not in self.lines and where:
@@ -205,11 +208,11 @@ class _Document:
 class _Fields:
     """Typed access to a mapping of the document; each value remembers where it was written."""
 
-    def __init__(self, doc: _Document, values: Mapping[str, tuple[Any, Path_]], where: Path_):
+    def __init__(self, doc: _Document, values: Mapping[str, tuple[Any, KeyPath]], where: KeyPath):
         self.doc, self.values, self.where = doc, values, where
 
     @classmethod
-    def of(cls, doc: _Document, path: Path_, data: Any, allowed: tuple[str, ...]) -> "_Fields":
+    def of(cls, doc: _Document, path: KeyPath, data: Any, allowed: tuple[str, ...]) -> "_Fields":
         """The mapping ``data`` at ``path``, checked against the ``allowed`` keys."""
         if not isinstance(data, Mapping):
             raise doc.error(path, f"expected a mapping, got {data!r}")
@@ -225,7 +228,7 @@ class _Fields:
     def has(self, key: str) -> bool:
         return key in self.values
 
-    def path(self, key: str) -> Path_:
+    def path(self, key: str) -> KeyPath:
         return self.values[key][1] if key in self.values else self.where + (key,)
 
     def raw(self, key: str, default: Any = ...) -> Any:
@@ -303,6 +306,15 @@ def _pattern(kind: str, axles: tuple[str, ...]) -> tuple[float, ...]:
     return tuple(gains.values())
 
 
+def _frequency(f: _Fields) -> float:
+    """The ``frequency_hz`` of ``f`` [Hz], positive and at most MAX_FREQUENCY_HZ."""
+    frequency = f.number("frequency_hz", positive=True)
+    if frequency > MAX_FREQUENCY_HZ:
+        raise f.fail("frequency_hz", f"expected at most {MAX_FREQUENCY_HZ} Hz (20 rig steps per period), "
+                                     f"got {frequency}")
+    return frequency
+
+
 def _periodic(f: _Fields, kind: str) -> tuple[Waveform, int]:
     """Triangle 0 → +A → −A → 0 or sine A·sin(2πft), ``cycles`` times, SI."""
     quantity = SIGNAL_TYPES[kind]
@@ -318,11 +330,7 @@ def _periodic(f: _Fields, kind: str) -> tuple[Waveform, int]:
             raise f.fail(speed_key, f"a speed defines a triangle only; give frequency_hz for a {shape}")
         period = 4.0 * amplitude / (f.number(speed_key, positive=True) * si)
     else:
-        frequency = f.number("frequency_hz", positive=True)
-        if frequency > MAX_FREQUENCY_HZ:
-            raise f.fail("frequency_hz", f"expected at most {MAX_FREQUENCY_HZ} Hz (20 rig steps per period), "
-                                         f"got {frequency}")
-        period = 1.0 / frequency
+        period = 1.0 / _frequency(f)
     if shape == "sine":
         return Waveform((0.0, cycles * period), (0.0, 0.0), ((amplitude, 1.0 / period),)), cycles
     times = [0.0] + [period * (c + q) for c in range(cycles) for q in (0.25, 0.75, 1.0)]
@@ -350,10 +358,7 @@ def _bisine(f: _Fields, axles: tuple[str, ...]) -> tuple[Waveform, tuple[float, 
     sines = []
     for i, item in enumerate(raw):
         c = _Fields.of(f.doc, f.path("components") + (i,), item, (f"amplitude_{unit}", "frequency_hz"))
-        frequency = c.number("frequency_hz", positive=True)
-        if frequency > MAX_FREQUENCY_HZ:
-            raise c.fail("frequency_hz", f"expected at most {MAX_FREQUENCY_HZ} Hz, got {frequency}")
-        sines.append((c.number(f"amplitude_{unit}", nonzero=True) * si, frequency))
+        sines.append((c.number(f"amplitude_{unit}", nonzero=True) * si, _frequency(c)))
     if f.has("duration_s") and f.has("cycles"):
         raise f.fail("duration_s", "give either cycles (of the slowest component) or duration_s, not both")
     duration = (f.number("duration_s", positive=True) if f.has("duration_s")
@@ -397,46 +402,29 @@ def csv_columns() -> tuple[str, ...]:
 
 def read_input_csv(path: Path) -> InputTable:
     """Read a scenario time series: a header ``t_s`` plus any of :func:`csv_columns` (absent
-    channels stay at 0), then one line per time. Raises InputError naming the file, the line and
-    the column for an unknown or missing column, a non-number, or a time that is not increasing
-    from 0."""
+    channels stay at 0), then one line per time, from 0. Raises InputError naming the file, the
+    line and the column for an unknown or missing column, a non-number, or a time that does not
+    start at 0 or does not increase (the numbers are read by :func:`bushings.records.read_csv_columns`)."""
     columns = csv_columns()
     with path.open(newline="") as handle:
-        rows = [(n, row) for n, row in enumerate(csv.reader(handle), start=1) if any(c.strip() for c in row)]
-    if not rows:
-        raise InputError("empty file; expected a header t_s,<channels> and data lines", source=str(path))
-    line, header = rows[0][0], [c.strip() for c in rows[0][1]]
-    for name in header:
-        if name != "t_s" and name not in columns:
-            raise InputError(f"unknown column {name!r}; expected t_s and any of {', '.join(columns)}",
-                             source=f"{path}:{line}", key=name)
-    if "t_s" not in header or len(header) < 2 or len(set(header)) != len(header):
-        raise InputError(f"expected a header with t_s and at least one distinct input column, got {','.join(header)}",
-                         source=f"{path}:{line}")
-    scale = {name: FILE_UNITS[input_quantity(ch)][1] for name, ch in zip(columns, INPUT_CHANNELS)}
-    times, values = [], []
-    for line, row in rows[1:]:
-        if len(row) != len(header):
-            raise InputError(f"expected {len(header)} values, got {len(row)}", source=f"{path}:{line}")
-        sample = np.zeros(len(INPUT_CHANNELS))
-        for name, text in zip(header, row):
-            try:
-                value = float(text)
-            except ValueError:
-                value = math.nan
-            if not math.isfinite(value):
-                raise InputError(f"expected a finite number, got {text.strip()!r}", source=f"{path}:{line}", key=name)
-            if name == "t_s":
-                if (not times and value != 0.0) or (times and value <= times[-1]):
-                    expected = "0 on the first data line" if not times else f"a time after {times[-1]} s"
-                    raise InputError(f"expected {expected}, got {value}", source=f"{path}:{line}", key=name)
-                times.append(value)
-            else:
-                sample[columns.index(name)] = value * scale[name]
-        values.append(sample)
-    if len(times) < 2:
-        raise InputError("expected at least two data lines", source=str(path))
-    return InputTable(np.asarray(times), np.asarray(values))
+        header = [c.strip() for c in next(csv.reader(handle), [])]
+    unknown = [c for c in header if c != "t_s" and c not in columns]
+    if unknown:
+        raise InputError(f"unknown column {unknown[0]!r}; expected t_s and any of {', '.join(columns)}",
+                         source=str(path), key="line 1")
+    present = [c for c in columns if c in header]
+    if not present:
+        raise InputError(f"expected t_s and at least one input column, got {','.join(header) or 'an empty file'}",
+                         source=str(path), key="line 1")
+    data = read_csv_columns(path, ("t_s", *present), min_rows=2)
+    if data["t_s"][0] != 0.0:
+        raise InputError(f"expected the inputs to start at t_s = 0, got {data['t_s'][0]}", source=str(path),
+                         key="first data line, column t_s")
+    values = np.zeros((len(data["t_s"]), len(INPUT_CHANNELS)))
+    for name in present:
+        k = columns.index(name)
+        values[:, k] = data[name] * FILE_UNITS[input_quantity(INPUT_CHANNELS[k])][1]
+    return InputTable(data["t_s"], values)
 
 
 # -- the file ---------------------------------------------------------------------------------------

@@ -1,10 +1,10 @@
 """Compiled stepping: the coupling of :mod:`vehicle.coupling` and ``mj_step`` in one numba loop.
 
-Per step the Python path costs a few numpy calls per force group (~150 µs on the rig); here the
-inputs, the bushing bank step, the damper and spring laws and ``mj_step`` (called through
-ctypes on the model's and data's addresses) all run in compiled code, so a step costs
-``mj_step`` plus the bank kernel. Results are identical to the Python path (same operations in
-the same order; see tests/test_vehicle_rig.py).
+A numpy coupling called from a Python loop cost ~150–250 µs per step on the rig, more than
+``mj_step``; here the rig inputs, the bushing bank step, the damper and spring laws and
+``mj_step`` (called through ctypes on the model's and data's addresses) all run in compiled code,
+so a step costs ``mj_step`` plus the bank kernel. :func:`run` gives bit-identical results to
+calling ``ForceCoupling.apply`` and ``mujoco.mj_step`` from Python (tests/test_vehicle_rig.py).
 
 Arrays of ``MjModel``/``MjData`` are numpy views of MuJoCo's memory, so the loop reads and writes
 them in place.
@@ -13,13 +13,37 @@ them in place.
 from __future__ import annotations
 
 import ctypes
+import inspect
 from pathlib import Path
 
 import mujoco
 import numba as nb
 import numpy as np
+from numba.core import caching
 
 from bushings import kernel as _kn
+
+class _KernelStampedLocator(caching.InTreeCacheLocator):
+    """Numba cache locator for this module: its stamp covers this file AND the bushing kernel.
+
+    :func:`coupling_step` compiles :func:`bushings.kernel.step_bank` into itself, but numba only
+    checks the stamp of the caller's file, so after a kernel change a cached caller would run the
+    old kernel on the new bank's arrays (memory corruption, seen as a segfault).
+    """
+
+    @classmethod
+    def from_function(cls, py_func, py_file):
+        if Path(py_file).resolve() != Path(__file__).resolve():
+            return None  # other modules keep numba's own locators
+        return super().from_function(py_func, py_file)
+
+    def get_source_stamp(self):
+        kernel = Path(_kn.__file__)
+        st = kernel.stat()
+        return super().get_source_stamp(), caching._hash_source_file(str(kernel), st.st_mtime, st.st_size)
+
+
+caching.CacheImpl._locator_classes.insert(0, _KernelStampedLocator)
 
 _LIB = ctypes.CDLL(str(next(Path(mujoco.__file__).parent.glob("libmujoco.so*"))))
 _mj_step = _LIB.mj_step
@@ -27,14 +51,18 @@ _mj_step.argtypes = (ctypes.c_size_t, ctypes.c_size_t)  # mjModel*, mjData* as a
 _mj_step.restype = None
 
 
-def bank_args(bank) -> tuple:
-    """The state and parameter arrays :func:`bushings.kernel.step_bank` takes after (e, h), in order.
+#: Bank attributes that differ in name from the kernel's parameters.
+_BANK_ATTR = {"F": "force", "K": "tangent", "work": "_work", "iwork": "_iwork"}
 
-    Mirrors :meth:`bushings.BushingBank.step`; kept in this one place (the bank has no public
-    accessor for them yet).
+
+def bank_args(bank) -> tuple:
+    """The arrays :func:`bushings.kernel.step_bank` takes after (e, h), in order, from ``bank``.
+
+    Matched by the kernel's parameter names, as :meth:`bushings.BushingBank.step` passes them
+    (the bank has no public accessor for them yet); force and tangent come last but two.
     """
-    return (bank.P, bank.I, bank.MX, bank.u, bank.wprev, bank.wprev2, bank.q, bank.eprev, bank.cs, bank.ck,
-            bank.stack, bank.diss, bank.nfail, bank.force, bank.tangent, bank._work, bank._iwork)
+    names = list(inspect.signature(_kn.step_bank.py_func).parameters)[2:]
+    return tuple(getattr(bank, _BANK_ATTR.get(n, n)) for n in names)
 
 
 @nb.njit(cache=True)
@@ -49,21 +77,20 @@ def _segment(x, xs, ys):
 
 
 @nb.njit(cache=True)
-def _push(qfrc, ten_J, joint, index, gen):
-    """Add generalised forces ``gen`` along joint dofs or tendons (through their Jacobian rows)."""
-    nv = qfrc.shape[0]
+def _push(qfrc, ten_J, ten_J_rowadr, ten_J_rownnz, ten_J_colind, joint, index, gen):
+    """Add generalised forces ``gen`` along joint dofs or tendons (through their sparse Jacobian rows)."""
     for k in range(gen.shape[0]):
         if joint[k]:
             qfrc[index[k]] += gen[k]
         elif gen[k] != 0.0:
-            row = index[k] * nv
-            for j in range(nv):
-                qfrc[j] += ten_J[row + j] * gen[k]
+            a = ten_J_rowadr[index[k]]
+            for p in range(a, a + ten_J_rownnz[index[k]]):
+                qfrc[ten_J_colind[p]] += ten_J[p] * gen[k]
 
 
 @nb.njit(cache=True)
-def coupling_step(h, qpos, qvel, qfrc, ten_length, ten_velocity, ten_J, jnt_stiffness, dof_damping,
-                  tendon_damping, bush, bank, damp, spring):
+def coupling_step(h, qpos, qvel, qfrc, ten_length, ten_velocity, ten_J, ten_J_rowadr, ten_J_rownnz, ten_J_colind,
+                  jnt_stiffness, dof_damping, tendon_damping, bush, bank, damp, spring):
     """Write the non-implicit forces for the next step of ``h`` [s] (see vehicle.coupling).
 
     ``bush`` = (qpos adr, dof adr, joint ids, base stiffness, K_ref, saturating, e work) of the
@@ -77,7 +104,7 @@ def coupling_step(h, qpos, qvel, qfrc, ten_length, ten_velocity, ten_J, jnt_stif
         for c in range(bq.shape[0]):
             e[c] = qpos[bq[c]]
         _kn.step_bank(e, h, *bank)
-        force, tangent = bank[13], bank[14]
+        force, tangent = bank[-4], bank[-3]
         for c in range(bq.shape[0]):
             if sat[c]:
                 kref[c] = max(kbase[c], tangent[c])
@@ -92,7 +119,7 @@ def coupling_step(h, qpos, qvel, qfrc, ten_length, ten_velocity, ten_J, jnt_stif
         else:
             tendon_damping[index[k]] = slope
         gen[k] = -sign[k] * offset[k]  # compression = sign·Δq: a force pushing apart acts along −sign
-    _push(qfrc, ten_J, joint, index, gen)
+    _push(qfrc, ten_J, ten_J_rowadr, ten_J_rownnz, ten_J_colind, joint, index, gen)
     sjoint, sindex, sqadr, design, ssign, sxs, sys_, rate, y0, nonlinear, rem = spring
     if nonlinear:
         for k in range(sjoint.shape[0]):
@@ -100,19 +127,19 @@ def coupling_step(h, qpos, qvel, qfrc, ten_length, ten_velocity, ten_J, jnt_stif
             x = ssign[k] * (coord - design[k])
             slope, icpt = _segment(x, sxs[k], sys_[k])
             rem[k] = -ssign[k] * (slope * x + icpt - y0[k] - rate[k] * x)
-        _push(qfrc, ten_J, sjoint, sindex, rem)
+        _push(qfrc, ten_J, ten_J_rowadr, ten_J_rownnz, ten_J_colind, sjoint, sindex, rem)
 
 
-@nb.njit
-def run(n, i0, n_ramp, start, end, active, eq_data, pad_eq, xfrc, carriage, wheel, m_addr, d_addr, h,
-        qpos, qvel, qfrc, ten_length, ten_velocity, ten_J, jnt_stiffness, dof_damping, tendon_damping,
-        bush, bank, damp, spring):
+@nb.njit(cache=True)
+def _run(mj_step, n, i0, n_ramp, start, end, active, eq_data, pad_eq, xfrc, carriage, wheel, m_addr, d_addr, h,
+        qpos, qvel, qfrc, ten_length, ten_velocity, ten_J, ten_J_rowadr, ten_J_rownnz, ten_J_colind, jnt_stiffness,
+        dof_damping, tendon_damping, bush, bank, damp, spring):
     """Advance ``n`` steps; rig inputs move linearly from ``start`` to ``end`` over ``n_ramp`` steps.
 
     Inputs (16 values): pad heights [m], Fx, Fy [N] at the carriages, Mz [N·m] at the wheels, four
     corners each; ``active[g]`` says whether group g is driven (else left as is). Step ``i0 + i``
-    of the ramp (1-based) sets start + (end − start)·(i0 + i)/n_ramp. Not cached: it holds the
-    address of ``mj_step``.
+    of the ramp (1-based) sets start + (end − start)·(i0 + i)/n_ramp. ``mj_step`` is MuJoCo's,
+    passed as a ctypes function so that the compiled code can be cached.
     """
     for i in range(1, n + 1):
         f = (i0 + i) / n_ramp
@@ -125,9 +152,14 @@ def run(n, i0, n_ramp, start, end, active, eq_data, pad_eq, xfrc, carriage, whee
                 xfrc[carriage[c], 1] = start[8 + c] + (end[8 + c] - start[8 + c]) * f
             if active[3]:
                 xfrc[wheel[c], 5] = start[12 + c] + (end[12 + c] - start[12 + c]) * f
-        coupling_step(h, qpos, qvel, qfrc, ten_length, ten_velocity, ten_J, jnt_stiffness, dof_damping,
-                      tendon_damping, bush, bank, damp, spring)
-        _mj_step(m_addr, d_addr)
+        coupling_step(h, qpos, qvel, qfrc, ten_length, ten_velocity, ten_J, ten_J_rowadr, ten_J_rownnz, ten_J_colind,
+                      jnt_stiffness, dof_damping, tendon_damping, bush, bank, damp, spring)
+        mj_step(m_addr, d_addr)
+
+
+def run(*args) -> None:
+    """:func:`_run` with MuJoCo's ``mj_step``; ``args`` are the rest of its arguments, from ``n``."""
+    _run(_mj_step, *args)
 
 
 def coupling_arrays(coupling) -> tuple:
