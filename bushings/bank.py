@@ -113,10 +113,14 @@ class BushingBank:
         """
         if not dt > 0.0:
             raise ValueError(f"time step must be positive, got {dt!r}")
-        kn.step_bank(np.ascontiguousarray(e, dtype=float), float(dt), self.P, self.I, self.MX,
-                     self.u, self.wprev, self.slope, self.q, self.eprev, self.cs, self.ck, self.stack,
-                     self.diss, self.nfail, self.force, self.tangent, self._work, self._iwork)
+        kn.step_bank(np.ascontiguousarray(e, dtype=float), float(dt), *self.kernel_args())
         return self.force, self.tangent
+
+    def kernel_args(self) -> tuple[np.ndarray, ...]:
+        """The arrays :func:`bushings.kernel.step_bank` takes after (e, h), in its order, for
+        compiled callers (e.g. a vehicle step loop) that call the kernel themselves."""
+        return (self.P, self.I, self.MX, self.u, self.wprev, self.slope, self.q, self.eprev, self.cs,
+                self.ck, self.stack, self.diss, self.nfail, self.force, self.tangent, self._work, self._iwork)
 
     def run(self, e: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
         """Step through a deflection history e (T, M) or (T,) for one channel; returns forces and

@@ -13,7 +13,6 @@ them in place.
 from __future__ import annotations
 
 import ctypes
-import inspect
 from pathlib import Path
 
 import mujoco
@@ -51,20 +50,6 @@ _mj_step.argtypes = (ctypes.c_size_t, ctypes.c_size_t)  # mjModel*, mjData* as a
 _mj_step.restype = None
 
 
-#: Bank attributes that differ in name from the kernel's parameters.
-_BANK_ATTR = {"F": "force", "K": "tangent", "work": "_work", "iwork": "_iwork"}
-
-
-def bank_args(bank) -> tuple:
-    """The arrays :func:`bushings.kernel.step_bank` takes after (e, h), in order, from ``bank``.
-
-    Matched by the kernel's parameter names, as :meth:`bushings.BushingBank.step` passes them
-    (the bank has no public accessor for them yet); force and tangent come last but two.
-    """
-    names = list(inspect.signature(_kn.step_bank.py_func).parameters)[2:]
-    return tuple(getattr(bank, _BANK_ATTR.get(n, n)) for n in names)
-
-
 @nb.njit(cache=True)
 def _segment(x, xs, ys):
     """Slope and intercept of the padded curve (xs, ys) at x (linear extrapolation at the ends)."""
@@ -94,7 +79,7 @@ def coupling_step(h, qpos, qvel, qfrc, ten_length, ten_velocity, ten_J, ten_J_ro
     """Write the non-implicit forces for the next step of ``h`` [s] (see vehicle.coupling).
 
     ``bush`` = (qpos adr, dof adr, joint ids, base stiffness, K_ref, saturating, e work) of the
-    bank channels, ``bank`` = :func:`bank_args`, ``damp`` = (is joint, dof or tendon index, sign,
+    bank channels, ``bank`` = :meth:`bushings.BushingBank.kernel_args`, ``damp`` = (is joint, dof or tendon index, sign,
     xs, ys, intercept out [N], work), ``spring`` = (is joint, index, qpos adr, design, sign, xs, ys, rate, y0,
     nonlinear?, remainder work).
     """
@@ -171,7 +156,7 @@ def coupling_arrays(coupling) -> tuple:
     idx = b.bank_idx if on else np.zeros(0, np.int64)
     bush = (b.qpos[idx].astype(np.int64), b.dof[idx].astype(np.int64), b.jnt[idx].astype(np.int64), b.K[idx].copy(),
             b.K_ref if on else np.zeros(0), b.saturating if on else np.zeros(0, np.bool_), np.zeros(idx.size))
-    bank = bank_args(b.bank if on else BushingBank([]))
+    bank = (b.bank if on else BushingBank([])).kernel_args()
     c = coupling
     damp = (c.dp_joint, c.dp_index.astype(np.int64), c.dp_sign.astype(float), c.dp_xs, c.dp_ys, c.dp_offset,
             np.zeros(len(c.dp_offset)))
