@@ -90,7 +90,7 @@ def test_sign_conventions(vehicle):
     r = KCRig(dataclasses.replace(vehicle, front=front))
     r.settle(0.3)
     o = r.measure()
-    m, d = r.model, r.data
+    d = r.data
     for corner, sign in (("front_left", 1.0), ("front_right", -1.0)):
         w = o.wheels[corner]
         assert math.degrees(w.toe) == pytest.approx(2.0, abs=0.3)

@@ -125,7 +125,7 @@ class ForceCoupling:
         self._kernel: tuple = ()
 
     def _init_elements(self) -> None:
-        m, d = self.model, self.data
+        m = self.model
         springs = [e for e in self.car.elements if e.spring is not None]
         dampers = [e for e in self.car.elements if e.damper_curve is not None]
         jid = lambda n: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, n)

@@ -10,7 +10,9 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from contextlib import contextmanager
 from dataclasses import dataclass
+from typing import Iterator
 
 import mujoco
 import numpy as np
@@ -100,6 +102,20 @@ class KCRig:
         self.coupling.reset()
         self.set_pads([0.0] * 4)
         self.set_rack(0.0)
+
+    @contextmanager
+    def bushing_laws_off(self) -> Iterator[None]:
+        """Within the block every bushing direction is linear, with the stiffness and damping held
+        in its joint (the reference tangent); on leaving, the laws are back, from their virgin state
+        (the thesis settles the car this way before switching the bushing models on)."""
+        # The coupling skips a bank it does not have and then reports the joint forces of every channel.
+        forces = self.coupling.bushings
+        laws, forces.bank = forces.bank, None
+        try:
+            yield
+        finally:
+            forces.bank = laws
+            self.coupling.reset()
 
     # -- running -----------------------------------------------------------------------------
     def step(self, n: int = 1) -> None:

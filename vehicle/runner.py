@@ -26,10 +26,9 @@ import importlib.metadata
 import math
 import subprocess
 import time
-from contextlib import contextmanager
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
-from typing import Callable, Iterator
+from typing import Callable
 
 import mujoco
 import numpy as np
@@ -170,20 +169,6 @@ def is_rotation(channel: str) -> bool:
 
 
 # -- the rig ----------------------------------------------------------------------------------------
-@contextmanager
-def bushing_laws_off(rig: KCRig) -> Iterator[None]:
-    """Within the block every bushing direction of ``rig`` is linear, with the stiffness and damping
-    held in its joint (the reference tangent); on leaving, the laws are back, from their virgin state."""
-    # The coupling skips a bank it does not have and then reports the joint forces of every channel.
-    forces = rig.coupling.bushings
-    laws, forces.bank = forces.bank, None
-    try:
-        yield
-    finally:
-        forces.bank = laws
-        rig.coupling.reset()
-
-
 def apply_inputs(rig: KCRig, u: np.ndarray) -> None:
     """Set the rig inputs ``u`` (SI, INPUT_CHANNELS order)."""
     rig.set_pads(u[0:4])
@@ -339,7 +324,7 @@ def _run_case(rig: KCRig, scenario: Scenario, case: Case, number: int, when: Cas
             record(step, phase, rest)
 
     apply_inputs(rig, rest)
-    with bushing_laws_off(rig):
+    with rig.bushing_laws_off():
         record(step, 0, rest)
         hold(0)
     hold(1)
