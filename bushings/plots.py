@@ -14,11 +14,16 @@ from bushings.parameters import ChannelParams
 from bushings.programmes import MM
 
 
+def save_figure(fig: Figure, path: Path, dpi: int = 120) -> Path:
+    """Write the figure as an image atomically, so that a reader never sees half a file."""
+    with atomic_output(path) as tmp:
+        fig.savefig(tmp, dpi=dpi)
+    return path
+
+
 def _save(fig: Figure, path: Path) -> Path:
     fig.tight_layout()
-    with atomic_output(path) as tmp:
-        fig.savefig(tmp, dpi=120)
-    return path
+    return save_figure(fig, path)
 
 
 def plot_time_series(columns: Mapping[str, np.ndarray], kind: str, out_dir: Path, stem: str) -> list[Path]:

@@ -11,6 +11,7 @@ matplotlib.use("Agg")  # files only: no display needed, and no GUI backend picke
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from bushings.plots import save_figure  # noqa: E402
 from vehicle.io import Run  # noqa: E402
 
 PAIR_PANEL_IN = (4.5, 3.4)
@@ -81,7 +82,7 @@ def plot_time_histories(run: Run, out_dir: Path, *, log_time: bool = False, t0_s
 
 
 def _save(fig: plt.Figure, path: Path) -> Path:
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)
     return path
 
