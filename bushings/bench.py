@@ -19,7 +19,7 @@ from typing import Any, Iterator, Mapping
 import numpy as np
 import yaml
 
-from bushings.bank import BushingBank
+from bushings.effects import NO_EFFECTS, Effects, ExtendedBank
 from bushings.errors import InputError
 from bushings.frequency import first_harmonic
 from bushings.parameters import MODELS, ChannelParams, load_parameter_set, to_si
@@ -36,6 +36,7 @@ class Bench:
     channel: ChannelParams
     dt_s: float                     #: time step [s] (for a sweep: the largest allowed real step)
     programme: TimeSeries | Sweep
+    effects: Effects = NO_EFFECTS   #: the parameter set's law extensions (time-series programmes)
 
 
 def parse_bench(data: Any, source: str, base_dir: Path | None = None) -> Bench:
@@ -57,12 +58,13 @@ def parse_bench(data: Any, source: str, base_dir: Path | None = None) -> Bench:
     if model is not None and model not in MODELS:
         raise InputError(f"unknown model {model!r}; expected one of {', '.join(MODELS)}", source=source, key="model")
     params = data["params"]
+    effects = NO_EFFECTS
     if isinstance(params, Mapping):
         if model is None:
             raise InputError("missing key (needed with inline params)", source=source, key="model")
         channel = to_si(model, params, source=source)
     elif isinstance(params, str):
-        channel = _named_set(params, model, source, base_dir)
+        channel, effects = _named_set(params, model, source, base_dir)
     else:
         raise InputError(f"expected a parameter-set name or a mapping, got {params!r}", source=source, key="params")
     if channel.quantity != "translation":
@@ -70,16 +72,22 @@ def parse_bench(data: Any, source: str, base_dir: Path | None = None) -> Bench:
     dt = data["dt_s"]
     if isinstance(dt, bool) or not isinstance(dt, (int, float)) or not 0.0 < dt < math.inf:
         raise InputError(f"expected a positive time step in s, got {dt!r}", source=source, key="dt_s")
-    return Bench(source, channel, float(dt), parse_programme(data["programme"], float(dt), source, base_dir))
+    programme = parse_programme(data["programme"], float(dt), source, base_dir)
+    if effects.active and isinstance(programme, Sweep):
+        raise InputError(f"set {params!r} has effects (state extensions), which a sweep's per-point restarts "
+                         f"would misrepresent; play its sines as time-series programmes", source=source, key="params")
+    return Bench(source, channel, float(dt), programme, effects)
 
 
-def _named_set(name: str, model: str | None, source: str, base_dir: Path | None) -> ChannelParams:
-    """A parameter set by name, or by path relative to the bench file; errors name both files."""
+def _named_set(name: str, model: str | None, source: str, base_dir: Path | None) -> tuple[ChannelParams, Effects]:
+    """A parameter set (SI law and effects) by name, or by path relative to the bench file; errors
+    name both files."""
     path = Path(name)
     if path.suffix in (".yaml", ".yml") and not path.is_absolute() and base_dir is not None:
         name = str(base_dir / path)
     try:
-        return load_parameter_set(name).channel(model)
+        pset = load_parameter_set(name)
+        return pset.channel(model), pset.effects_si()
     except InputError as exc:
         raise InputError(str(exc), source=source, key="params") from exc
 
@@ -104,7 +112,7 @@ def run_bench(bench: Bench) -> dict[str, np.ndarray]:
                                 points_per_cycle=prog.points_per_cycle, max_dt_s=bench.dt_s)
         return {"amplitude_mm": amplitude / MM, "frequency_hz": frequency,
                 "k_dyn_n_per_mm": result.k_dyn_n_per_m * MM, "tan_delta": result.tan_delta}
-    force, _ = BushingBank([bench.channel]).run(prog.e_m, bench.dt_s)
+    force = ExtendedBank([bench.channel], [bench.effects]).run(prog.e_m, bench.dt_s)[:, 0]
     return {"t_s": prog.t_s, "e_mm": prog.e_m / MM, "F_N": force}
 
 

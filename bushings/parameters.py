@@ -10,11 +10,14 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any, Mapping
+from typing import TYPE_CHECKING, Any, Mapping
 
 import yaml
 
 from bushings.errors import InputError
+
+if TYPE_CHECKING:
+    from bushings.effects import Effects
 
 #: The folder holding the named parameter sets shipped with the project.
 PARAMETER_SET_DIR = Path(__file__).resolve().parent.parent / "models" / "bushings"
@@ -32,17 +35,19 @@ _LENGTH_POWER = {
 }
 
 _ELASTIC_KEYS = ("N_sup", "N_inf", "S_sup", "S_inf", "P_sup", "P_inf")
+# Parallel Maxwell branches: the TVS's viscoelastic part, and broad-spectrum relaxation on any law.
+_MAXWELL_KEYS = ("maxwell_k", "maxwell_c")
 
 #: model name -> (required keys, optional keys) in the user-facing parameter mapping.
 MODELS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
-    "linear": (("K0",), ("C",) + _ELASTIC_KEYS),
-    "elastic": (("K0",) + _ELASTIC_KEYS, ("C",)),
-    "sts": (("K0", "Kpa", "Kr", "Ff"), ("N", "C") + _ELASTIC_KEYS),
-    "sts_continuous": (("K0", "Kpa", "Ct"), ("C",) + _ELASTIC_KEYS),
-    "stsn": (("K0", "Kpa", "Ct", "n"), ("C",) + _ELASTIC_KEYS),
-    "rt": (("K0", "Kpa", "Kr", "Co", "pw"), ("N", "C") + _ELASTIC_KEYS),
-    "stvs": (("K0", "Kpa", "Kr", "Ff", "Co", "pw"), ("N", "C") + _ELASTIC_KEYS),
-    "tvs": (("K0", "Kpa", "Kr", "Ff", "maxwell_k", "maxwell_c"), ("N", "C") + _ELASTIC_KEYS),
+    "linear": (("K0",), ("C",) + _ELASTIC_KEYS + _MAXWELL_KEYS),
+    "elastic": (("K0",) + _ELASTIC_KEYS, ("C",) + _MAXWELL_KEYS),
+    "sts": (("K0", "Kpa", "Kr", "Ff"), ("N", "C") + _ELASTIC_KEYS + _MAXWELL_KEYS),
+    "sts_continuous": (("K0", "Kpa", "Ct"), ("C",) + _ELASTIC_KEYS + _MAXWELL_KEYS),
+    "stsn": (("K0", "Kpa", "Ct", "n"), ("C",) + _ELASTIC_KEYS + _MAXWELL_KEYS),
+    "rt": (("K0", "Kpa", "Kr", "Co", "pw"), ("N", "C") + _ELASTIC_KEYS + _MAXWELL_KEYS),
+    "stvs": (("K0", "Kpa", "Kr", "Ff", "Co", "pw"), ("N", "C") + _ELASTIC_KEYS + _MAXWELL_KEYS),
+    "tvs": (("K0", "Kpa", "Kr", "Ff") + _MAXWELL_KEYS, ("N", "C") + _ELASTIC_KEYS),
 }
 
 #: Length unit of user-facing parameter values, per quantity, in SI.
@@ -151,7 +156,7 @@ def to_si(model: str, values: Mapping[str, Any], quantity: str = "translation",
         si["Co"] = si["Co"] / length ** si.get("pw", 1.0)
     if "n" in si:
         si["n_root"] = si.pop("n")
-    if "maxwell_k" in si and len(si["maxwell_k"]) != len(si.get("maxwell_c", ())):
+    if len(si.get("maxwell_k", ())) != len(si.get("maxwell_c", ())):
         raise InputError("maxwell_k and maxwell_c must have the same length", source=source, key="maxwell_c")
     _check_elastic(si, source)
     if model in ("sts", "rt", "stvs", "tvs"):
@@ -181,6 +186,13 @@ class ParameterSet:
     values: Mapping[str, Any]  #: user-facing values in the thesis's units
     source: str                #: provenance (publication, figure, measurement, assumption)
     path: Path | None = None
+    effects: Mapping[str, Any] = field(default_factory=dict)  #: law extensions, see :mod:`bushings.effects`
+
+    def effects_si(self) -> "Effects":
+        """The set's state extensions (preload, asymmetry, Mullins, self-heating, backlash) in SI."""
+        from bushings.effects import effects_to_si  # effects builds on this module
+
+        return effects_to_si(self.effects, self.quantity, str(self.path or self.name))
 
     def channel(self, model: str | None = None) -> ChannelParams:
         """SI parameters of this set, optionally read as another model.
@@ -207,7 +219,7 @@ def parse_parameter_set(data: Any, source: str, name: str | None = None) -> Para
     """Validate the mapping of a parameter-set file (keys: model, quantity, source, params)."""
     if not isinstance(data, Mapping):
         raise InputError("expected a mapping with keys model, params, source", source=source)
-    allowed = {"name", "model", "quantity", "source", "description", "params"}
+    allowed = {"name", "model", "quantity", "source", "description", "params", "effects"}
     unknown = sorted(set(data) - allowed)
     if unknown:
         raise InputError(f"unknown key {unknown[0]!r}; expected {', '.join(sorted(allowed))}",
@@ -215,13 +227,16 @@ def parse_parameter_set(data: Any, source: str, name: str | None = None) -> Para
     for key in ("model", "params"):
         if key not in data:
             raise InputError("missing key", source=source, key=key)
-    if not isinstance(data["params"], Mapping):
-        raise InputError(f"expected a mapping of parameters, got {data['params']!r}", source=source, key="params")
+    for key in ("params", "effects"):
+        if not isinstance(data.get(key, {}), Mapping):
+            raise InputError(f"expected a mapping, got {data[key]!r}", source=source, key=key)
     pset = ParameterSet(name=str(data.get("name", name or source)), model=str(data["model"]),
                         quantity=str(data.get("quantity", "translation")), values=dict(data["params"]),
                         source=str(data.get("source", "unspecified")),
-                        path=Path(source) if source.endswith((".yaml", ".yml")) else None)
+                        path=Path(source) if source.endswith((".yaml", ".yml")) else None,
+                        effects=dict(data.get("effects") or {}))
     pset.channel()  # validate now, so errors name this file
+    pset.effects_si()
     return pset
 
 

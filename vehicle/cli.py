@@ -19,6 +19,9 @@ COMMAND_MODULES = (
     "vehicle.model_cli",
     "vehicle.kc_cli",
     "vehicle.run_cli",
+    "vehicle.diagnose_cli",
+    "vehicle.rig_cli",
+    "vehicle.compare_cli",
 )
 
 

@@ -1,4 +1,5 @@
-"""Load a run recorded by :class:`vehicle.recording.RunWriter` back into numpy arrays."""
+"""Load a run recorded by :class:`vehicle.recording.RunWriter` back into numpy arrays: a simulated run,
+or a measured rig recording (``data/README.md``: no bodies, no model in its metadata)."""
 
 from __future__ import annotations
 
@@ -153,11 +154,12 @@ def load_run(path: str | os.PathLike[str]) -> Run:
         ],
         metadata=RunMetadata(
             scenario_yaml=run["scenario_yaml"],
-            vehicle_yaml=run["vehicle_yaml"],
-            bushing_parameters=json.loads(run["bushing_parameters"]),
+            vehicle_yaml=run.get("vehicle_yaml", ""),  # a rig recording has no model
+            bushing_parameters=json.loads(run.get("bushing_parameters", "{}")),
             software_version=run["software_version"],
             git_revision=run["git_revision"],
             extra=json.loads(run["extra"]),
+            source=run.get("source", "simulation"),  # files written before sources existed are simulated
         ),
         complete=status["complete"] == "true",
         reason=status["reason"],

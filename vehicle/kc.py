@@ -30,13 +30,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Callable
 
 import mujoco
 import numpy as np
 
 from vehicle.builder import BuildOptions
 from vehicle.definition import VehicleDefinition
-from vehicle.rig import KCRig, RigOutputs
+from vehicle.rig import KCRig, RigOutputs, WheelOutputs
 
 SETTLE = 0.5             #: rest before each test [s]
 FIT_FRACTION = 0.8       #: slopes and loop widths over ±80 % of the amplitude
@@ -62,6 +63,7 @@ TESTS = (
     Triangle("longitudinal", "fx", (-1, -1, -1, -1), 1500.0, 2000.0),
     Triangle("aligning", "mz", (1, 1, 1, 1), 150.0, 200.0),
 )
+TEST = {t.name: t for t in TESTS}   #: the tests by name
 
 #: JSON key, unit, and sign convention of each metric.
 METRICS = (
@@ -139,48 +141,88 @@ def _design_contact_base(rig: KCRig) -> dict[str, float]:
             for a in AXLES}
 
 
+#: Per-wheel quantities the metric definitions read, from one rig sample's wheel (SI).
+WHEEL_QUANTITIES: dict[str, Callable[[WheelOutputs], float]] = {
+    "pad_height": lambda w: w.pad_height, "toe": lambda w: w.toe, "camber": lambda w: w.camber,
+    "steer": lambda w: w.steer, "wheel_centre_y": lambda w: w.wheel_centre[1],
+    "pad_fx": lambda w: w.pad_force[0], "pad_fy": lambda w: w.pad_force[1], "pad_mz": lambda w: w.pad_torque,
+}
+
+#: One leg of a triangle: ``leg(quantity, corner)`` is that quantity's samples on the leg (SI;
+#: quantities of :data:`WHEEL_QUANTITIES`, corners of ``vehicle.builder.CORNERS``). Rig samples and
+#: recorded runs both provide legs, so that both use the definitions below.
+Leg = Callable[[str, str], np.ndarray]
+
+
+def rig_leg(samples: list[RigOutputs]) -> Leg:
+    """The :data:`Leg` of samples measured on the rig."""
+    return lambda quantity, corner: np.array([WHEEL_QUANTITIES[quantity](o.wheels[corner]) for o in samples])
+
+
+def fit_window(test: str, amplitude: float, base: float) -> float:
+    """Half-width of the fits of ``test`` [its fitted input's unit: m, N, N·m; roll: deg of roll]
+    for an input of ``amplitude`` [m, N or N·m] and an axle's contact-point base ``base`` [m]."""
+    return FIT_FRACTION * amplitude * _input_scale(test, base)
+
+
+def triangle_metrics(test: str, axle: str, down: Leg, up: Leg, window: float, base: float) -> dict[str, float]:
+    """The gradients and compliances of :data:`METRICS` that ``test`` (a :data:`TESTS` name) gives
+    for ``axle``, fitted over ±``window`` (:func:`fit_window`); ``base`` [m] is the axle's
+    contact-point base at design (used by roll only)."""
+    L, R = f"{axle}_left", f"{axle}_right"
+    deg = np.degrees
+
+    def slope(x: Callable[[Leg], np.ndarray], y: Callable[[Leg], np.ndarray]) -> float:
+        return centre_slope(Branches(x(down), y(down), x(up), y(up)), window)
+
+    def each(x: str, y: str, scale: Callable[[np.ndarray], np.ndarray] = deg) -> float:
+        """Mean over the axle's two wheels of the slope of scale(quantity y) against quantity x."""
+        return 0.5 * sum(slope(lambda g, c=c: g(x, c), lambda g, c=c: scale(g(y, c))) for c in (L, R))
+
+    steer = lambda g: deg(0.5 * (g("steer", L) + g("steer", R)))
+    # right minus left: the right wheel is the outer one in roll, and +Fy points inboard on it
+    camber = lambda g: deg(g("camber", R) - g("camber", L)) / 2
+    if test == "bump":
+        return {"bump_steer_deg_per_m": each("pad_height", "toe"), "bump_camber_deg_per_m": each("pad_height", "camber")}
+    if test == "roll":
+        roll = lambda g: deg((g("pad_height", R) - g("pad_height", L)) / base)
+        # the outer wheel's camber to the ground gains the roll angle itself
+        return {"roll_steer_deg_per_deg": slope(roll, steer), "roll_camber_deg_per_deg": 1.0 + slope(roll, camber)}
+    if test == "lateral":
+        fy = lambda g: g("pad_fy", L)
+        return {"lateral_force_compliance_steer_deg_per_kn": 1e3 * slope(fy, steer),
+                "lateral_force_compliance_camber_deg_per_kn": 1e3 * slope(fy, camber),
+                "lateral_compliance_mm_per_kn": 1e6 * each("pad_fy", "wheel_centre_y", lambda v: v)}
+    if test == "longitudinal":
+        return {"longitudinal_compliance_steer_deg_per_kn": -1e3 * each("pad_fx", "toe")}
+    if test == "aligning":
+        return {"aligning_torque_compliance_steer_deg_per_knm": 1e3 * slope(lambda g: g("pad_mz", L), steer)}
+    raise ValueError(f"unknown K&C test {test!r}; expected one of {', '.join(t.name for t in TESTS)}")
+
+
+def bump_loop_widths(axle: str, down: Leg, up: Leg, window: float) -> dict[str, float]:
+    """Toe and camber loop widths [deg] of the bump test (keys of :data:`METRICS`), mean of the
+    axle's two wheels, against the pad height over ±``window`` [m]."""
+    m = {}
+    for angle in ("toe", "camber"):
+        widths = [loop_width(Branches(down("pad_height", c), np.degrees(down(angle, c)),
+                                      up("pad_height", c), np.degrees(up(angle, c))), window)
+                  for c in (f"{axle}_left", f"{axle}_right")]
+        m[f"{angle}_loop_width_deg"] = float(np.mean([w[0] for w in widths]))
+        m[f"{angle}_loop_width_max_deg"] = float(np.mean([w[1] for w in widths]))
+    return m
+
+
 def kc_metrics(rig: KCRig) -> dict[str, dict[str, float]]:
     """Run the K&C sequence (:data:`TESTS`) on ``rig``; metrics per axle (keys of :data:`METRICS`)."""
     base = _design_contact_base(rig)
-    runs = {t.name: (t, run_triangle(rig, t)) for t in TESTS}
-    deg = math.degrees
+    legs = {t.name: [rig_leg(samples) for samples in run_triangle(rig, t)] for t in TESTS}
     out: dict[str, dict[str, float]] = {}
     for axle in AXLES:
-        L, R = f"{axle}_left", f"{axle}_right"
-
-        def slope(test: str, x, y) -> float:
-            t, (down, up) = runs[test]
-            return centre_slope(branches(down, up, x, y), FIT_FRACTION * t.amplitude * _input_scale(test, base[axle]))
-
-        def each(test: str, x, y) -> float:
-            """Mean over the axle's two wheels of slope(x(wheel), y(wheel))."""
-            return 0.5 * sum(slope(test, lambda o, c=c: x(o.wheels[c]), lambda o, c=c: y(o.wheels[c])) for c in (L, R))
-
-        roll = lambda o: deg((o.wheels[R].pad_height - o.wheels[L].pad_height) / base[axle])
-        steer = lambda o: deg(0.5 * (o.wheels[L].steer + o.wheels[R].steer))
-        m = {
-            "bump_steer_deg_per_m": each("bump", lambda w: w.pad_height, lambda w: deg(w.toe)),
-            "bump_camber_deg_per_m": each("bump", lambda w: w.pad_height, lambda w: deg(w.camber)),
-            "roll_steer_deg_per_deg": slope("roll", roll, steer),
-            # right wheel outer; its camber to the ground gains the roll angle itself
-            "roll_camber_deg_per_deg": 1.0 + slope("roll", roll, lambda o: deg(o.wheels[R].camber - o.wheels[L].camber) / 2),
-            "lateral_force_compliance_steer_deg_per_kn": 1e3 * slope("lateral", lambda o: o.wheels[L].pad_force[1], steer),
-            # +Fy points inboard on the right wheel, outboard on the left
-            "lateral_force_compliance_camber_deg_per_kn": 1e3 * slope(
-                "lateral", lambda o: o.wheels[L].pad_force[1], lambda o: deg(o.wheels[R].camber - o.wheels[L].camber) / 2),
-            "lateral_compliance_mm_per_kn": 1e6 * each("lateral", lambda w: w.pad_force[1], lambda w: w.wheel_centre[1]),
-            "longitudinal_compliance_steer_deg_per_kn": -1e3 * each("longitudinal", lambda w: w.pad_force[0],
-                                                                     lambda w: deg(w.toe)),
-            "aligning_torque_compliance_steer_deg_per_knm": 1e3 * slope("aligning", lambda o: o.wheels[L].pad_torque, steer),
-        }
-        t, (down, up) = runs["bump"]
-        window = FIT_FRACTION * t.amplitude
-        for name, angle in (("toe", "toe"), ("camber", "camber")):
-            widths = [loop_width(branches(down, up, lambda o, c=c: o.wheels[c].pad_height,
-                                           lambda o, c=c: deg(getattr(o.wheels[c], angle))), window) for c in (L, R)]
-            m[f"{name}_loop_width_deg"] = float(np.mean([w[0] for w in widths]))
-            m[f"{name}_loop_width_max_deg"] = float(np.mean([w[1] for w in widths]))
-        out[axle] = m
+        m = {}
+        for t in TESTS:
+            m |= triangle_metrics(t.name, axle, *legs[t.name], fit_window(t.name, t.amplitude, base[axle]), base[axle])
+        out[axle] = m | bump_loop_widths(axle, *legs["bump"], fit_window("bump", TEST["bump"].amplitude, base[axle]))
     rig.reset()
     return out
 

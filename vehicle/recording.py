@@ -5,7 +5,8 @@ Layout of a run file (topics, encodings and why):
 ``/tf``
     ``foxglove.FrameTransforms`` (protobuf), one message per recorded step holding every body's
     world pose (parent frame ``world``, child frame = body name, metres, unit quaternion).
-    Foxglove's 3D panel and Rerun's MCAP importer both turn it into transforms.
+    Foxglove's 3D panel and Rerun's MCAP importer both turn it into transforms. Absent from a
+    recording without bodies (a measured rig recording, ``data/README.md``).
 ``/signals/<group>``
     ``sensor_msgs/msg/JointState`` (ROS 2 message definition, CDR), one message per step and
     group: ``position`` holds the group's values, ``name`` the labels ``"<signal> [<unit>]"``.
@@ -16,8 +17,10 @@ Layout of a run file (topics, encodings and why):
     one ``foxglove.SceneUpdate`` at t = 0 with each body's primitives locked to the body's frame,
     so Foxglove's 3D panel shows the car moving.
 metadata record ``vsim.run``
-    scenario and vehicle YAML, bushing parameter sets, software version, git revision, free-form
-    extras, the signal list (name, unit, group, x-axis hint), the body list and the geometry (JSON).
+    the source (``simulation`` or ``rig``), scenario and vehicle YAML, bushing parameter sets,
+    software version, git revision, free-form extras, the signal list (name, unit, group, x-axis
+    hint), the body list and the geometry (JSON). A ``rig`` record has no vehicle YAML and no
+    bushing parameters: measured data carries nothing about a model.
 metadata record ``vsim.status``
     written by :meth:`RunWriter.close`: ``complete`` (``"true"``/``"false"``) and ``reason``.
 
@@ -66,6 +69,9 @@ STATUS_RECORD = "vsim.status"
 FORMAT_VERSION = "vsim-run/1"
 PARTIAL_SUFFIX = ".partial"
 
+#: Where a run's signals come from: the simulator, or a rig (measured data, see ``data/README.md``).
+SOURCES = ("simulation", "rig")
+
 #: Signal, group and body names become topics, frame ids and Rerun entity paths: keep them plain.
 NAME_PATTERN = re.compile(r"[A-Za-z0-9_.\-]+")
 
@@ -107,7 +113,11 @@ class GeomSpec:
 
 @dataclass(frozen=True)
 class RunMetadata:
-    """What is needed to reproduce and identify a run; stored verbatim in the ``vsim.run`` record."""
+    """What is needed to reproduce and identify a run; stored verbatim in the ``vsim.run`` record.
+
+    ``source`` is one of SOURCES; a ``rig`` run must leave ``vehicle_yaml`` and
+    ``bushing_parameters`` empty (they are not stored).
+    """
 
     scenario_yaml: str = ""
     vehicle_yaml: str = ""
@@ -115,6 +125,7 @@ class RunMetadata:
     software_version: str = ""
     git_revision: str = ""
     extra: Mapping[str, Any] = field(default_factory=dict)
+    source: str = "simulation"
 
 
 def _json(value: Any) -> str:
@@ -367,6 +378,11 @@ class RunWriter:
                 "the output exists; pass --overwrite (overwrite=True) to replace it", source=str(self.path)
             )
         _check_specs(signals, bodies, geometry)
+        if metadata.source not in SOURCES:
+            raise ValueError(f"run source {metadata.source!r}; expected one of {SOURCES}")
+        if metadata.source == "rig" and (metadata.vehicle_yaml or metadata.bushing_parameters):
+            raise ValueError("a rig recording carries no model: leave vehicle_yaml and bushing_parameters empty")
+        model = {"vehicle_yaml": metadata.vehicle_yaml, "bushing_parameters": _json(metadata.bushing_parameters)}
         self.signals = list(signals)
         self.bodies = list(bodies)
         self.partial_path = self.path.with_name(self.path.name + PARTIAL_SUFFIX)
@@ -376,9 +392,9 @@ class RunWriter:
 
         run_record = {
             "format": FORMAT_VERSION,
+            "source": metadata.source,
             "scenario_yaml": metadata.scenario_yaml,
-            "vehicle_yaml": metadata.vehicle_yaml,
-            "bushing_parameters": _json(metadata.bushing_parameters),
+            **(model if metadata.source == "simulation" else {}),
             "software_version": metadata.software_version,
             "git_revision": metadata.git_revision,
             "extra": _json(metadata.extra),
@@ -396,12 +412,13 @@ class RunWriter:
             writer_options=MCAPWriteOptions(compression=MCAPCompression.Zstd, profile=""),
         )
         self._writer.write_metadata(RUN_RECORD, run_record)
-        self._tf_channel = foxglove.Channel(
-            TF_TOPIC,
-            schema=foxglove.messages.FrameTransforms.get_schema(),
-            message_encoding="protobuf",
-            context=self._context,
-        )
+        if self.bodies:  # no empty /tf channel in a recording without bodies
+            self._tf_channel = foxglove.Channel(
+                TF_TOPIC,
+                schema=foxglove.messages.FrameTransforms.get_schema(),
+                message_encoding="protobuf",
+                context=self._context,
+            )
         joint_state = foxglove.Schema(name="sensor_msgs/msg/JointState", encoding="ros2msg", data=JOINT_STATE_SCHEMA)
         self._groups: list[tuple[foxglove.Channel, JointStateLayout, np.ndarray]] = []
         for group in dict.fromkeys(s.group for s in self.signals):

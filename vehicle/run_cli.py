@@ -1,9 +1,10 @@
 """`vsim run SCENARIO.yaml`: run a scenario on the K&C rig with a progress bar, record it, summarise it.
 
-The summary is computed from the recorded file (so it also describes an incomplete run): the
-centre-line gradients and loop widths of camber, toe and half-track on each case's last cycle
-(periodic inputs, with :mod:`vehicle.kc`'s definitions), the toe drift over the final hold (rack
-steps), and the peak deflection of every bushing during the inputs.
+The summary is computed from the recorded file (so it also describes an incomplete run) by
+:mod:`vehicle.run_metrics`: the centre-line gradients and loop widths of camber, toe and half-track
+on each case's last cycle and the named K&C metrics of `vsim kc` per case and axle (periodic
+inputs, with :mod:`vehicle.kc`'s definitions), the toe drift over the final hold (rack steps), and
+the peak deflection of every bushing during the inputs.
 """
 
 from __future__ import annotations
@@ -19,7 +20,6 @@ import numpy as np
 from vehicle.model_cli import BUSHING_MODELS
 
 SUMMARY_CORNERS = {"front": "fl", "rear": "rl"}   #: the left wheel of each axle is summarised
-BUMP_WINDOW_MM = 20.0   #: gradients against wheel travel at design height over ±20 mm (spec §4)
 _DIRECTIONS = ("x", "y", "z", "rx", "ry", "rz")
 
 
@@ -69,78 +69,65 @@ class ProgressBar:
             self.dirty = False
 
 
-def _case_mask(run, case: dict, last_cycle: bool) -> np.ndarray:
-    """Samples of ``case``'s input phase (or of its last cycle)."""
-    start, end = case["input_start_s"], case["end_s"]
-    if last_cycle:
-        start += (end - start) * (case["cycles"] - 1) / case["cycles"]
-    return (run.signals["case"] == case["case"]) & (run.signals["phase"] == 2) & (run.t_s >= start - 1e-9)
+def _loop_table(run) -> list[str]:
+    from vehicle.run_metrics import BUMP_WINDOW_M, FIT_FRACTION, case_loop, cases, gradient_unit, loop_axes
 
-
-def branches(run, case: dict, x: str, y: str, driver: str):
-    """:class:`vehicle.kc.Branches` of signal ``y`` against ``x`` on the last cycle of ``case``,
-    split by the direction of the input signal ``driver``; None without both branches."""
-    from vehicle.kc import Branches
-
-    mask = _case_mask(run, case, last_cycle=True)
-    xs, ys, drive = run.signals[x][mask], run.signals[y][mask], run.signals[driver][mask]
-    change = np.diff(drive, prepend=drive[:1])
-    down, up = change < 0, change > 0
-    if down.sum() < 2 or up.sum() < 2:
-        return None
-    return Branches(xs[down], ys[down], xs[up], ys[up])
-
-
-def _common_range(b) -> float:
-    """Half-width of the x range both branches cover on each side of 0."""
-    return float(min(b.x_down.max(), b.x_up.max(), -b.x_down.min(), -b.x_up.min()))
-
-
-def _loop_table(run, extra: dict) -> list[str]:
-    from vehicle.kc import FIT_FRACTION, centre_slope, loop_width
-
-    x_quantity = extra["x_quantity"]
-    travel = x_quantity == "wheel_travel"
-    driver = "pad_z" if travel else x_quantity
-    per = {"wheel_travel": "m", "pad_mz": "kN·m"}.get(x_quantity, "kN")  # x is in mm, N or N·m: slopes × 1000
-    quantities = (("camber", "deg"), ("toe", "deg"), ("half_track", "mm"))
+    extra = run.metadata.extra
+    travel = extra["x_quantity"] == "wheel_travel"
+    quantities = ("camber", "toe", "half_track")
+    x_unit = run.units[loop_axes(run, "fl")[0]]
+    units = {q: (run.units[f"{q}_fl"], gradient_unit(run.units[f"{q}_fl"], x_unit)) for q in quantities}
     window = f"±{FIT_FRACTION:.0%} of the range"
     rows = [f"last cycle, left wheels: gradient = centre-line slope at {'design height' if travel else 'zero load'} "
-            f"(over {f'±{BUMP_WINDOW_MM:g} mm or ' if travel else ''}{window}{', the smaller' if travel else ''}); "
+            f"(over {f'±{BUMP_WINDOW_M * 1e3:g} mm or ' if travel else ''}{window}{', the smaller' if travel else ''}); "
             f"loop = loop width there (largest over {window})",
-            f"  {'case':<24} {'wheel':<5}" + "".join(f" {f'{q} [{u}/{per}]':>20} {f'loop [{u}]':>18}" for q, u in quantities)]
-    for case in extra["cases"]:
+            f"  {'case':<24} {'wheel':<5}" + "".join(f" {f'{q} [{per}]':>20} {f'loop [{u}]':>18}"
+                                                      for q, (u, (_, per)) in units.items())]
+    for case in cases(run):
         for axle in extra["axles"]:
             tag = SUMMARY_CORNERS[axle]
-            cells = []
-            for quantity, _ in quantities:
-                b = branches(run, case, f"{x_quantity}_{tag}", f"{quantity}_{tag}", f"{driver}_{tag}")
-                reach = _common_range(b) if b is not None else 0.0
-                if not reach > 0:
-                    break  # an incomplete run did not reach this case's last cycle
-                gradient = centre_slope(b, min(FIT_FRACTION * reach, BUMP_WINDOW_MM) if travel else FIT_FRACTION * reach)
-                at, most = loop_width(b, FIT_FRACTION * reach)
-                cells.append(f" {1e3 * gradient:20.4f} {f'{at:.4f} ({most:.4f})':>18}")
-            else:
-                rows.append(f"  {case['label'][:24]:<24} {tag:<5}" + "".join(cells))
-    if any(case["cycles"] == 1 for case in extra["cases"]):
+            x, driver = loop_axes(run, tag)
+            loops = [case_loop(run, case, x, f"{q}_{tag}", driver) for q in quantities]
+            if None in loops:
+                continue  # an incomplete run did not reach this case's last cycle
+            cells = [f" {scale * loop.gradient:20.4f} {f'{loop.width:.4f} ({loop.width_max:.4f})':>18}"
+                     for loop, (_, (scale, _)) in zip(loops, units.values())]
+            rows.append(f"  {case['label'][:24]:<24} {tag:<5}" + "".join(cells))
+    if any(case["cycles"] == 1 for case in cases(run)):
         rows.append("  (a case of one cycle has the virgin first loading, 0 to +A, in its loading branch)")
     return rows
 
 
-def _drift_table(run, extra: dict) -> list[str]:
+def _kc_table(run) -> list[str]:
+    from vehicle.kc import METRICS
+    from vehicle.run_metrics import cases, run_metrics
+
+    metrics = run_metrics(run)
+    labels = {case["case"]: case["label"][:16] for case in cases(run)}
+    keys = [(key, unit) for key, unit, _ in METRICS if any(key in m for c in metrics.values() for m in c.values())]
+    if not keys:
+        return []
+    rows = ["K&C metrics from the recorded signals (definitions and signs of `vsim kc`, last cycle of each case):",
+            f"  {'metric':<46} {'unit':<9} {'axle':<6}" + "".join(f" {labels[k]:>16}" for k in metrics)]
+    for key, unit in keys:
+        for axle in run.metadata.extra["axles"]:
+            cells = [f" {metrics[k][axle][key]:16.5g}" if key in metrics[k].get(axle, {}) else f" {'-':>16}"
+                     for k in metrics]
+            rows.append(f"  {key:<46} {unit:<9} {axle:<6}" + "".join(cells))
+    return rows
+
+
+def _drift_table(run) -> list[str]:
+    from vehicle.run_metrics import case_mask, case_relaxation, cases
+
     rows = ["toe over the final hold (relaxation), front wheels [deg]:",
             f"  {'case':<28} {'wheel':<5} {'hold start':>11} {'end':>11} {'drift':>11}"]
-    for case in extra["cases"]:
-        hold = case.get("hold_from_s")
-        mask = _case_mask(run, case, last_cycle=False)
-        if hold is None or not mask.any():
-            continue
-        held = mask & (run.t_s >= hold - 1e-9)
+    for case in cases(run):
         for tag in ("fl", "fr"):
-            toe = run.signals[f"toe_{tag}"][held]
-            if toe.size:
-                rows.append(f"  {case['label'][:28]:<28} {tag:<5} {toe[0]:11.4f} {toe[-1]:11.4f} {toe[-1] - toe[0]:11.4f}")
+            drift = case_relaxation(run, case, f"toe_{tag}")
+            if drift is not None:
+                end = run.signals[f"toe_{tag}"][case_mask(run, case)][-1]
+                rows.append(f"  {case['label'][:28]:<28} {tag:<5} {end - drift:11.4f} {end:11.4f} {drift:11.4f}")
     return rows
 
 
@@ -159,15 +146,16 @@ def summary(run) -> str:
     """The text summary of a recorded run (:class:`vehicle.io.Run` written by the runner)."""
     extra = run.metadata.extra
     status = "complete" if run.complete else f"INCOMPLETE ({run.reason})"
-    lines = [f"{extra['scenario']} ({extra['type']}, bushings: {extra['bushing_model']}): "
+    origin = f"bushings: {extra['bushing_model']}" if "bushing_model" in extra else "measured on a rig"
+    lines = [f"{extra['scenario']} ({extra['type']}, {origin}): "
              f"{len(extra['cases'])} case(s), {run.t_s[-1] if run.t_s.size else 0.0:.1f} s recorded, {status}"]
     if extra["duration_scale"] != 1.0:
         lines.append(f"durations scaled by {extra['duration_scale']:g}: rates differ from the scenario's, "
                      f"and so do rate-dependent loops")
     if extra["x_quantity"] is not None:
-        lines += _loop_table(run, extra)
+        lines += _loop_table(run) + _kc_table(run)
     else:
-        lines += _drift_table(run, extra)
+        lines += _drift_table(run)
     return "\n".join(lines + _peak_table(run))
 
 
@@ -206,7 +194,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     run = subparsers.add_parser(
         "run", help="run a scenario (.yaml) on the K&C rig and record it (.mcap)",
         description="Run every case of a scenario file (format: scenarios/README.md) and record them in one "
-                    "MCAP file; print a summary (gradients and loop widths, relaxation, peak bushing deflections).")
+                    "MCAP file; print a summary (gradients and loop widths, K&C metrics, relaxation, peak bushing "
+                    "deflections).")
     run.add_argument("scenario", type=Path, metavar="SCENARIO.yaml")
     run.add_argument("-o", "--output", type=Path, metavar="OUT.mcap", help="run file (default: out/<scenario>.mcap)")
     run.add_argument("--bushings", choices=BUSHING_MODELS, default=None,

@@ -28,7 +28,7 @@ import subprocess
 import time
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
-from typing import Callable
+from typing import Callable, Sequence
 
 import mujoco
 import numpy as np
@@ -113,7 +113,11 @@ def output_interval(scenario: Scenario, dt: float) -> int:
 class SignalLayout:
     """The recorded signals of a rig, and one sample's values in the same order."""
 
-    def __init__(self, rig: KCRig, x_quantity: str | None):
+    def __init__(self, x_quantity: str | None, bushings: Sequence[str] = (), springs: Sequence[str] = (),
+                 dampers: Sequence[str] = ()):
+        """Wheel, pad and input signals, then each named spring's and damper's force and each bushing
+        direction's (``"<bushing>.<direction>"``) deflection and force; a rig records none of those."""
+
         def hint(tag: str) -> str | None:
             return f"{x_quantity}_{tag}" if x_quantity else None
 
@@ -126,12 +130,11 @@ class SignalLayout:
         specs += [SignalSpec(f"pad_fz_{t}", "N", "pads") for t in _TAGS]
         self.input_scale = np.array([_INPUT_UNITS[input_quantity(ch)][1] for ch in INPUT_CHANNELS])
         specs += [SignalSpec(ch, _INPUT_UNITS[input_quantity(ch)][0], "inputs") for ch in INPUT_CHANNELS]
-        c = rig.coupling
-        self.springs = [e.name for e in c.springs]
-        self.dampers = [e.name for e in c.dampers]
+        self.springs = list(springs)
+        self.dampers = list(dampers)
         specs += [SignalSpec(f"{n}_force", "N", "springs") for n in self.springs]
         specs += [SignalSpec(f"{n}_force", "N", "dampers") for n in self.dampers]
-        self.bushings = [ch.name for ch in rig.car.channels]
+        self.bushings = list(bushings)
         rotation = np.array([is_rotation(n) for n in self.bushings])
         self.deflection_scale = np.where(rotation, DEG, MM)
         for name, rot in zip(self.bushings, rotation):
@@ -142,6 +145,13 @@ class SignalLayout:
         specs += [SignalSpec("case", "-", "run"), SignalSpec("phase", "-", "run"),
                   SignalSpec("input_time", "s", "run"), SignalSpec("closure_error", "mm", "run")]
         self.specs = specs
+
+    @classmethod
+    def of_rig(cls, rig: KCRig, x_quantity: str | None) -> "SignalLayout":
+        """The signals of a simulated run on ``rig``."""
+        c = rig.coupling
+        return cls(x_quantity, [ch.name for ch in rig.car.channels], [e.name for e in c.springs],
+                   [e.name for e in c.dampers])
 
     def values(self, o: RigOutputs, design_z: np.ndarray, inputs: np.ndarray, case: int, phase: int,
                input_time_s: float) -> np.ndarray:
@@ -225,7 +235,10 @@ def git_revision() -> str:
     return rev.stdout.strip() + ("-dirty" if dirty.stdout.strip() else "")
 
 
-def _metadata(scenario: Scenario, rig: KCRig, plan: list[CaseSchedule], duration_scale: float, dt: float) -> RunMetadata:
+def run_metadata(scenario: Scenario, plan: list[CaseSchedule], duration_scale: float, dt: float,
+                 rig: KCRig | None = None) -> RunMetadata:
+    """The metadata of a run of ``scenario``: the scenario, the schedule of its cases, and (for a
+    simulated run, ``rig`` given) the vehicle and bushing parameters; software version and revision."""
     cases = []
     for k, (case, s) in enumerate(zip(scenario.cases, plan), start=1):
         entry = {"case": k, "label": case.label, "parameters": dict(case.parameters), "cycles": case.cycles,
@@ -235,18 +248,20 @@ def _metadata(scenario: Scenario, rig: KCRig, plan: list[CaseSchedule], duration
         if w is not None and not w.sines and len(w.values) > 2 and w.values[-1] == w.values[-2]:
             entry["hold_from_s"] = entry["input_start_s"] + w.times_s[-2] * duration_scale  # the final hold
         cases.append(entry)
+    model = {} if rig is None else {"vehicle_file": str(scenario.vehicle),
+                                    "bushing_model": scenario.bushing_model or "as in the vehicle file"}
     return RunMetadata(
         scenario_yaml=scenario.text,
-        vehicle_yaml=scenario.vehicle.read_text(),
-        bushing_parameters={ch.name: asdict(ch.params) for ch in rig.car.channels},
+        vehicle_yaml="" if rig is None else scenario.vehicle.read_text(),
+        bushing_parameters={} if rig is None else {ch.name: asdict(ch.params) for ch in rig.car.channels},
         software_version=software_version(),
         git_revision=git_revision(),
         extra={"scenario": scenario.name, "type": scenario.type, "description": scenario.description,
-               "scenario_file": str(scenario.path), "vehicle_file": str(scenario.vehicle),
-               "bushing_model": scenario.bushing_model or "as in the vehicle file", "axles": list(scenario.axles),
+               "scenario_file": str(scenario.path), **model, "axles": list(scenario.axles),
                "x_quantity": scenario.x_quantity, "duration_scale": duration_scale,
                "output_rate_hz": scenario.output_rate_hz, "timestep_s": dt,
                "limits": asdict(scenario.limits), "settle": asdict(scenario.settle), "cases": cases},
+        source="simulation" if rig is not None else "rig",
     )
 
 
@@ -276,11 +291,11 @@ def run_scenario(scenario: Scenario, output: Path, *, bushing_model: str | None 
     dt = rig.model.opt.timestep
     plan = schedule(scenario, duration_scale, dt)
     bodies = [mujoco.mj_id2name(rig.model, mujoco.mjtObj.mjOBJ_BODY, i) for i in range(1, rig.model.nbody)]
-    layout = SignalLayout(rig, scenario.x_quantity)
+    layout = SignalLayout.of_rig(rig, scenario.x_quantity)
     output.parent.mkdir(parents=True, exist_ok=True)
     total_s = plan[-1].end_s(dt)
     with RunWriter(output, signals=layout.specs, bodies=bodies, geometry=geometry_from_model(rig.model, bodies),
-                   metadata=_metadata(scenario, rig, plan, duration_scale, dt), overwrite=overwrite) as writer:
+                   metadata=run_metadata(scenario, plan, duration_scale, dt, rig), overwrite=overwrite) as writer:
         for k, (case, when) in enumerate(zip(scenario.cases, plan), start=1):
             if k > 1:
                 rig = KCRig(vehicle, options)

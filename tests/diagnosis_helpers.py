@@ -1,0 +1,54 @@
+"""Shared helpers for the diagnosis tests: draw a hidden effect from a seed, measure it on the
+virtual bench, and diagnose the copied measured directory in a fresh process (so that the
+diagnosis cannot read the truth)."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from vehicle.diagnosis.catalogue import CAUSES, draw
+from vehicle.diagnosis.virtual_rig import OUTSIDE, measure_bench, parse_truth
+
+#: The bench baseline each cause is hidden in: the viscoelastic causes need an STS or RT baseline.
+BASELINES = {"viscoelasticity_missing": "fig5_6_progressive", "viscoelasticity_excess": "fig5_8_progressive"}
+DEFAULT_BASELINE = "fig5_9_progressive"
+
+
+def hidden_truth(cause: str, seed: int) -> tuple[str, list[dict]]:
+    """(baseline set, effects) with the cause's magnitude drawn from the seed in its realistic range;
+    ``none`` hides nothing; an OUTSIDE effect (e.g. backlash) is drawn in its range likewise."""
+    rng = np.random.default_rng([seed, sum(map(ord, cause))])
+    baseline = BASELINES.get(cause, DEFAULT_BASELINE)
+    if cause == "none":
+        return baseline, []
+    if cause in OUTSIDE:
+        p = OUTSIDE[cause]
+        return baseline, [{"cause": cause, p.name: float(rng.uniform(*p.draw))}]
+    return baseline, [{"cause": cause, **draw(CAUSES[cause], rng)}]
+
+
+def measure(tmp: Path, cause: str, seed: int) -> tuple[str, list[dict], Path]:
+    """Measure a drawn truth into ``tmp/measured``; the noise and zero errors come from the seed too."""
+    baseline, effects = hidden_truth(cause, seed)
+    truth = parse_truth({"level": "bench", "baseline": baseline, "effects": effects, "seed": seed}, "<test truth>")
+    out = measure_bench(truth, tmp / "rig_output")
+    copy = tmp / "measured"
+    shutil.copytree(out, copy)
+    shutil.rmtree(out)
+    return baseline, effects, copy
+
+
+def diagnose_fresh(directory: Path, baseline: str, report: Path | None = None) -> dict:
+    """``vsim diagnose DIR --bushing-model BASELINE --json`` in a fresh Python process."""
+    cmd = [sys.executable, "-m", "vehicle.cli", "diagnose", str(directory), "--bushing-model", baseline, "--json"]
+    if report is not None:
+        cmd += ["-o", str(report)]
+    done = subprocess.run(cmd, capture_output=True, text=True, timeout=600, cwd=directory.parent)
+    assert done.returncode == 0, done.stderr
+    return json.loads(done.stdout)

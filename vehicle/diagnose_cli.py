@@ -1,0 +1,55 @@
+"""`vsim diagnose RIGDIR`: what the baseline gets wrong on measured data, the cause, the gain."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from bushings.errors import InputError
+
+
+def _diagnose(args: argparse.Namespace) -> int:
+    from bushings.parameters import load_parameter_set
+    from vehicle.diagnosis.bench_data import dataset_level, read_bench_dataset
+    from vehicle.diagnosis.bench_diagnosis import diagnose_bench
+    from vehicle.diagnosis.bench_report import summary, verdict_sentence, write_report
+
+    level = dataset_level(args.rigdir)
+    if level != "bench":
+        raise InputError("the diagnosis of K&C datasets is not available yet; bench datasets are",
+                         source=str(args.rigdir / "rig.yaml"), key="level")
+    if args.bushing_model is None:
+        raise InputError("a bench dataset needs the baseline law: --bushing-model SET (a parameter set name or "
+                         "YAML path)", source=str(args.rigdir))
+    baseline = load_parameter_set(args.bushing_model)
+    data = read_bench_dataset(args.rigdir)
+    quiet = args.json
+    result = diagnose_bench(data, baseline, progress=None if quiet else lambda s: print(f"  {s}", file=sys.stderr,
+                                                                                          flush=True))
+    written = write_report(result, args.output) if args.output is not None else []
+    if args.json:
+        print(json.dumps(summary(result)))
+    else:
+        print(verdict_sentence(result))
+        for path in written:
+            print(f"wrote {path}")
+    return 0
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add the ``diagnose`` sub-command."""
+    p = subparsers.add_parser(
+        "diagnose", help="name what the model misses in measured rig data (a directory with rig.yaml)",
+        description="Run the baseline on exactly the tests found in the data, fit every applicable cause of the "
+                    "catalogue on half of them, score it on the other half, and name the cause, or say that "
+                    "nothing significant is missing, or that the mismatch is unexplained.")
+    p.add_argument("rigdir", type=Path, metavar="RIGDIR")
+    group = p.add_mutually_exclusive_group()
+    group.add_argument("--vehicle", type=Path, metavar="V.yaml", help="baseline vehicle (K&C datasets)")
+    group.add_argument("--bushing-model", metavar="SET", help="baseline parameter set (bench datasets)")
+    p.add_argument("-o", "--output", type=Path, metavar="REPORT_DIR",
+                   help="write report.md, PNGs, diagnosis.json and extended_model.yaml here")
+    p.add_argument("--json", action="store_true", help="print the verdict as one JSON object")
+    p.set_defaults(func=_diagnose)

@@ -1,0 +1,1 @@
+"""Measured data against simulation: the virtual rig, the catalogue of causes and the diagnosis."""

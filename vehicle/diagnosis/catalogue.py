@@ -1,0 +1,158 @@
+"""The catalogue of causes (spec measured-data §2): each a physical extension of a bushing law with
+few parameters, that the virtual rig can switch on in a truth model and the diagnosis can fit.
+
+An extension acts on a parameter set as written in its YAML file (thesis units: N, mm, s; N·m and
+deg for rotations), so that an extended model is written back as an ordinary parameter set usable
+by ``vsim bushing run`` and by a vehicle.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Callable, Mapping
+
+import numpy as np
+
+from bushings.effects import BROAD_TAUS_S, broad_relaxation_branches
+from bushings.parameters import ParameterSet
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """One parameter of a cause, in the parameter sets' units."""
+
+    name: str
+    unit: str
+    bounds: tuple[float, float]        #: fit bounds
+    draw: tuple[float, float]          #: realistic magnitude range the virtual rig draws from
+    signed: bool = False               #: the virtual rig draws either sign
+    log: bool = False                  #: fitted on a log scale (positive, spans decades)
+    description: str = ""
+
+
+@dataclass(frozen=True)
+class Cause:
+    """A catalogue entry: its parameters, which baselines it applies to, and how it extends them."""
+
+    id: str
+    physics: str
+    signature: str
+    parameters: tuple[Parameter, ...]
+    applies: Callable[[ParameterSet], bool]
+    #: (params, effects, fitted values) -> extended (params, effects), all in parameter-set units
+    extend: Callable[[dict[str, Any], dict[str, Any], Mapping[str, float]], tuple[dict[str, Any], dict[str, Any]]]
+
+    def apply(self, base: ParameterSet, values: Mapping[str, float], source: str = "") -> ParameterSet:
+        """The baseline set extended by this cause with ``values``."""
+        params, effects = self.extend(dict(base.values), dict(base.effects), values)
+        model = base.model
+        if _ladder(base) and params.get("Co", 0.0) > 0.0:
+            model = "stvs" if params.get("Ff", 0.0) > 0.0 else "rt"
+        if model == "rt":
+            params.pop("Ff", None)
+        return ParameterSet(name=f"{base.name}+{self.id}", model=model, quantity=base.quantity, values=params,
+                            source=source or f"{base.source}; extended by {self.id}", effects=effects)
+
+
+def _ladder(base: ParameterSet) -> bool:
+    return base.model in ("sts", "rt", "stvs")
+
+
+def _elastic_law(base: ParameterSet) -> bool:
+    return "N_sup" in base.values
+
+
+def _add(mapping: dict[str, Any], key: str, value: float) -> dict[str, Any]:
+    mapping[key] = mapping.get(key, 0.0) + value
+    return mapping
+
+
+def _viscosity(params: dict, effects: dict, v: Mapping[str, float]) -> tuple[dict, dict]:
+    return {**params, "Co": v["Co"], "pw": v["pw"]}, effects
+
+
+def _friction(params: dict, effects: dict, v: Mapping[str, float]) -> tuple[dict, dict]:
+    return {**params, "Ff": v["Ff"], "Co": params["Co"] * v["co_scale"]}, effects
+
+
+def _broad(params: dict, effects: dict, v: Mapping[str, float]) -> tuple[dict, dict]:
+    k, c = broad_relaxation_branches(v["k1"], v["alpha"])
+    return {**params, "maxwell_k": [*params.get("maxwell_k", ()), *map(float, k)],
+            "maxwell_c": [*params.get("maxwell_c", ()), *map(float, c)]}, effects
+
+
+def _effect(key: str, parameter: str) -> Callable[[dict, dict, Mapping[str, float]], tuple[dict, dict]]:
+    def extend(params: dict, effects: dict, v: Mapping[str, float]) -> tuple[dict, dict]:
+        return params, _add(dict(effects), key, v[parameter])
+    return extend
+
+
+def _heating(params: dict, effects: dict, v: Mapping[str, float]) -> tuple[dict, dict]:
+    return params, {**_add(dict(effects), "heating", v["heating"]), "heating_tau_s": v["heating_tau_s"]}
+
+
+CAUSES: dict[str, Cause] = {c.id: c for c in (
+    Cause("viscoelasticity_missing",
+          "rate-dependent damping coupled to hysteresis: a power-law damper Co·|v|^pw at every ladder node "
+          "(STS -> STVS)",
+          "loop width and slope grow with loading speed; force relaxes after a step",
+          (Parameter("Co", "N/(mm/s)^pw", (0.1, 300.0), (15.0, 40.0), log=True,
+                     description="damper coefficient at every ladder node"),
+           Parameter("pw", "-", (0.03, 1.0), (0.1, 0.3), description="damper exponent")),
+          lambda b: _ladder(b) and b.values.get("Co", 0.0) == 0.0, _viscosity),
+    Cause("viscoelasticity_excess",
+          "the part is less viscous and more hysteretic than an RT-like law: slider threshold Ff added at every "
+          "ladder node, dampers scaled",
+          "simulated loops too round; measured hysteresis persists at low speed",
+          (Parameter("Ff", "N", (0.0, 200.0), (5.0, 15.0), description="slider threshold added at every node"),
+           Parameter("co_scale", "-", (0.02, 3.0), (0.4, 0.8), log=True, description="factor on the damper Co")),
+          lambda b: _ladder(b) and b.values.get("Co", 0.0) > 0.0, _friction),
+    Cause("preload",
+          "static load shifts the part's operating point along its nonlinear elastic law and leaves its "
+          "hysteresis on a loading branch",
+          "stiffness error that depends on static load, not on speed; loops not centred",
+          (Parameter("preload", "mm", (-5.0, 5.0), (1.5, 3.0), signed=True,
+                     description="deflection of the mounted part at the rig's zero (2-4 kN of static load)"),),
+          _elastic_law, _effect("preload", "preload")),
+    Cause("asymmetry",
+          "tension/compression asymmetry beyond the elastic law: one side progressively stiffer",
+          "loops not point-symmetric about their centre",
+          (Parameter("asymmetry", "1/mm", (-1.0, 1.0), (0.05, 0.15), signed=True,
+                     description="extra tangent fraction of K0 per mm; > 0 stiffens compression"),),
+          lambda b: b.values.get("K0", 0.0) > 0.0, _effect("asymmetry", "asymmetry")),
+    Cause("mullins",
+          "Mullins softening: the virgin part softens below the largest deflection it has seen",
+          "first cycle stiffer than the next; softening only below the previous maximum",
+          (Parameter("mullins", "-", (0.0, 0.8), (0.08, 0.25), description="softening fraction at zero deflection"),),
+          lambda b: True, _effect("mullins", "mullins")),
+    Cause("self_heating",
+          "dissipated energy heats the part; stiffness and viscous parameters fall with temperature",
+          "slow drift of loops over many cycles, growing with amplitude x frequency",
+          (Parameter("heating", "1/kJ", (1e-3, 5.0), (0.08, 0.2), log=True,
+                     description="softening per kJ of heat held (beta / thermal capacity)"),
+           Parameter("heating_tau_s", "s", (10.0, 5000.0), (100.0, 400.0), log=True,
+                     description="thermal time constant")),
+          lambda b: _ladder(b) or b.model == "tvs", _heating),
+    Cause("broad_relaxation",
+          f"relaxation over decades: a fractional element k1·t^-alpha in parallel (Prony series, "
+          f"{len(BROAD_TAUS_S)} branches from {BROAD_TAUS_S[0]:g} to {BROAD_TAUS_S[-1]:g} s)",
+          "log-time relaxation slope that a finite ladder cannot follow; stiffness rising with frequency",
+          (Parameter("k1", "N/mm", (0.5, 2000.0), (30.0, 100.0), log=True, description="relaxation stiffness at 1 s"),
+           Parameter("alpha", "-", (0.02, 0.9), (0.1, 0.25), description="order of the fractional element")),
+          lambda b: True, _broad),
+)}
+
+
+def applicable(base: ParameterSet) -> list[Cause]:
+    """The causes that can extend this baseline (e.g. missing viscoelasticity only on an STS)."""
+    return [c for c in CAUSES.values() if c.applies(base)]
+
+
+def draw(cause: Cause, rng: np.random.Generator) -> dict[str, float]:
+    """Parameter values drawn uniformly (log-uniformly for log parameters) in the realistic range."""
+    out = {}
+    for p in cause.parameters:
+        lo, hi = p.draw
+        value = float(np.exp(rng.uniform(np.log(lo), np.log(hi)))) if p.log else float(rng.uniform(lo, hi))
+        out[p.name] = value * (float(rng.choice([-1.0, 1.0])) if p.signed else 1.0)
+    return out
