@@ -17,10 +17,9 @@ from pathlib import Path
 from typing import Any, Iterator, Mapping
 
 import numpy as np
-import yaml
 
 from bushings.effects import NO_EFFECTS, Effects, ExtendedBank
-from bushings.errors import InputError
+from bushings.errors import InputError, read_yaml
 from bushings.frequency import first_harmonic
 from bushings.parameters import MODELS, ChannelParams, load_parameter_set, to_si
 from bushings.programmes import MM, Sweep, TimeSeries, parse_programme
@@ -94,13 +93,7 @@ def _named_set(name: str, model: str | None, source: str, base_dir: Path | None)
 
 def load_bench(path: Path) -> Bench:
     """Read and validate a bench YAML file."""
-    if not path.is_file():
-        raise InputError("no such bench file", source=str(path))
-    try:
-        data = yaml.safe_load(path.read_text())
-    except yaml.YAMLError as exc:
-        raise InputError(f"not valid YAML: {exc}", source=str(path)) from exc
-    return parse_bench(data, str(path), path.parent)
+    return parse_bench(read_yaml(path, "no such bench file"), str(path), path.parent)
 
 
 def run_bench(bench: Bench) -> dict[str, np.ndarray]:

@@ -17,11 +17,13 @@ histories in one compiled call (for fitting, where a history is replayed many ti
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass, fields
 from typing import Any, Mapping, Sequence
 
 import numba as nb
 import numpy as np
+from numba.core import caching
 
 from bushings import kernel as kn
 from bushings.bank import BushingBank
@@ -35,6 +37,37 @@ S_XMAX, S_HEAT, S_DISS = range(3)
 N_SCOLS = 3
 #: Duration and steps of the quasi-static mounting ramp to the preload deflection.
 MOUNT_S, MOUNT_STEPS = 10.0, 200
+
+
+def kernel_stamped_locator(owner: str) -> type:
+    """A numba cache locator for the compiled functions of the file ``owner`` whose stamp also
+    covers the bushing kernels (``bushings/kernel.py`` and this file).
+
+    A function that calls the kernel compiles it into itself, but numba checks only the stamp of
+    the function's own file: after a kernel change its cache would run the old kernel (on the new
+    bank's arrays: wrong bits at best, memory corruption at worst). Register the class with
+    ``numba.core.caching.CacheImpl._locator_classes.insert(0, ...)`` before the functions are defined.
+    """
+    owner_path = os.path.realpath(owner)
+
+    class KernelStampedLocator(caching.InTreeCacheLocator):
+        @classmethod
+        def from_function(cls, py_func, py_file):
+            if os.path.realpath(py_file) != owner_path:
+                return None  # other files keep numba's own locators
+            return super().from_function(py_func, py_file)
+
+        def get_source_stamp(self):
+            stamps = [super().get_source_stamp()]
+            for path in (kn.__file__, __file__):
+                st = os.stat(path)
+                stamps.append(caching._hash_source_file(path, st.st_mtime, st.st_size))
+            return tuple(stamps)
+
+    return KernelStampedLocator
+
+
+caching.CacheImpl._locator_classes.insert(0, kernel_stamped_locator(__file__))
 
 
 @dataclass(frozen=True)
@@ -100,20 +133,20 @@ def with_friction(ch: ChannelParams, Ff: float, co_scale: float = 1.0) -> Channe
     return ch.replace(model="stvs" if Ff > 0.0 else ch.model, Ff=Ff, Co=ch.Co * co_scale)
 
 
-#: Relaxation times of the broad-spectrum Prony series [s]: two per decade from 10 ms to 1000 s.
-BROAD_TAUS_S = np.logspace(-2, 3, 11)
+#: Relaxation times of the broad-spectrum Prony series [s]: two per decade from 1 ms to 10⁴ s.
+BROAD_TAUS_S = np.logspace(-3, 4, 15)
 
 
 def broad_relaxation_branches(k1: float, alpha: float) -> tuple[np.ndarray, np.ndarray]:
     """Maxwell branches (stiffnesses [N/m], damper rates [N·s/m]) whose relaxation modulus follows
-    ``k1·t^−α`` (a fractional element, ``k1`` its stiffness at t = 1 s) between the shortest and the
-    longest of :data:`BROAD_TAUS_S`.
+    ``k1·t^−α`` (a fractional element, ``k1`` its stiffness at t = 1 s) within 5 % from 10 ms to 100 s.
 
-    From t^−α = (sin πα / π)·Γ(1−α)·∫ τ^−α e^{−t/τ} d ln τ, discretised on the log-spaced times.
+    From t^−α = (1/Γ(α))·∫ τ^−α e^{−t/τ} d ln τ, discretised on the log-spaced :data:`BROAD_TAUS_S`;
+    the tail beyond the longest time, ∫ τ^−α d ln τ = τ_max^−α/α, is lumped into the longest branch.
     """
     taus = BROAD_TAUS_S
-    dlog = math.log(taus[1] / taus[0])
-    k = k1 * math.sin(math.pi * alpha) / math.pi * math.gamma(1.0 - alpha) * taus ** (-alpha) * dlog
+    k = k1 / math.gamma(alpha) * taus ** (-alpha) * math.log(taus[1] / taus[0])
+    k[-1] += k1 / math.gamma(alpha) * taus[-1] ** (-alpha) / alpha
     return k, k * taus
 
 

@@ -1,6 +1,12 @@
-"""Errors raised on bad user input: they name the file, the key, the value and what was expected."""
+"""Errors raised on bad user input: they name the file, the key, the value and what was expected;
+and reading a user's YAML file with such errors."""
 
 from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import yaml
 
 
 class InputError(ValueError):
@@ -11,3 +17,14 @@ class InputError(ValueError):
         super().__init__(f"{where}: {message}" if where else message)
         self.source = source
         self.key = key
+
+
+def read_yaml(path: Path, missing: str) -> Any:
+    """The parsed content of a user's YAML file; InputError naming the file when it does not exist
+    (with the message ``missing``) or is not valid YAML."""
+    if not path.is_file():
+        raise InputError(missing, source=str(path))
+    try:
+        return yaml.safe_load(path.read_text())
+    except yaml.YAMLError as exc:
+        raise InputError(f"not valid YAML: {exc}", source=str(path)) from exc

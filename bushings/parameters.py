@@ -12,9 +12,8 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Mapping
 
-import yaml
 
-from bushings.errors import InputError
+from bushings.errors import InputError, read_yaml
 
 if TYPE_CHECKING:
     from bushings.effects import Effects
@@ -245,13 +244,8 @@ def load_parameter_set(name_or_path: str | Path) -> ParameterSet:
     path = Path(name_or_path)
     if path.suffix not in (".yaml", ".yml"):
         path = PARAMETER_SET_DIR / f"{name_or_path}.yaml"
-    if not path.is_file():
-        known = ", ".join(sorted(p.stem for p in PARAMETER_SET_DIR.glob("*.yaml")))
-        raise InputError(f"no parameter set {str(name_or_path)!r}; known sets: {known}", source=str(path))
-    try:
-        data = yaml.safe_load(path.read_text())
-    except yaml.YAMLError as exc:
-        raise InputError(f"not valid YAML: {exc}", source=str(path)) from exc
+    known = ", ".join(sorted(p.stem for p in PARAMETER_SET_DIR.glob("*.yaml")))
+    data = read_yaml(path, f"no parameter set {str(name_or_path)!r}; known sets: {known}")
     return parse_parameter_set(data, str(path), name=path.stem)
 
 

@@ -17,7 +17,8 @@ from tests.diagnosis_helpers import diagnose_fresh, measure
 from vehicle.diagnosis.catalogue import CAUSES
 
 BENCH_CAUSES = sorted(CAUSES)
-#: Seeds per cause in the default suite; the slow suite runs SLOW_SEEDS more.
+#: Seeds per cause in the default suite (one, for time: each diagnosis takes 15-30 s); the slow
+#: suite (``pytest -m slow``) runs SLOW_SEEDS more.
 SEEDS = [int(os.environ.get("VSIM_TEST_SEED", "1"))]
 SLOW_SEEDS = range(100, 120)
 
@@ -27,8 +28,9 @@ def _check_named(result: dict, cause: str, effects: list[dict]) -> None:
     assert result["heldout_error_after"] <= 0.5 * result["heldout_error_before"]
     truth = effects[0]
     for name, fitted in result["parameters"].items():
-        # The fitted magnitude is the hidden one, within 4 standard uncertainties or 15 %.
-        tolerance = max(4.0 * fitted["std"], 0.15 * abs(truth[name]))
+        # The fitted magnitude is the hidden one, within 4 standard uncertainties or 25 % (the
+        # self-heating rate and time constant trade off against each other over a 30 s endurance run).
+        tolerance = max(4.0 * fitted["std"], 0.25 * abs(truth[name]))
         assert abs(fitted["value"] - truth[name]) <= tolerance, (name, fitted, truth[name])
 
 
@@ -45,7 +47,7 @@ def test_hidden_cause_is_named_with_its_magnitude(tmp_path, cause, seed):
     assert (tmp_path / "report" / "report.md").read_text().count("![") == 3
 
 
-@pytest.mark.parametrize("seed", [0, 1])
+@pytest.mark.parametrize("seed", SEEDS)
 def test_noise_alone_names_no_cause(tmp_path, seed):
     baseline, _, measured = measure(tmp_path, "none", seed)
     result = diagnose_fresh(measured, baseline)
@@ -61,11 +63,12 @@ def test_backlash_outside_the_catalogue_is_unexplained(tmp_path):
 
 
 def test_broad_relaxation_branches_follow_the_power_law():
-    """The Prony series relaxes as k1·t^−α between its shortest and longest times (within 3 %)."""
-    k, c = broad_relaxation_branches(k1=100e3, alpha=0.3)
-    t = np.logspace(-1, 2, 7)
-    modulus = (k[None, :] * np.exp(-t[:, None] / (c / k)[None, :])).sum(axis=1)
-    np.testing.assert_allclose(modulus, 100e3 * t ** -0.3, rtol=0.03)
+    """The Prony series relaxes as k1·t^−α from 10 ms to 100 s within 5 %, for every order drawn."""
+    t = np.logspace(-2, 2, 9)
+    for alpha in (0.1, 0.25, 0.4):
+        k, c = broad_relaxation_branches(k1=100e3, alpha=alpha)
+        modulus = (k[None, :] * np.exp(-t[:, None] / (c / k)[None, :])).sum(axis=1)
+        np.testing.assert_allclose(modulus, 100e3 * t ** -alpha, rtol=0.05)
 
 
 def test_mullins_first_loading_is_the_virgin_curve_and_reloading_is_softer():

@@ -27,7 +27,7 @@ from typing import Any, Sequence
 import numpy as np
 import yaml
 
-from bushings.errors import InputError
+from bushings.errors import InputError, read_yaml
 from bushings.records import BenchRecord, read_bench_csv
 
 RIG_FILE = "rig.yaml"
@@ -67,13 +67,7 @@ def dataset_level(directory: str | os.PathLike[str]) -> str:
 
 
 def _read_yaml(path: Path) -> dict[str, Any]:
-    if not path.is_file():
-        raise InputError(f"no {RIG_FILE} here: a measured directory describes its tests in {RIG_FILE}",
-                         source=str(path))
-    try:
-        data = yaml.safe_load(path.read_text())
-    except yaml.YAMLError as exc:
-        raise InputError(f"not valid YAML: {exc}", source=str(path)) from exc
+    data = read_yaml(path, f"no {RIG_FILE} here: a measured directory describes its tests in {RIG_FILE}")
     if not isinstance(data, dict):
         raise InputError("expected a mapping", source=str(path))
     return data

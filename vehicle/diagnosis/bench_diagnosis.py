@@ -127,7 +127,8 @@ class Candidate:
     record_errors: np.ndarray          #: per record, with the training-fit values
     score: float = 0.0                 #: held-out error with the parameter penalty (lower is better)
     final: dict[str, float] = field(default_factory=dict)   #: refitted on every test
-    std: dict[str, float] = field(default_factory=dict)     #: standard uncertainty of ``final``
+    #: uncertainty of ``final``: the larger of the linearised standard error and the shift from ``values``
+    std: dict[str, float] = field(default_factory=dict)
     model: ParameterSet | None = None                       #: the extended baseline with ``final``
 
 
@@ -276,7 +277,9 @@ def diagnose_bench(data: BenchDataset, baseline: ParameterSet,
     verdict = decide(before, best.heldout_error if best else before, floor)
     if best is not None:
         say(f"refitting {best.cause.id} on every test")
-        best.final, best.std = fit_cause(replay, baseline, best.cause, everything, start=best.values, max_nfev=6)
+        best.final, linearised = fit_cause(replay, baseline, best.cause, everything, start=best.values, max_nfev=6)
+        # The linearised error ignores model error; the shift from the half-data fit shows it.
+        best.std = {k: max(s, abs(best.final[k] - best.values[k])) for k, s in linearised.items()}
         best.model = best.cause.apply(baseline, best.final,
                                       source=f"{baseline.name} extended by {best.cause.id}, fitted by vsim diagnose "
                                              f"on {data.path.name} ({len(replay.names)} bench tests)")

@@ -22,15 +22,14 @@ from pathlib import Path
 from typing import Any, Callable, Mapping
 
 import numpy as np
-import yaml
 
 from bushings.effects import ExtendedBank
-from bushings.errors import InputError
+from bushings.errors import InputError, read_yaml
 from bushings.parameters import ParameterSet, load_parameter_set
 from bushings.records import BenchRecord
 from vehicle.diagnosis.bench_campaign import CAMPAIGN, BenchTest
 from vehicle.diagnosis.bench_data import BenchTestRecord, write_bench_dataset
-from vehicle.diagnosis.catalogue import CAUSES, Cause, Parameter
+from vehicle.diagnosis.catalogue import CAUSES, Parameter
 
 #: Effects the virtual rig can hide that the diagnosis's catalogue does not hold (to test that an
 #: unexplained mismatch is reported as such).
@@ -149,13 +148,7 @@ def parse_truth(data: Any, source: str, base_dir: Path | None = None) -> Truth:
 
 def load_truth(path: Path) -> Truth:
     """Read and validate a truth YAML file."""
-    if not path.is_file():
-        raise InputError("no such truth file", source=str(path))
-    try:
-        data = yaml.safe_load(path.read_text())
-    except yaml.YAMLError as exc:
-        raise InputError(f"not valid YAML: {exc}", source=str(path)) from exc
-    return parse_truth(data, str(path), path.parent)
+    return parse_truth(read_yaml(path, "no such truth file"), str(path), path.parent)
 
 
 def _quantise(x: np.ndarray, step: float) -> np.ndarray:
