@@ -6,9 +6,10 @@ Topology (per side; the right side mirrors the left):
   six joints, 3 slide + 3 hinge in the bushing's frame); every further bushing of the wishbone
   (E2 front) is a light sleeve on six joints of its own, welded to the wishbone. The knuckle sits
   on the wishbone through a ball joint; the strut rod slides in the tube on the knuckle along the
-  strut axis (spring and damper on that slide) and is tied to the body at the top mount by a
-  ``connect``. The rack slides laterally in the body; each tie rod is a spatial tendon of fixed
-  length (``equality/tendon``). The wheel turns on a hinge of the knuckle.
+  strut axis (spring, damper and the rod's Coulomb friction, MuJoCo's ``frictionloss``, on that
+  slide) and is tied to the body at the top mount by a ``connect``. The rack slides laterally in
+  the body; each tie rod is a spatial tendon of fixed length (``equality/tendon``). The wheel
+  turns on a hinge of the knuckle.
 * rear twist beam: each trailing arm hangs from the body on its E1 rear bushing; the left arm
   carries the beam centre on a hinge about the beam axis (torsional stiffness of the beam),
   welded to the right arm. Springs and dampers are spatial tendons between arm and body.
@@ -17,18 +18,22 @@ Topology (per side; the right side mirrors the left):
   by a ``connect``; wheel hinges are locked (brakes on); the rack position is driven.
 
 Linear bushing directions live in the joints' ``stiffness``/``damping`` (implicit under
-``integrator="discrete"``); the others get a reference stiffness in the joint and the rest of
-their force from :mod:`vehicle.coupling`.
+``integrator="discrete"``); the others (and any law with effects) get a reference stiffness in the
+joint and the rest of their force from :mod:`vehicle.coupling`, as do the bushings' cross
+stiffnesses. The right side's laws, effects and cross stiffnesses are the mirror images of the
+left's (:func:`mirror_signs`).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 
 import mujoco
 import numpy as np
 
+from bushings.effects import NO_EFFECTS, Effects
 from vehicle.definition import DIRECTIONS, BushingDef, Spring, VehicleDefinition
 
 SIDES = (("left", 1.0), ("right", -1.0))
@@ -62,12 +67,23 @@ class Channel:
     name: str                            #: e.g. ``e1_front_left.y``
     joint: str
     params: object                       #: bushings.ChannelParams (SI)
+    effects: Effects = NO_EFFECTS        #: state extensions of the law (bushings.effects, SI)
 
     @property
     def linear(self) -> bool:
         """True when the whole law fits in the joint's stiffness and damping."""
         p = self.params
-        return p.model == "linear" and not math.isfinite(p.S_sup) and not math.isfinite(p.S_inf)
+        return (p.model == "linear" and not math.isfinite(p.S_sup) and not math.isfinite(p.S_inf)
+                and not self.effects.active)
+
+
+@dataclass(frozen=True)
+class CrossTerm:
+    """A cross stiffness between two bushing joints: τ_a += −k·q_b, τ_b += −k·q_a (explicit)."""
+
+    joint_a: str
+    joint_b: str
+    stiffness: float                     #: k [N/m or N·m/rad], this side's sign included
 
 
 @dataclass
@@ -95,6 +111,7 @@ class CarModel:
     elements: list[Element]
     closures: list[str]                  #: loop-closure equality names
     corners: dict[str, dict[str, str]] = field(default_factory=dict)
+    cross: list[CrossTerm] = field(default_factory=list)   #: directional couplings of the bushings
 
     def xml(self) -> str:
         """The MJCF of the model."""
@@ -113,6 +130,11 @@ def mirror(p, sign: float) -> np.ndarray:
     return np.array([p[0], sign * p[1], p[2]], dtype=float)
 
 
+def _reversed_axis(axes) -> int:
+    """Index of the bushing axis closest to the lateral direction (reversed on the right side)."""
+    return int(np.argmax(np.abs(np.asarray(axes, float)[:, 1])))
+
+
 def mirror_axes(axes, sign: float) -> np.ndarray:
     """Bushing axes (rows x, y, z) on side ``sign``, kept right-handed.
 
@@ -121,8 +143,35 @@ def mirror_axes(axes, sign: float) -> np.ndarray:
     """
     rows = np.array([mirror(a, sign) for a in axes])
     if sign < 0:
-        rows[int(np.argmax(np.abs(rows[:, 1])))] *= -1.0
+        rows[_reversed_axis(axes)] *= -1.0
     return rows
+
+
+def mirror_signs(axes, sign: float) -> np.ndarray:
+    """Per direction (x, y, z, rx, ry, rz), +1 or −1: in the mirror image of a left-side motion, a
+    direction's deflection on side ``sign`` is this sign times the left one's.
+
+    On the right the reversed axis (:func:`mirror_axes`) flips its translation, and a reflection
+    flips every rotation (a pseudovector) except the one about the reversed axis.
+    """
+    signs = np.ones(6)
+    if sign < 0:
+        k = _reversed_axis(axes)
+        signs[k] = -1.0
+        signs[3:] = -1.0
+        signs[3 + k] = 1.0
+    return signs
+
+
+def mirrored_law(params, effects: Effects, sign: float):
+    """(law, effects) of a direction whose deflection is the left one's times ``sign`` (see
+    :func:`mirror_signs`): F(e) becomes −F(−e), so the elastic law's sides, the preload and the
+    asymmetry swap; the rest of a law is odd already."""
+    if sign > 0:
+        return params, effects
+    p = params.replace(N_sup=-params.N_inf, N_inf=-params.N_sup, S_sup=-params.S_inf, S_inf=-params.S_sup,
+                       P_sup=params.P_inf, P_inf=params.P_sup)
+    return p, dataclasses.replace(effects, preload=-effects.preload, asymmetry=-effects.asymmetry)
 
 
 def wheel_axis(toe: float, camber: float, sign: float) -> np.ndarray:
@@ -172,6 +221,7 @@ class _Builder:
         self.elements: list[Element] = []
         self.closures: list[str] = []
         self.corners: dict[str, dict[str, str]] = {}
+        self.cross: list[CrossTerm] = []
 
     # -- primitives --------------------------------------------------------------------------
     def local(self, body: str, p) -> np.ndarray:
@@ -225,22 +275,29 @@ class _Builder:
                                     name1=joint)
         self._stiff(eq)
 
-    def bushing_joints(self, body: str, bushing: BushingDef, side: str):
-        """Six joints (slide x, y, z; hinge x, y, z) in the bushing frame = ``body``'s frame."""
+    def bushing_joints(self, body: str, bushing: BushingDef, side: str, sign: float):
+        """Six joints (slide x, y, z; hinge x, y, z) in the bushing frame = ``body``'s frame, and the
+        bushing's cross stiffnesses; side ``sign`` (+1 left, −1 right) mirrors the left's laws."""
         b = self.bodies[body]
         name = f"{bushing.name}_{side}"
+        signs = dict(zip(DIRECTIONS, mirror_signs(bushing.axes, sign)))
         for i, d in enumerate(DIRECTIONS):
-            params = bushing.directions[d].channel(self.o.bushing_model)
+            direction = bushing.directions[d]
+            params, effects = mirrored_law(direction.channel(self.o.bushing_model), direction.effects_si(), signs[d])
             if self.o.rigid_bushings and len(d) == 1:
                 params = params.replace(model="linear", K0=RIGID_TRANSLATION, C=0.0, n_cells=0,
                                         S_sup=math.inf, S_inf=-math.inf)
-            ch = Channel(f"{name}.{d}", f"{name}_{d}", params)
+                effects = NO_EFFECTS
+            ch = Channel(f"{name}.{d}", f"{name}_{d}", params, effects)
             axis = np.eye(3)[i % 3]
             kind = mujoco.mjtJoint.mjJNT_SLIDE if len(d) == 1 else mujoco.mjtJoint.mjJNT_HINGE
             j = b.add_joint(name=ch.joint, type=kind, axis=axis)
             j.stiffness = [joint_stiffness(ch), 0.0, 0.0]
             j.damping = [params.C, 0.0, 0.0]
             self.channels.append(ch)
+        for term in bushing.coupling:
+            a, c = term.directions
+            self.cross.append(CrossTerm(f"{name}_{a}", f"{name}_{c}", signs[a] * signs[c] * term.stiffness))
 
     # -- the car -----------------------------------------------------------------------------
     def build(self) -> CarModel:
@@ -261,7 +318,8 @@ class _Builder:
         self.beam()
         self.anti_roll_bar()
         model = self.spec.compile()
-        return CarModel(v, self.o, self.spec, model, self.channels, self.elements, self.closures, self.corners)
+        return CarModel(v, self.o, self.spec, model, self.channels, self.elements, self.closures, self.corners,
+                        self.cross)
 
     def rack(self):
         f = self.v.front
@@ -303,6 +361,10 @@ class _Builder:
         self.body(knuckle, rod, hp["strut_lower"], rot, f.masses["strut_rod"],
                   (hp["strut_lower"] + hp["strut_top"]) / 2, [0.02, 0.02, 1e-3])
         j = self.bodies[rod].add_joint(name=f"strut_{side}", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[0, 0, 1])
+        j.frictionloss = f.strut_friction[0 if sign > 0 else 1]
+        # friction as stiff as the loop closures: at MuJoCo's default (0.02 s) the regularised friction
+        # let the rod creep through 200 N at 2 mm/s (pad-force loop 7 N wide instead of 2·200 N·MR)
+        j.solref_friction, j.solimp_friction = [2.0 * self.o.timestep, 1.0], list(CLOSURE_SOLIMP)
         self.capsule(rod, hp["strut_lower"], hp["strut_top"], 0.01, (0.8, 0.8, 0.8, 1))
         self._spring_damper_joint(j, f"front_{side}", f.spring, f.damper.curve)
         self.closure(f"top_mount_{side}", mujoco.mjtEq.mjEQ_CONNECT, rod, "chassis", hp["strut_top"])
@@ -358,7 +420,7 @@ class _Builder:
         # the middle of the beam, taken from the arms' masses: its inertia stiffens the weld in rotation
         self.body("arm_left", "beam_centre", centre, np.eye(3), 2 * BEAM_CENTRE_MASS, centre, [0.25, 0.01, 0.25])
         j = self.bodies["beam_centre"].add_joint(name="beam_torsion", type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 1, 0])
-        j.stiffness = [r.beam_torsional_stiffness, 0.0, 0.0]
+        j.stiffness = [r.beam_torsion, 0.0, 0.0]
         self.closure("beam_weld", mujoco.mjtEq.mjEQ_WELD, "beam_centre", "arm_right")
 
     def anti_roll_bar(self):
@@ -374,12 +436,12 @@ class _Builder:
         first, *others = bushings
         axes = mirror_axes(first.axes, sign)
         self.body(parent, part, mirror(first.location, sign), axes.T, mass, com, inertia)
-        self.bushing_joints(part, first, side)
+        self.bushing_joints(part, first, side, sign)
         for b in others:
             sleeve = f"{b.name}_{side}_sleeve"
             loc = mirror(b.location, sign)
             self.body(parent, sleeve, loc, mirror_axes(b.axes, sign).T, SLEEVE_MASS, loc, [1e-3] * 3)
-            self.bushing_joints(sleeve, b, side)
+            self.bushing_joints(sleeve, b, side, sign)
             self.closure(f"{b.name}_{side}_weld", mujoco.mjtEq.mjEQ_WELD, sleeve, part)
 
     def _spring_damper_joint(self, joint, name: str, spring: Spring, damper_curve):

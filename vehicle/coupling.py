@@ -6,10 +6,14 @@ joint stiffness and damping implicitly, forces written to ``qfrc_applied`` expli
 * a linear bushing direction lives entirely in its joint (stiffness K0, damping C);
 * any other direction keeps a reference stiffness K_ref = K0 + Kpa (its tangent at small
   amplitude, the largest tangent of the ladder family) and its damping C in the joint; before each
-  step ONE vectorised call of the bushing bank gives F(e) at the current deflections and only
-  F(e) − K_ref·e is applied explicitly. That remainder's stiffness lies in [−Kpa, 0] ⊂ (−K_ref, 0],
-  so the explicit part can never destabilise the implicit one (laws that stiffen beyond K_ref, the
-  nonlinear elastic saturation, get K_ref raised to their current tangent each step);
+  step ONE compiled call of the bushing bank (:func:`bushings.effects.step_extended`: the law with
+  its state extensions, if any) gives F(e) at the current deflections and only F(e) − K_ref·e is
+  applied explicitly. That remainder's stiffness lies in [−Kpa, 0] ⊂ (−K_ref, 0], so the explicit
+  part can never destabilise the implicit one (laws that may stiffen beyond K_ref, the nonlinear
+  elastic saturation and any law with effects, get K_ref raised to their current tangent each step);
+* a bushing's directional coupling (cross stiffness k between two of its directions) is applied
+  explicitly; k² < K0_a·K0_b (checked on loading) keeps the coupled tangent positive definite,
+  which is also what keeps that explicit term below the implicit diagonal;
 * springs: rate and preload in the joint or tendon; a curve's departure from its rate explicit;
 * dampers: the slope of the active curve segment set as the joint/tendon damping each step
   (implicit), the segment's intercept applied explicitly.
@@ -21,11 +25,12 @@ also runs whole stretches of steps with ``mj_step`` inside the compiled loop).
 from __future__ import annotations
 
 import math
+from typing import Sequence
 
 import mujoco
 import numpy as np
 
-from vehicle.builder import CarModel
+from vehicle.builder import CarModel, CrossTerm
 
 
 def _pad_curves(curves) -> tuple[np.ndarray, np.ndarray]:
@@ -56,11 +61,14 @@ class BushingForces:
     Each channel's joint must carry its reference stiffness (K0 for linear laws, K0 + Kpa
     otherwise, see :func:`vehicle.builder.joint_stiffness`). The parallel damping C is taken where
     the model put it: in the joint if the joint has damping (implicit), else in the bank (explicit).
+    The bank is an :class:`bushings.effects.ExtendedBank`: a channel with a preload is mounted at
+    the design position (deflection 0) on every reset, with zero force there. ``cross`` are the
+    bushings' cross stiffnesses between channels (:class:`vehicle.builder.CrossTerm`).
     """
 
-    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, channels):
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, channels, cross: Sequence[CrossTerm] = ()):
         self.model, self.data = model, data
-        from bushings import BushingBank
+        from bushings.effects import ExtendedBank
 
         ids = np.array([mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, c.joint) for c in channels], dtype=np.int64)
         self.jnt = ids
@@ -71,30 +79,48 @@ class BushingForces:
         self.bank_idx = np.flatnonzero([not c.linear for c in channels])
         params = [channels[i].params for i in self.bank_idx]
         params = [p.replace(C=0.0) if self.C[i] > 0 else p for p, i in zip(params, self.bank_idx)]
-        #: possibly empty (all laws linear, in the joints); None = laws off, joints only (vehicle.runner)
-        self.bank: BushingBank | None = BushingBank(params)
+        effects = [channels[i].effects for i in self.bank_idx]
+        #: possibly empty (all laws linear, in the joints); None = laws off, joints only (KCRig.bushing_laws_off)
+        self.bank: ExtendedBank | None = ExtendedBank(params, effects)
         self.bank_force = np.zeros(self.bank_idx.size)
         self.bank_jnt, self.bank_qpos = ids[self.bank_idx], self.qpos[self.bank_idx]
         self.bank_dof = self.dof[self.bank_idx]
         self.K_ref = self.K[self.bank_idx].copy()
-        self.saturating = np.array([math.isfinite(p.S_sup) or math.isfinite(p.S_inf) for p in params], dtype=np.bool_)
+        self.saturating = np.array([math.isfinite(p.S_sup) or math.isfinite(p.S_inf) or fx.active
+                                    for p, fx in zip(params, effects)], dtype=np.bool_)
+        index = {c.joint: i for i, c in enumerate(channels)}
+        #: (P, 2) channel indices of each cross term's two directions, and its stiffness k (P,)
+        self.cross_channels = np.array([[index[t.joint_a], index[t.joint_b]] for t in cross],
+                                       dtype=np.int64).reshape(-1, 2)
+        self.cross_k = np.array([t.stiffness for t in cross], dtype=float)
 
     def apply(self, dt: float) -> None:
-        """Step the bank to the current deflections and add F(e) − K_ref·e to ``qfrc_applied``."""
-        if self.bank is None or not self.bank.size:
-            return
+        """Step the bank to the current deflections and add F(e) − K_ref·e, and the cross
+        stiffnesses' forces, to ``qfrc_applied``."""
         d = self.data
-        e = d.qpos[self.bank_qpos]
-        force, tangent = self.bank.step(e, dt)
-        self.bank_force = force
-        if self.saturating.any():
-            self.K_ref[:] = np.where(self.saturating, np.maximum(self.K[self.bank_idx], tangent), self.K_ref)
-            self.model.jnt_stiffness[self.bank_jnt] = self.K_ref
-        d.qfrc_applied[self.bank_dof] += self.K_ref * e - force
+        if self.bank is not None and self.bank.size:
+            e = d.qpos[self.bank_qpos]
+            force, tangent = self.bank.step(e, dt)
+            self.bank_force = force
+            if self.saturating.any():
+                self.K_ref[:] = np.where(self.saturating, np.maximum(self.K[self.bank_idx], tangent), self.K_ref)
+                self.model.jnt_stiffness[self.bank_jnt] = self.K_ref
+            d.qfrc_applied[self.bank_dof] += self.K_ref * e - force
+        if self.cross_k.size:
+            d.qfrc_applied[self.dof] -= self.cross_forces()
 
     def deflections(self) -> np.ndarray:
         """Deflection of every direction [m or rad], in the bushing's frame."""
         return self.data.qpos[self.qpos].copy()
+
+    def cross_forces(self) -> np.ndarray:
+        """Force of the cross stiffnesses on every direction [N or N·m], resisting deflection."""
+        q = self.data.qpos[self.qpos]
+        a, b = self.cross_channels.T
+        force = np.zeros(self.qpos.size)
+        np.add.at(force, a, self.cross_k * q[b])
+        np.add.at(force, b, self.cross_k * q[a])
+        return force
 
     def forces(self) -> np.ndarray:
         """Force of every direction [N or N·m], resisting its deflection (joint damping included)."""
@@ -102,7 +128,7 @@ class BushingForces:
         force = self.K * d.qpos[self.qpos] + self.C * d.qvel[self.dof]
         if self.bank is not None:
             force[self.bank_idx] = self.bank_force + self.C[self.bank_idx] * d.qvel[self.bank_dof]
-        return force
+        return force + self.cross_forces()
 
     def reset(self) -> None:
         """Forget the bushings' history (virgin state)."""
@@ -119,7 +145,7 @@ class ForceCoupling:
 
     def __init__(self, car: CarModel, data: mujoco.MjData):
         self.model, self.car, self.data = car.model, car, data
-        self.bushings = BushingForces(car.model, data, car.channels)
+        self.bushings = BushingForces(car.model, data, car.channels, car.cross)
         self._init_elements()
         self._kernel_bank: object = False  # the bank the compiled-kernel arrays were built for
         self._kernel: tuple = ()

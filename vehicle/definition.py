@@ -3,20 +3,29 @@
 Everything returned is SI (m, kg, N, s, rad) and ISO 8855 (x forward, y left, z up); hardpoints
 are the left side's, the right side being their mirror image. Bushing directions keep their
 parameters in the bushing library's user-facing form and are converted by
-:meth:`DirectionDef.channel`. Bad input raises :class:`InputError` naming file, key and value.
+:meth:`DirectionDef.channel` (and their law extensions by :meth:`DirectionDef.effects_si`). Bad
+input raises :class:`InputError` naming file, key and value.
+
+The catalogue's extensions (spec measured-data.md §2) are parameters of the definition, off by
+default: bushing law effects and directional coupling per bushing, the front struts' friction and a
+factor on the twist beam's torsion; :func:`with_extensions` sets them without a file (a truth
+vehicle and its hypotheses from one baseline).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any, Mapping
+from typing import TYPE_CHECKING, Any, Mapping, Sequence
 
 import numpy as np
 import yaml
 
 from bushings.errors import InputError
+
+if TYPE_CHECKING:
+    from bushings.effects import Effects
 
 #: Folder of the vehicle files shipped with the project.
 VEHICLE_DIR = Path(__file__).resolve().parent.parent / "models" / "vehicles"
@@ -33,6 +42,8 @@ DIRECTIONS = ("x", "y", "z", "rx", "ry", "rz")
 #: Parts a bushing may connect (`child`); the parent is always the body.
 BUSHING_PARTS = ("front.wishbone", "rear.arm")
 Vec3 = tuple[float, float, float]
+#: Source named in the errors of :func:`with_extensions`.
+EXTENSIONS_SOURCE = "with_extensions"
 
 
 @dataclass(frozen=True)
@@ -120,6 +131,17 @@ class DirectionDef:
     params: Mapping[str, Any] | None    #: inline parameters (thesis units), or None
     source: str                         #: file and key, for error messages
     families: Families = NO_FAMILIES    #: laws for run-time models this one cannot be read as
+    #: state extensions of the law (:mod:`bushings.effects`, parameter-set units), over the set's own
+    effects: Mapping[str, Any] = field(default_factory=dict)
+
+    def effects_si(self) -> Effects:
+        """The law's :class:`bushings.effects.Effects` (SI): its set's ``effects`` with this
+        direction's own ``effects`` keys over them. They apply whatever model the law is read as."""
+        from bushings.effects import effects_to_si
+        from bushings.parameters import load_parameter_set
+
+        own = load_parameter_set(self.set_name).effects if self.set_name is not None else {}
+        return effects_to_si({**own, **self.effects}, self.quantity, self.source)
 
     def channel(self, override_model: str | None = None):
         """SI :class:`bushings.ChannelParams` of this direction, optionally read as another model.
@@ -159,6 +181,18 @@ class DirectionDef:
 
 
 @dataclass(frozen=True)
+class CrossStiffness:
+    """A symmetric stiffness between two directions of one bushing (directional coupling).
+
+    It adds F_a += k·e_b and F_b += k·e_a, the forces of the energy k·e_a·e_b, so it stores and
+    returns energy but never dissipates it. Both directions have the same quantity.
+    """
+
+    directions: tuple[str, str]          #: two of DIRECTIONS, both translations or both rotations
+    stiffness: float                     #: k [N/m] or [N·m/rad]
+
+
+@dataclass(frozen=True)
 class BushingDef:
     """A 6-direction bushing between the body and a suspension part (left side)."""
 
@@ -168,6 +202,7 @@ class BushingDef:
     location: Vec3                       #: centre [m]
     axes: tuple[Vec3, Vec3, Vec3]        #: the bushing's x, y, z axes (orthonormal, right-handed)
     directions: Mapping[str, DirectionDef]
+    coupling: tuple[CrossStiffness, ...] = ()   #: cross stiffnesses between its directions
 
 
 @dataclass(frozen=True)
@@ -196,6 +231,7 @@ class FrontAxle:
     damper: Damper
     anti_roll_rate: float                #: [N/m] of left-minus-right strut length
     rack_travel_per_rev: float           #: [m] per steering-wheel revolution
+    strut_friction: tuple[float, float] = (0.0, 0.0)   #: Coulomb friction of the rod in the tube [N], (left, right)
 
 
 @dataclass(frozen=True)
@@ -207,6 +243,12 @@ class RearAxle:
     beam_torsional_stiffness: float      #: [N·m/rad]
     spring: Spring
     damper: Damper
+    beam_torsion_scale: float = 1.0      #: factor on beam_torsional_stiffness (an error of the beam's design value)
+
+    @property
+    def beam_torsion(self) -> float:
+        """Torsional stiffness of the beam as built [N·m/rad]."""
+        return self.beam_torsional_stiffness * self.beam_torsion_scale
 
 
 @dataclass(frozen=True)
@@ -315,33 +357,88 @@ def _masses(r: _Reader, names: tuple[str, ...]) -> dict[str, float]:
     return {name: r.number(name, positive=True) for name in names}
 
 
+def _per_side(value: Any, source: str, key: str) -> tuple[float, float]:
+    """A non-negative value for both sides, or ``{left: a, right: b}``: (left, right)."""
+    if isinstance(value, Mapping):
+        r = _Reader(value, source, key, ("left", "right"))
+        return r.number("left", nonneg=True), r.number("right", nonneg=True)
+    v = _number(value, source, key, nonneg=True)
+    return v, v
+
+
+def _mapping(value: Any, source: str, key: str) -> dict[str, Any]:
+    if not isinstance(value, Mapping):
+        raise InputError(f"expected a mapping, got {value!r}", source=source, key=key)
+    return dict(value)
+
+
+def _checked(d: DirectionDef, source: str, key: str) -> DirectionDef:
+    """``d`` after building its law and effects once, so that errors name ``source`` and ``key``."""
+    try:
+        d.channel()
+        d.effects_si()
+    except InputError as exc:
+        if exc.source and exc.source.startswith(source):
+            raise
+        raise InputError(str(exc), source=source, key=key) from exc
+    return d
+
+
 def _direction(value: Any, source: str, key: str, quantity: str, families: Families) -> DirectionDef:
-    r = _Reader(value, source, key, ("set", "model", "params"))
+    r = _Reader(value, source, key, ("set", "model", "params", "effects"))
     if ("set" in r.data) == ("params" in r.data):
         raise InputError("give either `set` (a parameter set of models/bushings/) or `model` with `params`",
                          source=source, key=key)
     model = r.raw("model", None)
     if model is not None and not isinstance(model, str):
         raise InputError(f"expected a model name, got {model!r}", source=source, key=r.sub("model"))
+    effects = _mapping(r.raw("effects", {}), source, r.sub("effects"))
     if "set" in r.data:
         name = r.raw("set")
         if not isinstance(name, str):
             raise InputError(f"expected a parameter-set name, got {name!r}", source=source, key=r.sub("set"))
-        d = DirectionDef(quantity, name, model, None, f"{source}: {key}", families)
+        d = DirectionDef(quantity, name, model, None, f"{source}: {key}", families, effects)
     else:
         if model is None:
             raise InputError("missing key (inline parameters need a model)", source=source, key=r.sub("model"))
         if not isinstance(r.raw("params"), Mapping):
             raise InputError(f"expected a mapping of parameters, got {r.raw('params')!r}",
                              source=source, key=r.sub("params"))
-        d = DirectionDef(quantity, None, model, dict(r.raw("params")), f"{source}: {key}", families)
-    try:
-        d.channel()  # validate now so that errors name the vehicle file and key
-    except InputError as exc:
-        if exc.source and exc.source.startswith(source):
-            raise
-        raise InputError(str(exc), source=source, key=key) from exc
-    return d
+        d = DirectionDef(quantity, None, model, dict(r.raw("params")), f"{source}: {key}", families, effects)
+    return _checked(d, source, key)
+
+
+def _coupling(value: Any, source: str, key: str, directions: Mapping[str, DirectionDef]) -> tuple[CrossStiffness, ...]:
+    """A bushing's ``coupling`` list: ``[{directions: [a, b], stiffness: k}]``, k in N/mm between two
+    translations or N·m/deg between two rotations (mixed pairs are refused: no common unit)."""
+    from bushings.parameters import LENGTH_UNIT_SI, UNIT_LABELS
+
+    if not isinstance(value, (list, tuple)):
+        raise InputError(f"expected a list of {{directions: [a, b], stiffness: k}}, got {value!r}", source=source,
+                         key=key)
+    terms: list[CrossStiffness] = []
+    for i, item in enumerate(value):
+        r = _Reader(item, source, f"{key}[{i}]", ("directions", "stiffness"))
+        pair = r.raw("directions")
+        if (not isinstance(pair, (list, tuple)) or len(pair) != 2 or any(p not in DIRECTIONS for p in pair)
+                or pair[0] == pair[1] or any({pair[0], pair[1]} == set(t.directions) for t in terms)):
+            raise InputError(f"expected two different directions of {', '.join(DIRECTIONS)}, not coupled "
+                             f"already, got {pair!r}", source=source, key=r.sub("directions"))
+        a, b = directions[pair[0]], directions[pair[1]]
+        if a.quantity != b.quantity:
+            raise InputError(f"cannot couple a translation with a rotation ({pair[0]}, {pair[1]}): their "
+                             f"stiffness has no common unit", source=source, key=r.sub("directions"))
+        unit = LENGTH_UNIT_SI[a.quantity]
+        k = r.number("stiffness") / unit
+        # the coupled tangent [[K0_a, k], [k, K0_b]] must stay positive definite at large amplitude
+        bound = math.sqrt(a.channel().K0 * b.channel().K0)
+        if not abs(k) < bound:
+            force, length = UNIT_LABELS[a.quantity]
+            raise InputError(f"expected |stiffness| < sqrt(K0_{pair[0]}·K0_{pair[1]}) = {bound * unit:.6g} "
+                             f"{force}/{length} (the coupled law must stay positive definite), got {k * unit!r}",
+                             source=source, key=r.sub("stiffness"))
+        terms.append(CrossStiffness((pair[0], pair[1]), k))
+    return tuple(terms)
 
 
 def _axis(value: Any, source: str, key: str, points: Mapping[str, np.ndarray]) -> np.ndarray:
@@ -363,7 +460,7 @@ def _axis(value: Any, source: str, key: str, points: Mapping[str, np.ndarray]) -
 
 
 def _bushing(value: Any, source: str, key: str, points: Mapping[str, np.ndarray], families: Families) -> BushingDef:
-    r = _Reader(value, source, key, ("name", "parent", "child", "location", "axes", "directions"))
+    r = _Reader(value, source, key, ("name", "parent", "child", "location", "axes", "directions", "coupling"))
     name = r.raw("name")
     if not isinstance(name, str) or not name.isidentifier():
         raise InputError(f"expected an identifier, got {name!r}", source=source, key=r.sub("name"))
@@ -394,8 +491,9 @@ def _bushing(value: Any, source: str, key: str, points: Mapping[str, np.ndarray]
     for d in DIRECTIONS:
         quantity = "translation" if len(d) == 1 else "rotation"
         directions[d] = _direction(dr.raw(d), source, dr.sub(d), quantity, families)
+    coupling = _coupling(r.raw("coupling", []), source, r.sub("coupling"), directions)
     return BushingDef(name, "body", child, location,
-                      (tuple(x.tolist()), tuple(y.tolist()), tuple(z.tolist())), directions)
+                      (tuple(x.tolist()), tuple(y.tolist()), tuple(z.tolist())), directions, coupling)
 
 
 def _families(top: _Reader) -> Families:
@@ -440,7 +538,7 @@ def load_vehicle(path: str | Path = DEFAULT_VEHICLE) -> VehicleDefinition:
                 b.vector("ride_height_point"), b.number("design_ride_height"))
 
     f = top.reader("front", ("hardpoints", "static_toe", "static_camber", "masses", "spring", "damper",
-                             "anti_roll_bar", "steering"))
+                             "anti_roll_bar", "steering", "strut_friction"))
     front = FrontAxle(
         hardpoints=_points(f.reader("hardpoints", FRONT_POINTS), FRONT_POINTS),
         static_toe=math.radians(f.number("static_toe")), static_camber=math.radians(f.number("static_camber")),
@@ -449,16 +547,18 @@ def load_vehicle(path: str | Path = DEFAULT_VEHICLE) -> VehicleDefinition:
         damper=Damper(_curve(f.reader("damper", ("curve",)).raw("curve"), source, "front.damper.curve")),
         anti_roll_rate=f.reader("anti_roll_bar", ("rate",)).number("rate", nonneg=True),
         rack_travel_per_rev=f.reader("steering", ("rack_travel_per_rev",)).number("rack_travel_per_rev",
-                                                                                  positive=True))
+                                                                                  positive=True),
+        strut_friction=_per_side(f.raw("strut_friction", 0.0), source, f.sub("strut_friction")))
     rr = top.reader("rear", ("hardpoints", "static_toe", "static_camber", "masses", "beam_torsional_stiffness",
-                             "spring", "damper"))
+                             "beam_torsion_scale", "spring", "damper"))
     rear = RearAxle(
         hardpoints=_points(rr.reader("hardpoints", REAR_POINTS), REAR_POINTS),
         static_toe=math.radians(rr.number("static_toe")), static_camber=math.radians(rr.number("static_camber")),
         masses=_masses(rr.reader("masses", REAR_MASSES), REAR_MASSES),
         beam_torsional_stiffness=rr.number("beam_torsional_stiffness", positive=True),
         spring=_spring(rr.reader("spring", ("rate", "curve", "preload"))),
-        damper=Damper(_curve(rr.reader("damper", ("curve",)).raw("curve"), source, "rear.damper.curve")))
+        damper=Damper(_curve(rr.reader("damper", ("curve",)).raw("curve"), source, "rear.damper.curve")),
+        beam_torsion_scale=rr.number("beam_torsion_scale", positive=True, default=1.0))
 
     points = {f"front.{k}": np.array(v) for k, v in front.hardpoints.items()}
     points |= {f"rear.{k}": np.array(v) for k, v in rear.hardpoints.items()}
@@ -477,3 +577,45 @@ def load_vehicle(path: str | Path = DEFAULT_VEHICLE) -> VehicleDefinition:
     if not isinstance(name, str):
         raise InputError(f"expected a name, got {name!r}", source=source, key="name")
     return VehicleDefinition(name, str(top.raw("description", "")), path, tyre, body, front, rear, bushings)
+
+
+def with_extensions(v: VehicleDefinition, *, strut_friction: float | Mapping[str, float] | None = None,
+                    beam_torsion_scale: float | None = None,
+                    effects: Mapping[str, Mapping[str, float]] | None = None,
+                    coupling: Mapping[str, Sequence[Mapping[str, Any]]] | None = None) -> VehicleDefinition:
+    """``v`` with the catalogue's extensions set, without writing a file (None keeps one as it is).
+
+    ``strut_friction`` [N] and ``beam_torsion_scale`` as the keys ``front.strut_friction`` (a number
+    for both struts or ``{left: a, right: b}``) and ``rear.beam_torsion_scale``; ``effects`` maps
+    ``"bushing.direction"`` to effect keys in parameter-set units (``{"e1_rear.z": {"mullins": 0.2}}``),
+    laid over the direction's own; ``coupling`` maps a bushing name to its new ``coupling`` list
+    (``{"e1_rear": [{"directions": ["x", "z"], "stiffness": 50.0}]}``, N/mm or N·m/deg), which
+    replaces the old one. Values are checked as in a vehicle file; errors name ``with_extensions``.
+    """
+    src = EXTENSIONS_SOURCE
+    front, rear = v.front, v.rear
+    if strut_friction is not None:
+        front = replace(front, strut_friction=_per_side(strut_friction, src, "strut_friction"))
+    if beam_torsion_scale is not None:
+        rear = replace(rear, beam_torsion_scale=_number(beam_torsion_scale, src, "beam_torsion_scale", positive=True))
+    bushings = {b.name: b for b in v.bushings}
+
+    def bushing(name: str, key: str) -> BushingDef:
+        if name not in bushings:
+            raise InputError(f"unknown bushing {name!r}; expected one of {', '.join(bushings)}", source=src, key=key)
+        return bushings[name]
+
+    for target, values in (effects or {}).items():
+        key = f"effects.{target}"
+        name, _, direction = str(target).partition(".")
+        b = bushing(name, key)
+        if direction not in DIRECTIONS:
+            raise InputError(f"expected 'bushing.direction' with a direction of {', '.join(DIRECTIONS)}, got "
+                             f"{target!r}", source=src, key=key)
+        d = b.directions[direction]
+        d = _checked(replace(d, effects={**d.effects, **_mapping(values, src, key)}), src, key)
+        bushings[name] = replace(b, directions={**b.directions, direction: d})
+    for name, terms in (coupling or {}).items():
+        b = bushing(name, f"coupling.{name}")
+        bushings[name] = replace(b, coupling=_coupling(terms, src, f"coupling.{name}", b.directions))
+    return replace(v, front=front, rear=rear, bushings=tuple(bushings.values()))

@@ -1,10 +1,11 @@
 """Compiled stepping: the coupling of :mod:`vehicle.coupling` and ``mj_step`` in one numba loop.
 
 A numpy coupling called from a Python loop cost ~150–250 µs per step on the rig, more than
-``mj_step``; here the rig inputs, the bushing bank step, the damper and spring laws and
-``mj_step`` (called through ctypes on the model's and data's addresses) all run in compiled code,
-so a step costs ``mj_step`` plus the bank kernel. :func:`run` gives bit-identical results to
-calling ``ForceCoupling.apply`` and ``mujoco.mj_step`` from Python (tests/test_vehicle_rig.py).
+``mj_step``; here the rig inputs, the bushing bank step (the laws with their state extensions,
+:func:`bushings.effects.step_extended`), the bushings' cross stiffnesses, the damper and spring
+laws and ``mj_step`` (called through ctypes on the model's and data's addresses) all run in
+compiled code, so a step costs ``mj_step`` plus the bank kernel. :func:`run` gives bit-identical
+results to calling ``ForceCoupling.apply`` and ``mujoco.mj_step`` from Python (tests/test_vehicle_rig.py).
 
 Arrays of ``MjModel``/``MjData`` are numpy views of MuJoCo's memory, so the loop reads and writes
 them in place.
@@ -20,29 +21,10 @@ import numba as nb
 import numpy as np
 from numba.core import caching
 
-from bushings import kernel as _kn
+from bushings import effects as _fx
 
-class _KernelStampedLocator(caching.InTreeCacheLocator):
-    """Numba cache locator for this module: its stamp covers this file AND the bushing kernel.
-
-    :func:`coupling_step` compiles :func:`bushings.kernel.step_bank` into itself, but numba only
-    checks the stamp of the caller's file, so after a kernel change a cached caller would run the
-    old kernel on the new bank's arrays (memory corruption, seen as a segfault).
-    """
-
-    @classmethod
-    def from_function(cls, py_func, py_file):
-        if Path(py_file).resolve() != Path(__file__).resolve():
-            return None  # other modules keep numba's own locators
-        return super().from_function(py_func, py_file)
-
-    def get_source_stamp(self):
-        kernel = Path(_kn.__file__)
-        st = kernel.stat()
-        return super().get_source_stamp(), caching._hash_source_file(str(kernel), st.st_mtime, st.st_size)
-
-
-caching.CacheImpl._locator_classes.insert(0, _KernelStampedLocator)
+# coupling_step compiles the bushing kernels into itself: its cache must follow their files too
+caching.CacheImpl._locator_classes.insert(0, _fx.kernel_stamped_locator(__file__))
 
 _LIB = ctypes.CDLL(str(next(Path(mujoco.__file__).parent.glob("libmujoco.so*"))))
 _mj_step = _LIB.mj_step
@@ -75,26 +57,31 @@ def _push(qfrc, ten_J, ten_J_rowadr, ten_J_rownnz, ten_J_colind, joint, index, g
 
 @nb.njit(cache=True)
 def coupling_step(h, qpos, qvel, qfrc, ten_length, ten_velocity, ten_J, ten_J_rowadr, ten_J_rownnz, ten_J_colind,
-                  jnt_stiffness, dof_damping, tendon_damping, bush, bank, damp, spring):
+                  jnt_stiffness, dof_damping, tendon_damping, bush, bank, cross, damp, spring):
     """Write the non-implicit forces for the next step of ``h`` [s] (see vehicle.coupling).
 
     ``bush`` = (qpos adr, dof adr, joint ids, base stiffness, K_ref, saturating, e work) of the
-    bank channels, ``bank`` = :meth:`bushings.BushingBank.kernel_args`, ``damp`` = (is joint, dof or tendon index, sign,
-    xs, ys, intercept out [N], work), ``spring`` = (is joint, index, qpos adr, design, sign, xs, ys, rate, y0,
-    nonlinear?, remainder work).
+    bank channels, ``bank`` = :meth:`bushings.effects.ExtendedBank.kernel_args`, ``cross`` = (qpos adr
+    (P, 2), dof adr (P, 2), stiffness (P,)) of the cross stiffnesses, ``damp`` = (is joint, dof or
+    tendon index, sign, xs, ys, intercept out [N], work), ``spring`` = (is joint, index, qpos adr,
+    design, sign, xs, ys, rate, y0, nonlinear?, remainder work).
     """
     qfrc[:] = 0.0
     bq, bd, bj, kbase, kref, sat, e = bush
     if bq.shape[0]:
         for c in range(bq.shape[0]):
             e[c] = qpos[bq[c]]
-        _kn.step_bank(e, h, *bank)
-        force, tangent = bank[-4], bank[-3]
+        _fx.step_extended(e, h, *bank)
+        force, tangent = bank[3], bank[4]
         for c in range(bq.shape[0]):
             if sat[c]:
                 kref[c] = max(kbase[c], tangent[c])
                 jnt_stiffness[bj[c]] = kref[c]
             qfrc[bd[c]] += kref[c] * e[c] - force[c]
+    xq, xd, xk = cross
+    for p in range(xk.shape[0]):
+        qfrc[xd[p, 0]] -= xk[p] * qpos[xq[p, 1]]
+        qfrc[xd[p, 1]] -= xk[p] * qpos[xq[p, 0]]
     joint, index, sign, xs, ys, offset, gen = damp
     for k in range(joint.shape[0]):
         v = qvel[index[k]] if joint[k] else ten_velocity[index[k]]
@@ -118,7 +105,7 @@ def coupling_step(h, qpos, qvel, qfrc, ten_length, ten_velocity, ten_J, ten_J_ro
 @nb.njit(cache=True)
 def _run(mj_step, n, i0, n_ramp, start, end, active, eq_data, pad_eq, xfrc, carriage, wheel, m_addr, d_addr, h,
         qpos, qvel, qfrc, ten_length, ten_velocity, ten_J, ten_J_rowadr, ten_J_rownnz, ten_J_colind, jnt_stiffness,
-        dof_damping, tendon_damping, bush, bank, damp, spring):
+        dof_damping, tendon_damping, bush, bank, cross, damp, spring):
     """Advance ``n`` steps; rig inputs move linearly from ``start`` to ``end`` over ``n_ramp`` steps.
 
     Inputs (16 values): pad heights [m], Fx, Fy [N] at the carriages, Mz [N·m] at the wheels, four
@@ -138,7 +125,7 @@ def _run(mj_step, n, i0, n_ramp, start, end, active, eq_data, pad_eq, xfrc, carr
             if active[3]:
                 xfrc[wheel[c], 5] = start[12 + c] + (end[12 + c] - start[12 + c]) * f
         coupling_step(h, qpos, qvel, qfrc, ten_length, ten_velocity, ten_J, ten_J_rowadr, ten_J_rownnz, ten_J_colind,
-                      jnt_stiffness, dof_damping, tendon_damping, bush, bank, damp, spring)
+                      jnt_stiffness, dof_damping, tendon_damping, bush, bank, cross, damp, spring)
         mj_step(m_addr, d_addr)
 
 
@@ -148,18 +135,18 @@ def run(*args) -> None:
 
 
 def coupling_arrays(coupling) -> tuple:
-    """The (bush, bank, damp, spring) tuples of :func:`coupling_step` for a ForceCoupling."""
-    from bushings import BushingBank
-
+    """The (bush, bank, cross, damp, spring) tuples of :func:`coupling_step` for a ForceCoupling."""
     b = coupling.bushings
     on = b.bank is not None  # None: laws off, every direction linear in its joint
     idx = b.bank_idx if on else np.zeros(0, np.int64)
     bush = (b.qpos[idx].astype(np.int64), b.dof[idx].astype(np.int64), b.jnt[idx].astype(np.int64), b.K[idx].copy(),
             b.K_ref if on else np.zeros(0), b.saturating if on else np.zeros(0, np.bool_), np.zeros(idx.size))
-    bank = (b.bank if on else BushingBank([])).kernel_args()
+    bank = (b.bank if on else _fx.ExtendedBank([])).kernel_args()
+    # the cross stiffnesses are linear and stay on when the laws are off
+    cross = (b.qpos[b.cross_channels].astype(np.int64), b.dof[b.cross_channels].astype(np.int64), b.cross_k)
     c = coupling
     damp = (c.dp_joint, c.dp_index.astype(np.int64), c.dp_sign.astype(float), c.dp_xs, c.dp_ys, c.dp_offset,
             np.zeros(len(c.dp_offset)))
     spring = (c.sp_joint, c.sp_index.astype(np.int64), c.sp_qadr.astype(np.int64), c.sp_design, c.sp_sign.astype(float),
               c.sp_xs, c.sp_ys, c.sp_rate, c.sp_y0, bool(c.sp_nonlinear), np.zeros(len(c.sp_rate)))
-    return bush, bank, damp, spring
+    return bush, bank, cross, damp, spring
