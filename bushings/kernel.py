@@ -20,6 +20,7 @@ from __future__ import annotations
 import math
 
 import numba as nb
+import numpy as np
 
 # Columns of the float parameter matrix P (one row per channel, SI).
 P_K0, P_C, P_NSUP, P_NINF, P_SSUP, P_SINF, P_PSUP, P_PINF, P_KPA, P_KR, P_FF, P_CO, P_PW, P_CT, P_NROOT, \
@@ -35,8 +36,20 @@ STACK_SIZE = 64
 # so that an overshoot in a simulation gives a large finite force instead of an infinite one.
 _THETA_MAX = 0.49 * math.pi
 _MAX_NEWTON = 80
+#: Relative Newton step above which a growing node takes the power-law step of _grow.
+_R_GROW = 0.02
 # Fast-math without 'nnan'/'ninf', so the solver's NaN checks keep working.
 _FAST = {"nsz", "arcp", "contract", "afn", "reassoc"}
+# Rows of the ladder scratch: left spring stiffness of each node (a row rather than a test on the
+# node index, which would make LLVM peel the loops instead of vectorising them), node slips w, slip
+# directions (±1, 0 = stuck), positions u_old + w, power-law forces and slopes, residuals / Newton
+# steps, zero-slip imbalances a0, relative Newton steps, and for the solve: diagonal mantissas and
+# powers of 2 (see _scale_diagonal), reciprocal pivots.
+_KL, _W, _SG, _POS, _PSI, _DFL, _RHS, _A0, _RR, _AP, _SC, _DP = range(12)
+_NROWS = 12
+# ln 2 split so that k·_LN2_HI is exact for |k| < 2^20.
+_LN2_HI = 6.93147180369123816490e-01
+_LN2_LO = 1.90821492927058770002e-10
 
 
 @nb.njit(cache=True, inline="always", fastmath=_FAST)
@@ -63,192 +76,291 @@ def _elastic(x, K0, nsup, ninf, ssup, sinf, psup, pinf):
     return K0 * x, K0
 
 
-@nb.njit(cache=True, inline="always", fastmath=_FAST)
-def _damper(w, h, Ff, Co, pw):
-    """Dissipative force magnitude Ff + Co·|w/h|^pw for |w| > 0 and its derivative d/d|w|."""
-    aw = abs(w)
-    if Co == 0.0:
-        return Ff, 0.0
-    f = Co * math.exp(pw * math.log(aw / h))  # cheaper than ** here (~14 ns against 20-30 ns)
-    return Ff + f, pw * f / aw
+@nb.njit(cache=True, inline="always", fastmath=_FAST, error_model="numpy")
+def _pow(x, p):
+    """x**p for x > 0 and 0 ≤ p ≤ 1 (not below e^-708), relative error < 2e-16·(1 + p·|ln x|).
+
+    Branch-free exp(p·ln x) from the bits of x (no libm call), so that LLVM vectorises the node
+    loop that calls it: the power law's exp and log calls were most of the solver's cost.
+    """
+    tiny = x < 2.0 ** -900
+    x = x * 2.0 ** 200 if tiny else x
+    # x = 2^k·m with m in [√½, √2): k from the exponent bits, as an exact double.
+    b = np.float64(x).view(np.int64)
+    k = (b - 0x3FE6A09E667F3BCD) >> 52
+    m = np.int64(b - (k << 52)).view(np.float64)
+    kd = float(np.int32(k)) - (200.0 if tiny else 0.0)
+    # log m = 2·atanh(s), s = (m − 1)/(m + 1), |s| ≤ 0.172: series to s^21 (next term < 2e-17).
+    s = (m - 1.0) / (m + 1.0)
+    s2 = s * s
+    s4 = s2 * s2
+    q = ((1.0 / 3.0 + s2 * (1.0 / 5.0)) + s4 * ((1.0 / 7.0 + s2 * (1.0 / 9.0)) + s4 * (
+        (1.0 / 11.0 + s2 * (1.0 / 13.0)) + s4 * ((1.0 / 15.0 + s2 * (1.0 / 17.0)) + s4 * (
+            1.0 / 19.0 + s2 * (1.0 / 21.0))))))
+    y = max(p * (kd * _LN2_HI + (kd * _LN2_LO + (2.0 * s + 2.0 * s * s2 * q))), -708.0)
+    # exp y = 2^j·e^r, |r| ≤ ½·ln 2: Taylor to r^13 (next term < 5e-18); 2^j from its bits.
+    j = np.floor(y * (1.0 / _LN2_HI) + 0.5)
+    r = (y - j * _LN2_HI) - j * _LN2_LO
+    r2 = r * r
+    e = (1.0 + r) + r2 * ((1.0 / 2.0 + r * (1.0 / 6.0)) + r2 * ((1.0 / 24.0 + r * (1.0 / 120.0)) + r2 * (
+        (1.0 / 720.0 + r * (1.0 / 5040.0)) + r2 * ((1.0 / 40320.0 + r * (1.0 / 362880.0)) + r2 * (
+            (1.0 / 3628800.0 + r * (1.0 / 39916800.0)) + r2 * (
+                1.0 / 479001600.0 + r * (1.0 / 6227020800.0)))))))
+    return e * np.int64(np.float64(j + 6755399441056767.0).view(np.int64) << 52).view(np.float64)
 
 
 @nb.njit(cache=True, fastmath=_FAST)
 def _release(a, ks, h, Ff, Co, pw):
     """Slip magnitude of one node with its neighbours held: |a| − ks·w = Ff + Co(w/h)^pw.
 
-    ``a`` is the node's spring imbalance at zero slip (|a| > Ff). The root is bracketed by
-    (0, min((|a|−Ff)/ks, h((|a|−Ff)/Co)^(1/pw))); safeguarded Newton.
+    ``a`` is the node's spring imbalance at zero slip (|a| > Ff). Newton in log w from the smaller
+    of the springs-only and damper-only slips, which lies above the root: the residual is concave
+    in log w, so the iterates fall monotonically onto the root (Newton in w from below climbs the
+    power law slowly: ~7 iterations against ~2).
     """
     excess = abs(a) - Ff
-    hi = excess / ks
+    ws = excess / ks
     if Co == 0.0:
-        return hi
+        return ws
     if pw == 1.0:
         return excess / (ks + Co / h)
-    hi = min(hi, h * (excess / Co) ** (1.0 / pw))
-    lo = 0.0
-    w = 0.5 * hi
+    ls = math.log(ws / h)
+    lp = math.log(excess / Co) / pw
+    if ls < lp:
+        w = ws
+        f = Co * math.exp(pw * ls)  # damper force at w
+    else:
+        w = h * math.exp(lp)  # 0 if below float range: the node stays stuck
+        f = excess
     for _ in range(60):
-        d, dd = _damper(w, h, Ff, Co, pw)
-        r = excess + Ff - ks * w - d  # decreasing in w
-        if r > 0.0:
-            lo = w
-        else:
-            hi = w
-        step = r / (ks + dd)
-        wn = w + step
-        if wn <= lo or wn >= hi:
-            wn = 0.5 * (lo + hi)
-        if abs(wn - w) <= 1e-12 * wn:
-            return wn
-        w = wn
+        dy = (excess - ks * w - f) / (ks * w + pw * f)
+        w *= math.exp(dy)
+        f *= math.exp(pw * dy)
+        if abs(dy) <= 1e-12:
+            break
     return w
 
 
-@nb.njit(cache=True, inline="always", fastmath=_FAST)
-def _solve_active(n, st, Kpa, Kr, slope, rhs, cp, dp):
-    """Solve (K + diag(slope)) x = rhs in place on the slipping nodes (st ≠ 0); stuck nodes get x = 0.
+@nb.njit(cache=True, inline="always", fastmath=_FAST, error_model="numpy")
+def _scale_diagonal(m, S, Kr):
+    """Diagonal of K + diag S[_DFL] over Kr (≥ 1), split exactly as S[_AP]·2^e, S[_AP] in [1, 2),
+    S[_SC] = 2^-e, on nodes 1..m (K: the ladder stiffness, diagonal k_left + Kr)."""
+    for j in range(1, m + 1):
+        b = np.float64((S[_KL, j] + Kr + S[_DFL, j]) / Kr).view(np.int64)
+        S[_AP, j] = np.int64((b & 0x000FFFFFFFFFFFFF) | 0x3FF0000000000000).view(np.float64)
+        S[_SC, j] = np.int64(0x7FE0000000000000 - (b & 0x7FF0000000000000)).view(np.float64)
 
-    K is the ladder stiffness (diagonal k_left + Kr, off-diagonal −Kr); Thomas algorithm.
+
+@nb.njit(cache=True, inline="always", fastmath=_FAST, error_model="numpy")
+def _solve_active(n, m, S, Kr):
+    """Solve (K + diag S[_DFL]) x = S[_RHS] in place on the slipping nodes; x = 0 on stuck nodes.
+
+    S[_RHS] must be 0 on stuck nodes. Thomas algorithm with its pivots taken as ratios of successive
+    leading minors of each block of slipping nodes: the minors' recurrence chains only multiply-adds,
+    and the divisions, off the chain, overlap (a chain of divisions was most of the solve's time).
+    The minors are scaled by Kr and by the diagonal's powers of 2, which bounds them within
+    [~4^-n, 2^n] whatever the slopes. The reciprocal pivots are kept in S[_DP] (0 on stuck nodes,
+    which decouples their neighbours), so the back substitution does not divide.
     """
-    for i in range(n):
-        if st[i] == 0:
-            diag = 1.0
-            rhs[i] = 0.0
-            lower = 0.0
-        else:
-            diag = (Kpa if i == 0 else Kr) + Kr + slope[i]
-            lower = -Kr if (i > 0 and st[i - 1] != 0) else 0.0
-        if i == 0:
-            dp[i] = diag
-        else:
-            m = lower / dp[i - 1]
-            dp[i] = diag - m * cp[i - 1]
-            rhs[i] -= m * rhs[i - 1]
-        if i < n - 1:  # the upper diagonal of row i is the lower diagonal of row i+1
-            cp[i] = -Kr if (st[i] != 0 and st[i + 1] != 0) else 0.0
-    for i in range(n - 1, -1, -1):
-        nxt = rhs[i + 1] if i < n - 1 else 0.0
-        rhs[i] = (rhs[i] - cp[i] * nxt) / dp[i]
+    _scale_diagonal(m, S, Kr)
+    kri = 1.0 / Kr
+    # Recurrences carried in locals, not re-read from S (whose rows LLVM cannot tell apart).
+    d2, d1 = 0.0, 1.0  # minors before node j; (0, 1) starts a block
+    sc = 1.0  # S[_SC, j - 1]
+    q = 0.0  # reciprocal pivot of node j - 1
+    y = 0.0  # eliminated right-hand side of node j - 1
+    for j in range(1, n + 1):
+        if S[_SG, j] == 0.0:
+            S[_DP, j] = 0.0
+            d2, d1 = 0.0, 1.0
+            q = 0.0
+            continue
+        scj = S[_SC, j]
+        d = S[_AP, j] * d1 - (scj * sc) * d2
+        y = S[_RHS, j] + Kr * q * y
+        q = d1 / d * (scj * kri)
+        S[_DP, j] = q
+        S[_RHS, j] = y
+        d2, d1 = d1, d
+        sc = scj
+    x = 0.0
+    for j in range(n, 0, -1):
+        x = (Kr * S[_DP, j]) * x + S[_DP, j] * S[_RHS, j]
+        S[_RHS, j] = x
 
 
-@nb.njit(cache=True, fastmath=_FAST)
-def _ladder_step(e, de, h, n, Kpa, Kr, Ff, Co, pw, tol_x, u, wprev, slope, w, st, dflat, rhs, cp, dp, a0, dval):
+@nb.njit(cache=True, inline="always", fastmath=_FAST, error_model="numpy")
+def _grow(n, S, Kr, pw):
+    """Step the slipping nodes whose Newton step r·w (r = S[_RR] ≥ _R_GROW) grows them much
+    (S[_W] = w on entry).
+
+    Newton climbs the concave power law from below, monotonically but slowly: a node that speeds up
+    tenfold in a step took several passes. Where the power law dominates the node's stiffness
+    (weight theta), step instead to where the power law alone gives the force increase Newton asks
+    of it, w·(1 + pw·r)^(1/pw); blend with Newton's step by theta, and cap at the step the node's
+    springs alone would take (its damper force can only grow).
+    """
+    for j in range(1, n + 1):
+        r = S[_RR, j]
+        if S[_SG, j] == 0.0 or r < _R_GROW:
+            continue
+        dfl = S[_DFL, j]
+        ks = S[_KL, j] + Kr
+        theta = dfl / (ks + dfl)
+        g = (1.0 - theta) * r + theta * (math.exp(math.log1p(pw * r) / pw) - 1.0)
+        S[_W, j] *= 1.0 + min(g, r * (ks + dfl) / ks)
+
+
+@nb.njit(cache=True, fastmath=_FAST, error_model="numpy")
+def _ladder_step(e, de, h, n, Kpa, Kr, Ff, Co, pw, tol_x, u, wprev, slope, S):
     """Advance one ladder of n nodes to deflection e; returns (F_ladder, dF/de, energy dissipated, ok).
 
     Converged when every node's force residual is below tol_x·(Kpa + 2·Kr), i.e. the nodes are
-    placed to about tol_x [m or rad].
+    placed to about tol_x [m or rad]. ``S`` is scratch (rows _KL.._DP); node i is column i + 1, and
+    columns 0 and n + 1 onwards hold the boundaries (input, ground), so the node loops need no
+    branches and, run to a multiple of 4 nodes, vectorise whole.
     """
     # Sliders are released at their threshold to round-off, whatever tol_x: the stick–slip pattern
     # is exact, and a Coulomb ladder (one linear solve per active set) is solved to round-off.
     tol_stick = 1e-13 * (Kpa + 2.0 * Kr)
     tol = tol_x * (Kpa + 2.0 * Kr) if Co > 0.0 else tol_stick
+    m = (n + 3) // 4 * 4
+    for j in range(m + 2):
+        S[_KL, j] = Kr if j <= n else 0.0  # padding nodes: no spring to their left, never loaded
+        S[_W, j] = 0.0
+        S[_SG, j] = 0.0
+        S[_POS, j] = 0.0
+        S[_RHS, j] = 0.0
+        S[_SC, j] = 1.0
+        S[_DP, j] = 0.0
+    S[_KL, 1] = Kpa
+    S[_POS, 0] = e
     # Predictor: one Newton step from the last increment with the last converged slopes (no
     # transcendental calls): the residual of w = wprev at the new step is Kpa·Δe·δ_i1 − (K·wprev)_i.
-    for i in range(n):
-        st[i] = 0 if wprev[i] == 0.0 else (1 if wprev[i] > 0.0 else -1)
-        w[i] = wprev[i]
-    for i in range(n):
-        if st[i] != 0:
-            kw = ((Kpa if i == 0 else Kr) + Kr) * wprev[i]
-            if i > 0:
-                kw -= Kr * wprev[i - 1]
-            if i < n - 1:
-                kw -= Kr * wprev[i + 1]
-            rhs[i] = (Kpa * de if i == 0 else 0.0) - kw
-    _solve_active(n, st, Kpa, Kr, slope, rhs, cp, dp)
-    for i in range(n):
-        if st[i] != 0 and (wprev[i] + rhs[i]) * st[i] > 0.0:
-            w[i] = wprev[i] + rhs[i]
+    for j in range(1, n + 1):
+        S[_W, j] = wprev[j - 1]
+        S[_SG, j] = 0.0 if wprev[j - 1] == 0.0 else (1.0 if wprev[j - 1] > 0.0 else -1.0)
+        S[_DFL, j] = slope[j - 1]
+    for j in range(1, m + 1):
+        r = -((S[_KL, j] + Kr) * S[_W, j] - Kr * S[_W, j - 1] - Kr * S[_W, j + 1])
+        S[_RHS, j] = r if S[_SG, j] != 0.0 else 0.0
+    S[_RHS, 1] += Kpa * de if S[_SG, 1] != 0.0 else 0.0
+    _solve_active(n, m, S, Kr)
+    for j in range(1, m + 1):
+        wn = S[_W, j] + S[_RHS, j]
+        S[_W, j] = wn if wn * S[_SG, j] > 0.0 else S[_W, j]
     ok = False
     for _ in range(_MAX_NEWTON):
-        # Spring imbalance ΔF_i = k_left(u_{i-1} − u_i) − Kr(u_i − u_{i+1}) at u = u_old + w.
-        done = True
-        nreleased = 0
-        for i in range(n):
-            ui = u[i] + w[i]
-            left = e if i == 0 else u[i - 1] + w[i - 1]
-            kl = Kpa if i == 0 else Kr
-            right = 0.0 if i == n - 1 else u[i + 1] + w[i + 1]
-            df = kl * (left - ui) - Kr * (ui - right)
-            a0[i] = df + (kl + Kr) * w[i]  # imbalance this node would have if it did not slip
-            if st[i] == 0:
-                rhs[i] = 0.0
-                if abs(df) > Ff + tol_stick:
-                    done = False
-                    # Start slipping: one-node return map as first guess, neighbours held.
-                    st[i] = 1 if df > 0.0 else -1
-                    w[i] = st[i] * _release(df, kl + Kr, h, Ff, Co, pw)
-                    if w[i] == 0.0:  # slip below float range: the node is stuck for all purposes
-                        st[i] = 0
-                    else:
-                        nreleased += 1
-            else:
-                d, dd = _damper(w[i], h, Ff, Co, pw)
-                rhs[i] = df - st[i] * d
-                dflat[i] = dd
-                dval[i] = d
-                if not abs(rhs[i]) <= tol:  # also catches NaN
-                    done = False
-        if done:
+        for j in range(1, n + 1):
+            S[_POS, j] = u[j - 1] + S[_W, j]
+        # Spring imbalance ΔF_i = k_left(u_{i-1} − u_i) − Kr(u_i − u_{i+1}) at u = u_old + w, the
+        # power law Co·|w/h|^pw and its slope (junk where w = 0, never used), residuals of the
+        # slipping nodes; a0 = ΔF + (k_left + Kr)·w: the imbalance the node would have if it did
+        # not slip (ΔF itself on stuck nodes).
+        nslip = 0  # slipping nodes whose residual is above tol (or NaN)
+        nstuck = 0  # stuck nodes whose imbalance is above the slider threshold
+        for j in range(1, m + 1):
+            kl = S[_KL, j]
+            df = kl * (S[_POS, j - 1] - S[_POS, j]) - Kr * (S[_POS, j] - S[_POS, j + 1])
+            S[_A0, j] = df + (kl + Kr) * S[_W, j]
+            aw = abs(S[_W, j]) if S[_W, j] != 0.0 else h
+            f = Co * _pow(aw / h, pw) if Co > 0.0 else 0.0
+            S[_PSI, j] = f
+            S[_DFL, j] = pw * f / aw
+            sg = S[_SG, j]
+            r = df - sg * (Ff + f)
+            S[_RHS, j] = r if sg != 0.0 else 0.0
+            nslip += 0 if sg == 0.0 or abs(r) <= tol else 1
+            nstuck += 0 if sg != 0.0 or abs(df) <= Ff + tol_stick else 1  # padding: unloaded
+        if nslip + nstuck == 0:
             ok = True
             break
-        if nreleased > 0:
-            continue  # re-evaluate residuals with the released nodes' first guesses
+        if nstuck > 0:
+            # Start slipping the stuck nodes beyond threshold: one-node return map as first guess,
+            # neighbours held, in node order, each seeing the slip just given to its left neighbour.
+            nreleased = 0
+            dwl = 0.0
+            for j in range(1, n + 1):
+                if S[_SG, j] != 0.0:
+                    dwl = 0.0
+                    continue
+                df = S[_A0, j] + Kr * dwl
+                dwl = 0.0
+                if abs(df) > Ff + tol_stick:
+                    sg = 1.0 if df > 0.0 else -1.0
+                    wr = sg * _release(df, S[_KL, j] + Kr, h, Ff, Co, pw)
+                    if wr != 0.0:  # else: slip below float range, the node is stuck for all purposes
+                        S[_W, j] = wr
+                        S[_SG, j] = sg
+                        nreleased += 1
+                        dwl = wr
+            if nreleased > 0:
+                continue  # re-evaluate residuals with the released nodes' first guesses
         # Newton: (K + diag ψ') δ = R on slipping nodes, stuck nodes fixed.
-        _solve_active(n, st, Kpa, Kr, dflat, rhs, cp, dp)
-        for i in range(n):
-            if st[i] == 0:
+        _solve_active(n, m, S, Kr)
+        if Co == 0.0:
+            # Coulomb ladder: a linear complementarity problem; a node that would reverse, or stop
+            # to within the solve's round-off, sticks and is re-checked (and released if it must)
+            # at the next pass. (Left slipping at a round-off speed, it would creep.)
+            for j in range(1, m + 1):
+                w = S[_W, j]
+                r = S[_RHS, j] / (w if w != 0.0 else 1.0)
+                S[_W, j] = w + S[_RHS, j] if r > -1.0 + 1e-10 else 0.0
+                S[_SG, j] = S[_SG, j] if r > -1.0 + 1e-10 else 0.0
+            continue
+        nfix = 0
+        for j in range(1, m + 1):
+            w = S[_W, j]
+            d = S[_RHS, j]
+            r = d / (w if w != 0.0 else 1.0)
+            S[_RR, j] = r
+            # Growing: Newton's step, or _grow's if large. Shrinking: where the power law dominates
+            # the node's stiffness (weight theta), step towards log|w| (w·e^r, here its Padé
+            # form), which does not overshoot towards zero as the linear step (w·(1 + r)) does.
+            theta = S[_DFL, j] / (S[_KL, j] + Kr + S[_DFL, j])
+            wp = w * (1.0 + r * (1.0 - 0.5 * theta)) / (1.0 - 0.5 * theta * r)
+            S[_W, j] = (w + d if r < _R_GROW else w) if r >= 0.0 else wp
+            nfix += 1 if r >= _R_GROW or r <= -0.9 else 0  # one counter: with two, no vectorising
+        if nfix == 0:
+            continue
+        _grow(n, S, Kr, pw)
+        # Newton would reverse these nodes or overshoot towards zero on the concave power law:
+        # replace their step by the one-node return map with the neighbours held, which sticks
+        # the node, restarts it in the other direction, or gives a slip inside the bracket.
+        for j in range(1, n + 1):
+            if S[_SG, j] == 0.0 or S[_RR, j] > -0.9:
                 continue
-            r = rhs[i] / w[i]
-            if Co == 0.0:
-                # Coulomb ladder: a linear complementarity problem; a node that would reverse sticks
-                # and is re-checked (and released if it must) at the next pass.
-                if r > -1.0:
-                    w[i] += rhs[i]
-                else:
-                    w[i] = 0.0
-                    st[i] = 0
-                continue
-            if r >= 0.0:
-                w[i] += rhs[i]  # growing: Newton approaches the root from below, monotonically
-                continue
-            if r > -0.9:
-                # Shrinking: where the power law dominates the node's stiffness (weight theta),
-                # step towards log|w| (w·e^r, here its Padé form), which does not overshoot
-                # towards zero as the linear step (w·(1 + r)) does.
-                theta = dflat[i] / ((Kpa if i == 0 else Kr) + Kr + dflat[i])
-                w[i] *= (1.0 + r * (1.0 - 0.5 * theta)) / (1.0 - 0.5 * theta * r)
-                continue
-            # Newton would reverse the node or overshoot towards zero on the concave power law:
-            # replace its step by the one-node return map with its neighbours held, which sticks
-            # it, restarts it in the other direction, or gives a slip inside the bracket.
-            ks = (Kpa if i == 0 else Kr) + Kr
-            if abs(a0[i]) <= Ff + tol_stick:
-                w[i] = 0.0
-                st[i] = 0
-            else:
-                st[i] = 1 if a0[i] > 0.0 else -1
-                w[i] = st[i] * _release(a0[i], ks, h, Ff, Co, pw)
-                if w[i] == 0.0:
-                    st[i] = 0
+            a0 = S[_A0, j]
+            S[_W, j] = 0.0
+            S[_SG, j] = 0.0
+            if abs(a0) > Ff + tol_stick:
+                sg = 1.0 if a0 > 0.0 else -1.0
+                wr = sg * _release(a0, S[_KL, j] + Kr, h, Ff, Co, pw)
+                if wr != 0.0:
+                    S[_W, j] = wr
+                    S[_SG, j] = sg
     # Consistent tangent: du_1/de = Kpa·[A⁻¹]_11 on the final slipping set, with the damper
-    # slopes of the converged pass (the factorisation above predates the last update).
+    # slopes of the converged pass. Only the run of slipping nodes from node 1 couples to the input.
     diss = 0.0
-    for i in range(n):
-        if st[i] != 0:
-            diss += dval[i] * abs(w[i])
-        u[i] += w[i]
-        wprev[i] = w[i]
-        slope[i] = dflat[i] if st[i] != 0 else 0.0
+    for j in range(1, n + 1):
+        sg = S[_SG, j]
+        if sg != 0.0:
+            diss += (Ff + S[_PSI, j]) * abs(S[_W, j])
+        u[j - 1] += S[_W, j]
+        wprev[j - 1] = S[_W, j]
+        slope[j - 1] = S[_DFL, j] if sg != 0.0 else 0.0
     du1 = 0.0
-    if st[0] != 0:
-        for i in range(n):
-            rhs[i] = 0.0
-        rhs[0] = 1.0
-        _solve_active(n, st, Kpa, Kr, dflat, rhs, cp, dp)
-        du1 = Kpa * rhs[0]
+    if S[_SG, 1] != 0.0:
+        b = 1
+        while b < n and S[_SG, b + 1] != 0.0:
+            b += 1
+        # [A⁻¹]_11 = (minor of nodes 2..b)/(minor of nodes 1..b), the minors from the bottom up,
+        # scaled as in _solve_active.
+        _scale_diagonal(m, S, Kr)
+        d2, d1 = 0.0, 1.0
+        for j in range(b, 0, -1):
+            d2, d1 = d1, S[_AP, j] * d1 - (S[_SC, j] * S[_SC, j + 1]) * d2
+        du1 = Kpa * d2 / d1 * (S[_SC, 1] / Kr)
     return Kpa * (e - u[0]), Kpa * (1.0 - du1), diss, ok
 
 
@@ -331,8 +443,16 @@ def _continuous_step(x, Kpa, Ct, nroot, eps, stack, cs, ck):
 
 @nb.njit(cache=True, fastmath=_FAST)
 def step_bank(e, h, P, I, MX, u, wprev, slope, q, eprev, cs, ck, stack, diss, nfail, F, K, work, iwork):
-    """Advance all channels of a bank by one step of h seconds to deflections e (in place)."""
+    """Advance all channels of a bank by one step of h seconds to deflections e (in place).
+
+    ``work`` and ``iwork`` are no longer used (the ladder scratch, padded for vectorisation, is
+    allocated here once per call); they stay in the signature for existing callers.
+    """
     M = e.shape[0]
+    ncell = 0
+    for c in range(M):
+        ncell = max(ncell, I[c, I_NCELL])
+    S = np.empty((_NROWS, (ncell + 3) // 4 * 4 + 2))
     for c in range(M):
         x = e[c]
         f, k = _elastic(x, P[c, P_K0], P[c, P_NSUP], P[c, P_NINF], P[c, P_SSUP], P[c, P_SINF],
@@ -349,8 +469,7 @@ def step_bank(e, h, P, I, MX, u, wprev, slope, q, eprev, cs, ck, stack, diss, nf
                 o = I[c, I_NODE_OFF]
                 fl, kl, dl, ok = _ladder_step(
                     x, de, h, n, P[c, P_KPA], P[c, P_KR], P[c, P_FF], P[c, P_CO], P[c, P_PW], P[c, P_TOL],
-                    u[o:o + n], wprev[o:o + n], slope[o:o + n], work[0, :n], iwork[:n], work[1, :n],
-                    work[2, :n], work[3, :n], work[4, :n], work[5, :n], work[6, :n])
+                    u[o:o + n], wprev[o:o + n], slope[o:o + n], S)
                 f += fl
                 k += kl
                 diss[c] += dl

@@ -253,7 +253,8 @@ def run_metadata(scenario: Scenario, plan: list[CaseSchedule], duration_scale: f
     return RunMetadata(
         scenario_yaml=scenario.text,
         vehicle_yaml="" if rig is None else scenario.vehicle.read_text(),
-        bushing_parameters={} if rig is None else {ch.name: asdict(ch.params) for ch in rig.car.channels},
+        bushing_parameters={} if rig is None else {ch.name: {**asdict(ch.params), "effects": asdict(ch.effects)}
+                                                   for ch in rig.car.channels},
         software_version=software_version(),
         git_revision=git_revision(),
         extra={"scenario": scenario.name, "type": scenario.type, "description": scenario.description,
