@@ -275,7 +275,7 @@ def diagnose_bench(data: BenchDataset, baseline: ParameterSet,
     floor = aggregate(noise, heldout)
     best = ranking[0] if ranking else None
     verdict = decide(before, best.heldout_error if best else before, floor)
-    if best is not None:
+    if verdict == "named":
         say(f"refitting {best.cause.id} on every test")
         best.final, linearised = fit_cause(replay, baseline, best.cause, everything, start=best.values, max_nfev=6)
         # The linearised error ignores model error; the shift from the half-data fit shows it.
@@ -283,7 +283,7 @@ def diagnose_bench(data: BenchDataset, baseline: ParameterSet,
         best.model = best.cause.apply(baseline, best.final,
                                       source=f"{baseline.name} extended by {best.cause.id}, fitted by vsim diagnose "
                                              f"on {data.path.name} ({len(replay.names)} bench tests)")
-    return BenchDiagnosis(verdict if best is None or verdict != "named" else best.cause.id, baseline, replay, heldout,
+    return BenchDiagnosis(best.cause.id if verdict == "named" else verdict, baseline, replay, heldout,
                           base_errors, noise, ranking, best, data.part, time.perf_counter() - started)
 
 
