@@ -7,10 +7,8 @@ import datetime as dt
 from pathlib import Path
 from typing import Sequence
 
-import yaml
-
 from bushings.identification import FIT_PARAMETERS, FitResult, fit, rt_initial, stvs_initial
-from bushings.parameters import DEFAULT_CELLS, load_parameter_set
+from bushings.parameters import DEFAULT_CELLS, ParameterSet, load_parameter_set, save_parameter_set
 from bushings.records import read_bench_csv
 
 _UNITS = {"K0": "N/mm", "Kpa": "N/mm", "Kr": "N/mm", "Ff": "N", "Co": "N/(mm/s)^pw", "pw": ""}
@@ -73,6 +71,4 @@ def write_parameter_set(path: Path, result: FitResult, record_paths: Sequence[st
     source = (f"fitted by vsim bushing fit ({result.model}) on {dt.date.today().isoformat()} to "
               f"{', '.join(record_paths)}; RMS fit error {errors}")
     params = {k: (int(v) if k == "N" else float(f"{v:.5g}")) for k, v in result.values.items()}
-    text = yaml.safe_dump({"model": result.model, "source": source, "params": params},
-                          sort_keys=False, default_flow_style=None, width=10_000, allow_unicode=True)
-    Path(path).write_text(text)
+    save_parameter_set(ParameterSet(Path(path).stem, result.model, "translation", params, source), path)

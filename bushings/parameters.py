@@ -12,6 +12,8 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Mapping
 
+import yaml
+
 
 from bushings.errors import InputError, read_yaml
 
@@ -247,6 +249,26 @@ def load_parameter_set(name_or_path: str | Path) -> ParameterSet:
     known = ", ".join(sorted(p.stem for p in PARAMETER_SET_DIR.glob("*.yaml")))
     data = read_yaml(path, f"no parameter set {str(name_or_path)!r}; known sets: {known}")
     return parse_parameter_set(data, str(path), name=path.stem)
+
+
+def save_parameter_set(pset: ParameterSet, path: str | Path) -> Path:
+    """Write a parameter set in the format of ``models/bushings/*.yaml`` (read back by
+    :func:`load_parameter_set`), atomically."""
+    from bushings.bench import atomic_output  # bench builds on this module
+
+    def plain(v: Any) -> Any:
+        if isinstance(v, (list, tuple)):
+            return [float(x) for x in v]
+        return int(v) if isinstance(v, int) else float(v)
+
+    data: dict[str, Any] = {"model": pset.model, "quantity": pset.quantity, "source": pset.source,
+                            "params": {k: plain(v) for k, v in pset.values.items()}}
+    if pset.effects:
+        data["effects"] = {k: float(v) for k, v in pset.effects.items()}
+    with atomic_output(Path(path)) as tmp:
+        tmp.write_text(yaml.safe_dump(data, sort_keys=False, default_flow_style=None, width=10_000,
+                                      allow_unicode=True))
+    return Path(path)
 
 
 def available_parameter_sets() -> list[str]:

@@ -15,6 +15,7 @@ import os
 import time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Callable, Sequence
 
 import numpy as np
@@ -77,6 +78,7 @@ class Replay:
         bank = ExtendedBank([m.channel() for m in models], [m.effects_si() for m in models], REPLAY_TOLERANCE_M)
         return bank.run(np.repeat(self.e[:, None], len(models), axis=1), self.dts).T
 
+    @cached_property
     def weights(self) -> np.ndarray:
         """Per-step residual weights: each record counts equally, relative to its force level."""
         w = np.zeros(len(self.e))
@@ -88,7 +90,7 @@ class Replay:
     def residuals(self, forces: np.ndarray, records: np.ndarray) -> np.ndarray:
         """Measured − simulated forces [N] (K, T), with the load-cell zero error fitted on ``records``
         (a boolean mask over records) removed; 0 during rests."""
-        w2 = self.weights() ** 2 * np.isin(self.record, np.flatnonzero(records))
+        w2 = self.weights ** 2 * np.isin(self.record, np.flatnonzero(records))
         raw = self.measured - np.atleast_2d(forces)
         offset = (raw * w2).sum(axis=1, keepdims=True) / w2.sum()
         return np.where(self.record >= 0, raw - offset, 0.0)
@@ -148,6 +150,11 @@ class BenchDiagnosis:
     wall_s: float = 0.0
 
     @property
+    def named(self) -> bool:
+        """True when a catalogue cause is named (then ``best`` is it, refitted on every test)."""
+        return self.verdict not in ("none", "unexplained")
+
+    @property
     def heldout_error_before(self) -> float:
         return aggregate(self.baseline_errors, self.heldout)
 
@@ -163,7 +170,7 @@ class _Objective:
     def __init__(self, replay: Replay, base: ParameterSet, cause: Cause, train: np.ndarray):
         self.replay, self.base, self.cause, self.train = replay, base, cause, train
         on = np.isin(replay.record, np.flatnonzero(train))
-        self.w = replay.weights() * on
+        self.w = replay.weights * on
         self.cache: dict[bytes, np.ndarray] = {}
 
     def values(self, z: np.ndarray) -> dict[str, float]:

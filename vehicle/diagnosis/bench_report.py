@@ -9,10 +9,10 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 from matplotlib.figure import Figure
 
 from bushings.bench import atomic_output
+from bushings.parameters import save_parameter_set
 from bushings.plots import save_figure
 from vehicle.diagnosis.bench_diagnosis import BenchDiagnosis, aggregate
 
@@ -35,7 +35,7 @@ def record_features(d: BenchDiagnosis) -> list[dict[str, float]]:
 
 
 def _parameters(d: BenchDiagnosis) -> dict[str, Any]:
-    if d.best is None or d.verdict in ("none", "unexplained"):
+    if not d.named:
         return {}
     return {p.name: {"value": d.best.final[p.name], "std": d.best.std.get(p.name, math.nan), "unit": p.unit}
             for p in d.best.cause.parameters}
@@ -43,10 +43,9 @@ def _parameters(d: BenchDiagnosis) -> dict[str, Any]:
 
 def summary(d: BenchDiagnosis) -> dict[str, Any]:
     """The machine-readable verdict (``vsim diagnose --json``)."""
-    named = d.verdict not in ("none", "unexplained")
     return {
         "cause": d.verdict,
-        "location": {"level": "bench", "part": d.part} if named else None,
+        "location": {"level": "bench", "part": d.part} if d.named else None,
         "parameters": _parameters(d),
         "heldout_error_before": d.heldout_error_before,
         "heldout_error_after": d.heldout_error_after,
@@ -54,7 +53,7 @@ def summary(d: BenchDiagnosis) -> dict[str, Any]:
         "ranking": [{"cause": c.cause.id, "heldout_error": c.heldout_error, "score": c.score,
                      "n_parameters": len(c.cause.parameters), "parameters": c.values} for c in d.ranking],
         "tests": [{"name": n, "heldout": bool(h), "error_before": float(b),
-                   "error_after": float(d.best.record_errors[k]) if named else float(b)}
+                   "error_after": float(d.best.record_errors[k]) if d.named else float(b)}
                   for k, (n, h, b) in enumerate(zip(d.replay.names, d.heldout, d.baseline_errors))],
         "baseline": {"name": d.baseline.name, "model": d.baseline.model},
         "wall_s": d.wall_s,
@@ -78,16 +77,7 @@ def verdict_sentence(d: BenchDiagnosis) -> str:
 
 def write_extended_model(d: BenchDiagnosis, path: Path) -> Path | None:
     """The baseline parameter set extended by the named cause, as a parameter-set YAML file."""
-    if d.best is None or d.best.model is None or d.verdict in ("none", "unexplained"):
-        return None
-    m = d.best.model
-    data = {"model": m.model, "quantity": m.quantity, "source": m.source,
-            "params": {k: (list(v) if isinstance(v, (list, tuple)) else float(v)) for k, v in m.values.items()}}
-    if m.effects:
-        data["effects"] = {k: float(v) for k, v in m.effects.items()}
-    with atomic_output(path) as tmp:
-        tmp.write_text(yaml.safe_dump(data, sort_keys=False))
-    return path
+    return save_parameter_set(d.best.model, path) if d.named else None
 
 
 def _overlays(d: BenchDiagnosis, after: np.ndarray | None, out: Path) -> Path:
@@ -118,13 +108,12 @@ def _overlays(d: BenchDiagnosis, after: np.ndarray | None, out: Path) -> Path:
 
 def _residuals(d: BenchDiagnosis, features: list[dict[str, float]], out: Path) -> Path:
     fig = Figure(figsize=(12, 3.6))
-    named = d.verdict not in ("none", "unexplained")
     for i, (key, label) in enumerate((("speed_mm_s", "median speed [mm/s]"), ("amplitude_mm", "amplitude [mm]"),
                                       ("static_mm", "static level [mm]"))):
         ax = fig.add_subplot(1, 3, i + 1)
         x = np.array([f[key] for f in features])
         ax.scatter(x, 100 * d.baseline_errors, c="C3", label="baseline", s=14)
-        if named:
+        if d.named:
             ax.scatter(x, 100 * d.best.record_errors, c="C0", marker="s", label=f"+ {d.verdict}", s=14)
         if key == "speed_mm_s" and (x > 0).all():
             ax.set_xscale("log")
@@ -153,8 +142,7 @@ def write_report(d: BenchDiagnosis, out_dir: Path) -> list[Path]:
     import json
 
     out_dir.mkdir(parents=True, exist_ok=True)
-    named = d.verdict not in ("none", "unexplained")
-    after = d.replay.simulate([d.best.model])[0] if named and d.best and d.best.model else None
+    after = d.replay.simulate([d.best.model])[0] if d.named else None
     features = record_features(d)
     written = [_overlays(d, after, out_dir / "overlays.png"), _residuals(d, features, out_dir / "residuals.png"),
                _ranking(d, out_dir / "ranking.png")]

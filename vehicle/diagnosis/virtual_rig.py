@@ -17,7 +17,7 @@ TRUTH.yaml (bench level)::
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
@@ -62,10 +62,11 @@ class Truth:
     measurement: dict[str, float]
     seed: int
     part: str = "bushing under test"
-    model: ParameterSet = field(init=False)
 
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "model", truth_model(self.baseline, self.effects))
+    @property
+    def model(self) -> ParameterSet:
+        """The truth: the baseline with its effects switched on."""
+        return truth_model(self.baseline, self.effects)
 
 
 def truth_model(baseline: ParameterSet, effects: list[tuple[str, dict[str, float]]]) -> ParameterSet:
@@ -166,7 +167,8 @@ def measure_bench(truth: Truth, output: Path, *, overwrite: bool = False, tests:
     m = truth.measurement
     force_offset = rng.uniform(-1.0, 1.0) * m["force_offset_n"]
     e_offset_mm = rng.uniform(-1.0, 1.0) * m["displacement_offset_mm"]
-    bank = ExtendedBank([truth.model.channel()], [truth.model.effects_si()])
+    model = truth.model
+    bank = ExtendedBank([model.channel()], [model.effects_si()])
     records = []
     for i, test in enumerate(tests):
         if progress is not None:
