@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Mapping, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Mapping, Sequence
 
 import numpy as np
 import yaml
@@ -582,7 +582,8 @@ def load_vehicle(path: str | Path = DEFAULT_VEHICLE) -> VehicleDefinition:
 def with_extensions(v: VehicleDefinition, *, strut_friction: float | Mapping[str, float] | None = None,
                     beam_torsion_scale: float | None = None,
                     effects: Mapping[str, Mapping[str, float]] | None = None,
-                    coupling: Mapping[str, Sequence[Mapping[str, Any]]] | None = None) -> VehicleDefinition:
+                    coupling: Mapping[str, Sequence[Mapping[str, Any]]] | None = None,
+                    laws: Mapping[str, Any] | None = None) -> VehicleDefinition:
     """``v`` with the catalogue's extensions set, without writing a file (None keeps one as it is).
 
     ``strut_friction`` [N] and ``beam_torsion_scale`` as the keys ``front.strut_friction`` (a number
@@ -590,7 +591,10 @@ def with_extensions(v: VehicleDefinition, *, strut_friction: float | Mapping[str
     ``"bushing.direction"`` to effect keys in parameter-set units (``{"e1_rear.z": {"mullins": 0.2}}``),
     laid over the direction's own; ``coupling`` maps a bushing name to its new ``coupling`` list
     (``{"e1_rear": [{"directions": ["x", "z"], "stiffness": 50.0}]}``, N/mm or N·m/deg), which
-    replaces the old one. Values are checked as in a vehicle file; errors name ``with_extensions``.
+    replaces the old one; ``laws`` maps ``"bushing.direction"`` to a
+    :class:`bushings.parameters.ParameterSet` that replaces the direction's law, its effects included
+    (a catalogue cause applied to the direction's own set). Values are checked as in a vehicle file;
+    errors name ``with_extensions``.
     """
     src = EXTENSIONS_SOURCE
     front, rear = v.front, v.rear
@@ -605,16 +609,28 @@ def with_extensions(v: VehicleDefinition, *, strut_friction: float | Mapping[str
             raise InputError(f"unknown bushing {name!r}; expected one of {', '.join(bushings)}", source=src, key=key)
         return bushings[name]
 
-    for target, values in (effects or {}).items():
-        key = f"effects.{target}"
+    def set_direction(target: str, key: str, change: Callable[[DirectionDef], DirectionDef]) -> None:
         name, _, direction = str(target).partition(".")
         b = bushing(name, key)
         if direction not in DIRECTIONS:
             raise InputError(f"expected 'bushing.direction' with a direction of {', '.join(DIRECTIONS)}, got "
                              f"{target!r}", source=src, key=key)
-        d = b.directions[direction]
-        d = _checked(replace(d, effects={**d.effects, **_mapping(values, src, key)}), src, key)
+        d = _checked(change(b.directions[direction]), src, key)
         bushings[name] = replace(b, directions={**b.directions, direction: d})
+
+    for target, pset in (laws or {}).items():
+        key = f"laws.{target}"
+
+        def law(d: DirectionDef) -> DirectionDef:
+            if pset.quantity != d.quantity:
+                raise InputError(f"parameter set {pset.name!r} is a {pset.quantity} set; {target} needs a "
+                                 f"{d.quantity} set", source=src, key=key)
+            return replace(d, set_name=None, model=pset.model, params=dict(pset.values), source=f"{src}: {key}",
+                           effects=dict(pset.effects))
+        set_direction(target, key, law)
+    for target, values in (effects or {}).items():
+        key = f"effects.{target}"
+        set_direction(target, key, lambda d: replace(d, effects={**d.effects, **_mapping(values, src, key)}))
     for name, terms in (coupling or {}).items():
         b = bushing(name, f"coupling.{name}")
         bushings[name] = replace(b, coupling=_coupling(terms, src, f"coupling.{name}", b.directions))

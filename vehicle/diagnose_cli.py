@@ -11,31 +11,51 @@ from bushings.errors import InputError
 
 
 def _diagnose(args: argparse.Namespace) -> int:
-    from bushings.parameters import load_parameter_set
-    from vehicle.diagnosis.bench_data import dataset_level, read_bench_dataset
-    from vehicle.diagnosis.bench_diagnosis import diagnose_bench
-    from vehicle.diagnosis.bench_report import summary, verdict_sentence, write_report
+    from vehicle.diagnosis.bench_data import dataset_level
 
     level = dataset_level(args.rigdir)
-    if level != "bench":
-        raise InputError("the diagnosis of K&C datasets is not available yet; bench datasets are",
-                         source=str(args.rigdir / "rig.yaml"), key="level")
-    if args.bushing_model is None:
-        raise InputError("a bench dataset needs the baseline law: --bushing-model SET (a parameter set name or "
-                         "YAML path)", source=str(args.rigdir))
-    baseline = load_parameter_set(args.bushing_model)
-    data = read_bench_dataset(args.rigdir)
     quiet = args.json
-    result = diagnose_bench(data, baseline, progress=None if quiet else lambda s: print(f"  {s}", file=sys.stderr,
-                                                                                          flush=True))
-    written = write_report(result, args.output) if args.output is not None else []
+    progress = None if quiet else lambda s: print(f"  {s}", file=sys.stderr, flush=True)
+    if level == "kc":
+        if args.bushing_model is not None:
+            raise InputError("a K&C dataset is diagnosed against a vehicle: --vehicle V.yaml (default: the built-in "
+                             "car), not --bushing-model", source=str(args.rigdir / "rig.yaml"), key="level")
+        result, written, sentence, summary = _kc(args, progress)
+    else:
+        if args.bushing_model is None:
+            raise InputError("a bench dataset needs the baseline law: --bushing-model SET (a parameter set name or "
+                             "YAML path)", source=str(args.rigdir))
+        result, written, sentence, summary = _bench(args, progress)
     if args.json:
         print(json.dumps(summary(result)))
     else:
-        print(verdict_sentence(result))
+        print(sentence(result))
         for path in written:
             print(f"wrote {path}")
     return 0
+
+
+def _bench(args: argparse.Namespace, progress):
+    from bushings.parameters import load_parameter_set
+    from vehicle.diagnosis.bench_data import read_bench_dataset
+    from vehicle.diagnosis.bench_diagnosis import diagnose_bench
+    from vehicle.diagnosis.bench_report import summary, verdict_sentence, write_report
+
+    result = diagnose_bench(read_bench_dataset(args.rigdir), load_parameter_set(args.bushing_model), progress=progress)
+    written = write_report(result, args.output) if args.output is not None else []
+    return result, written, verdict_sentence, summary
+
+
+def _kc(args: argparse.Namespace, progress):
+    from vehicle.definition import DEFAULT_VEHICLE, load_vehicle
+    from vehicle.diagnosis.kc_data import read_kc_dataset
+    from vehicle.diagnosis.kc_diagnosis import diagnose_kc
+    from vehicle.diagnosis.kc_report import summary, verdict_sentence, write_report
+
+    vehicle = load_vehicle(args.vehicle or DEFAULT_VEHICLE)
+    result = diagnose_kc(read_kc_dataset(args.rigdir), vehicle, progress=progress)
+    written = write_report(result, vehicle, args.output, str(args.rigdir)) if args.output is not None else []
+    return result, written, verdict_sentence, summary
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:

@@ -1,5 +1,6 @@
 """`vsim rig`: K&C rig measurements. `vsim rig import DATA.csv --meta META.yaml -o RIG.mcap` turns a
-rig's CSV export into a measured rig recording (formats: ``data/README.md``).
+rig's CSV export into a measured rig recording (formats: ``data/README.md``); `vsim rig measure
+TRUTH.yaml -o DIR` writes a measured dataset with the virtual rig (bench or K&C level).
 
 META.yaml says which scenario was played, which CSV column holds the time, and for every imported
 column the run channel, the unit and the sign (and optionally an offset) it is written in. Units
@@ -182,25 +183,30 @@ def _add_import(commands: argparse._SubParsersAction) -> None:
 
 
 def _measure(args: argparse.Namespace) -> int:
+    from vehicle.diagnosis.kc_rig import KCTruth, measure_kc
     from vehicle.diagnosis.virtual_rig import load_truth, measure_bench
 
     truth = load_truth(args.truth)
+    kc = isinstance(truth, KCTruth)
 
     def progress(i: int, n: int, name: str) -> None:
-        print(f"  test {i + 1}/{n}: {name}", file=sys.stderr, flush=True)
+        print(f"  {'scenario' if kc else 'test'} {i + 1}/{n}: {name}", file=sys.stderr, flush=True)
 
-    out = measure_bench(truth, args.output, overwrite=args.overwrite, progress=progress)
-    print(f"wrote {out} (measured bench dataset, no trace of the truth)")
+    measure = measure_kc if kc else measure_bench
+    out = measure(truth, args.output, overwrite=args.overwrite, progress=progress)
+    print(f"wrote {out} (measured {'K&C' if kc else 'bench'} dataset, no trace of the truth)")
     return 0
 
 
 def _add_measure(commands: argparse._SubParsersAction) -> None:
     p = commands.add_parser(
         "measure", help="play the standard campaign on a truth model and write what a rig would measure",
-        description="Virtual rig: a truth model (a baseline parameter set + effects from the catalogue or outside "
-                    "it + measurement imperfections; format in vehicle/diagnosis/virtual_rig.py) played through "
-                    "the standard bench campaign and written as a measured dataset (rig.yaml + CSVs) that carries "
-                    "no trace of the truth.")
+        description="Virtual rig: a truth model (a baseline + effects from the catalogue or outside it + "
+                    "measurement imperfections) played through the standard campaign and written as a measured "
+                    "dataset that carries no trace of the truth. level: bench (a parameter set on the bushing "
+                    "bench; format in vehicle/diagnosis/virtual_rig.py) writes rig.yaml + CSVs; level: kc (a "
+                    "vehicle on the K&C rig, the scenarios of scenarios/kc; format in "
+                    "vehicle/diagnosis/kc_rig.py) writes rig.yaml + MCAP rig recordings (data/README.md).")
     p.add_argument("truth", type=Path, metavar="TRUTH.yaml")
     p.add_argument("-o", "--output", type=Path, required=True, metavar="DIR", help="measured dataset to write")
     p.add_argument("--overwrite", action="store_true", help="replace an existing output directory")

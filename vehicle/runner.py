@@ -35,7 +35,8 @@ import numpy as np
 
 from bushings.errors import InputError
 from vehicle.builder import CORNERS, BuildOptions
-from vehicle.definition import load_vehicle
+from vehicle.definition import VehicleDefinition, load_vehicle
+from vehicle.io import Run
 from vehicle.recording import RunMetadata, RunWriter, SignalSpec, geometry_from_model
 from vehicle.rig import KCRig, RigOutputs
 from vehicle.scenarios import CORNER_TAGS, INPUT_CHANNELS, Case, Scenario, input_quantity
@@ -280,37 +281,93 @@ def run_scenario(scenario: Scenario, output: Path, *, bushing_model: str | None 
     (settle phases, periods, holds) for quick runs. Raises InputError if ``output`` exists and not
     ``overwrite``, DivergenceError when the simulation diverges (the file is kept, incomplete).
     """
-    if not duration_scale > 0:
-        raise InputError(f"expected a positive duration scale, got {duration_scale}", key="--duration-scale")
     output = Path(output)
     if bushing_model is not None:
         scenario = replace(scenario, bushing_model=bushing_model)
     started = time.perf_counter()
-    vehicle = load_vehicle(scenario.vehicle)
-    options = BuildOptions(bushing_model=scenario.bushing_model)
-    rig = KCRig(vehicle, options)
-    dt = rig.model.opt.timestep
-    plan = schedule(scenario, duration_scale, dt)
-    bodies = [mujoco.mj_id2name(rig.model, mujoco.mjtObj.mjOBJ_BODY, i) for i in range(1, rig.model.nbody)]
-    layout = SignalLayout.of_rig(rig, scenario.x_quantity)
+    play = _Play(scenario, load_vehicle(scenario.vehicle), duration_scale, progress)
     output.parent.mkdir(parents=True, exist_ok=True)
-    total_s = plan[-1].end_s(dt)
-    with RunWriter(output, signals=layout.specs, bodies=bodies, geometry=geometry_from_model(rig.model, bodies),
-                   metadata=run_metadata(scenario, plan, duration_scale, dt, rig), overwrite=overwrite) as writer:
-        for k, (case, when) in enumerate(zip(scenario.cases, plan), start=1):
+    bodies = play.bodies()
+    with RunWriter(output, signals=play.layout.specs, bodies=bodies,
+                   geometry=geometry_from_model(play.rig.model, bodies), metadata=play.metadata(),
+                   overwrite=overwrite) as writer:
+        play.run(writer)
+    return RunResult(output, play.total_s, time.perf_counter() - started)
+
+
+class _Memory:
+    """A run's samples kept in memory (the :class:`RunWriter` interface, without body poses)."""
+
+    def __init__(self) -> None:
+        self.t_s: list[float] = []
+        self.rows: list[np.ndarray] = []
+
+    def write(self, t_s: float, values: np.ndarray, body_pos_m: np.ndarray, body_quat_wxyz: np.ndarray) -> None:
+        self.t_s.append(t_s)
+        self.rows.append(values)
+
+
+def simulate(scenario: Scenario, vehicle: VehicleDefinition | None = None, *, duration_scale: float = 1.0,
+             progress: Callable[[Progress], None] | None = None) -> Run:
+    """Run every case of ``scenario`` on ``vehicle`` (default: the scenario's file) in memory.
+
+    The result is the :class:`vehicle.io.Run` that :func:`run_scenario` would record, without the
+    body poses: the same signals, units and metadata (``vehicle_yaml`` empty when ``vehicle`` was
+    given, as it need not come from a file).
+    """
+    play = _Play(scenario, load_vehicle(scenario.vehicle) if vehicle is None else vehicle, duration_scale, progress)
+    memory = _Memory()
+    play.run(memory)
+    specs = play.layout.specs
+    values = np.array(memory.rows).reshape(len(memory.rows), len(specs))
+    metadata = play.metadata()
+    if vehicle is not None:
+        metadata = replace(metadata, vehicle_yaml="", extra={**metadata.extra, "vehicle_file": "(in memory)"})
+    return Run(path=Path("(in memory)"), t_s=np.array(memory.t_s), signals={s.name: values[:, i] for i, s in
+                                                                          enumerate(specs)},
+               units={s.name: s.unit for s in specs}, groups={s.name: s.group for s in specs}, specs=specs,
+               body_names=[], body_pos=np.empty((len(values), 0, 3)), body_quat_wxyz=np.empty((len(values), 0, 4)),
+               geometry=[], metadata=metadata, complete=True, reason="")
+
+
+class _Play:
+    """The cases of a scenario played one after the other, each on a fresh rig."""
+
+    def __init__(self, scenario: Scenario, vehicle: VehicleDefinition, duration_scale: float,
+                 progress: Callable[[Progress], None] | None):
+        if not duration_scale > 0:
+            raise InputError(f"expected a positive duration scale, got {duration_scale}", key="--duration-scale")
+        self.scenario, self.vehicle, self.duration_scale = scenario, vehicle, duration_scale
+        self.progress = progress
+        self.options = BuildOptions(bushing_model=scenario.bushing_model)
+        self.rig = KCRig(vehicle, self.options)
+        self.dt = self.rig.model.opt.timestep
+        self.plan = schedule(scenario, duration_scale, self.dt)
+        self.layout = SignalLayout.of_rig(self.rig, scenario.x_quantity)
+        self.total_s = self.plan[-1].end_s(self.dt)
+
+    def bodies(self) -> list[str]:
+        m = self.rig.model
+        return [mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, i) for i in range(1, m.nbody)]
+
+    def metadata(self) -> RunMetadata:
+        return run_metadata(self.scenario, self.plan, self.duration_scale, self.dt, self.rig)
+
+    def run(self, sink: RunWriter | _Memory) -> None:
+        rig, cases = self.rig, self.scenario.cases
+        for k, (case, when) in enumerate(zip(cases, self.plan), start=1):
             if k > 1:
-                rig = KCRig(vehicle, options)
+                rig = KCRig(self.vehicle, self.options)
 
             def report(phase: int, t: float) -> None:
-                if progress is not None:
-                    progress(Progress(k, len(scenario.cases), case.label, phase, t, total_s))
+                if self.progress is not None:
+                    self.progress(Progress(k, len(cases), case.label, phase, t, self.total_s))
 
-            _run_case(rig, scenario, case, k, when, duration_scale, layout, writer, report)
-    return RunResult(output, total_s, time.perf_counter() - started)
+            _run_case(rig, self.scenario, case, k, when, self.duration_scale, self.layout, sink, report)
 
 
 def _run_case(rig: KCRig, scenario: Scenario, case: Case, number: int, when: CaseSchedule, duration_scale: float,
-              layout: SignalLayout, writer: RunWriter, report: Callable[[int, float], None]) -> None:
+              layout: SignalLayout, writer: RunWriter | _Memory, report: Callable[[int, float], None]) -> None:
     """Simulate one case from a fresh rig, recording every output interval."""
     m, d = rig.model, rig.data
     dt = m.opt.timestep

@@ -149,9 +149,14 @@ def applicable(base: ParameterSet) -> list[Cause]:
 
 
 def draw(cause: Cause, rng: np.random.Generator) -> dict[str, float]:
+    """Values of a cause's parameters drawn in their realistic range (see :func:`draw_parameters`)."""
+    return draw_parameters(cause.parameters, rng)
+
+
+def draw_parameters(parameters: tuple[Parameter, ...], rng: np.random.Generator) -> dict[str, float]:
     """Parameter values drawn uniformly (log-uniformly for log parameters) in the realistic range."""
     out = {}
-    for p in cause.parameters:
+    for p in parameters:
         lo, hi = p.draw
         value = float(np.exp(rng.uniform(np.log(lo), np.log(hi)))) if p.log else float(rng.uniform(lo, hi))
         out[p.name] = value * (float(rng.choice([-1.0, 1.0])) if p.signed else 1.0)

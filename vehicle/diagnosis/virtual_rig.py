@@ -1,6 +1,7 @@
 """The virtual rig (spec measured-data §1): a truth model = a baseline + effects from the catalogue
 (or outside it) + measurement imperfections, played through the standard campaign and written in
-exactly the format of real rig data, with no trace of the truth.
+exactly the format of real rig data, with no trace of the truth. This module holds the bench level;
+the K&C level is :mod:`vehicle.diagnosis.kc_rig`, and :func:`load_truth` reads either.
 
 TRUTH.yaml (bench level)::
 
@@ -19,7 +20,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Mapping
+from typing import TYPE_CHECKING, Any, Callable, Mapping
 
 import numpy as np
 
@@ -30,6 +31,9 @@ from bushings.records import BenchRecord
 from vehicle.diagnosis.bench_campaign import CAMPAIGN, BenchTest
 from vehicle.diagnosis.bench_data import BenchTestRecord, write_bench_dataset
 from vehicle.diagnosis.catalogue import CAUSES, Parameter
+
+if TYPE_CHECKING:
+    from vehicle.diagnosis.kc_rig import KCTruth
 
 #: Effects the virtual rig can hide that the diagnosis's catalogue does not hold (to test that an
 #: unexplained mismatch is reported as such).
@@ -96,8 +100,10 @@ def parse_truth(data: Any, source: str, base_dir: Path | None = None) -> Truth:
         raise InputError(f"unknown key {unknown[0]!r}; expected {', '.join(sorted(_KEYS))}", source=source, key=unknown[0])
     level = data.get("level")
     if level != "bench":
-        raise InputError(f"level {level!r}: the virtual rig plays the bench level (level: bench); the K&C level "
-                         f"is not available yet", source=source, key="level")
+        hint = ("a K&C truth is read by vehicle.diagnosis.kc_rig.parse_kc_truth (load_truth reads either)"
+                if level == "kc" else "expected level: bench or level: kc")
+        raise InputError(f"level {level!r}: this parser reads bench truths (level: bench); {hint}", source=source,
+                         key="level")
     if not isinstance(data.get("baseline"), str):
         raise InputError(f"expected a parameter-set name or path, got {data.get('baseline')!r}", source=source,
                          key="baseline")
@@ -147,9 +153,16 @@ def parse_truth(data: Any, source: str, base_dir: Path | None = None) -> Truth:
     return truth
 
 
-def load_truth(path: Path) -> Truth:
-    """Read and validate a truth YAML file."""
-    return parse_truth(read_yaml(path, "no such truth file"), str(path), path.parent)
+def load_truth(path: Path) -> "Truth | KCTruth":
+    """Read and validate a truth YAML file of either level: a :class:`Truth` (``level: bench``) or a
+    :class:`vehicle.diagnosis.kc_rig.KCTruth` (``level: kc``)."""
+    path = Path(path)
+    data = read_yaml(path, "no such truth file")
+    if isinstance(data, Mapping) and data.get("level") == "kc":
+        from vehicle.diagnosis.kc_rig import parse_kc_truth
+
+        return parse_kc_truth(data, str(path), path.parent)
+    return parse_truth(data, str(path), path.parent)
 
 
 def _quantise(x: np.ndarray, step: float) -> np.ndarray:
