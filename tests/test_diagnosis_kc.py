@@ -18,11 +18,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import yaml
 
 from bushings.errors import InputError
 from bushings.parameters import load_parameter_set
-from vehicle.definition import DEFAULT_VEHICLE, load_vehicle, with_extensions
+from vehicle.definition import load_vehicle, with_extensions
 from vehicle.diagnosis.kc_catalogue import (OBSERVABLE, Hypothesis, draw, extended_vehicle, extended_vehicle_yaml,
                                             locations, parameters)
 from vehicle.diagnosis.kc_rig import DEFAULT_SCENARIOS, measure_kc, parse_kc_truth
@@ -31,7 +30,7 @@ from vehicle.runner import run_scenario, simulate
 from vehicle.scenarios import load_scenario
 
 KC_CAUSES = sorted(c for c in OBSERVABLE if c != "backlash")
-#: The default suite diagnoses one draw (about 3 min); the slow suite 20 per cause.
+#: The default suite diagnoses one draw (about 2 min); the slow suite 20 per cause.
 SEED = int(os.environ.get("VSIM_TEST_SEED", "0"))
 SLOW_SEEDS = range(100, 120)
 
@@ -109,21 +108,9 @@ def test_diagnose_refuses_a_bushing_model_for_a_kc_dataset(tmp_path):
 
 
 # -- hidden causes --------------------------------------------------------------------------------
-def _campaign(tmp: Path) -> list[str]:
-    """The K&C campaign cut to its largest case per scenario (4 tests: 2 fitted, 2 held out)."""
-    paths = []
-    for source in DEFAULT_SCENARIOS:
-        data = yaml.safe_load(Path(source).read_text())
-        data["cases"] = data["cases"][-1:]
-        data["vehicle"] = str(DEFAULT_VEHICLE)
-        path = tmp / Path(source).name
-        path.write_text(yaml.safe_dump(data))
-        paths.append(str(path))
-    return paths
-
-
 def measure(tmp: Path, cause: str, seed: int) -> tuple[Hypothesis | None, Path]:
-    """A drawn truth measured on the short campaign at half speed, copied to ``tmp/measured``."""
+    """A drawn truth measured on the K&C campaign at 4 times its speed (7 tests, 3 held out; each
+    recording keeps its duration scale, so the baseline plays the same), copied to ``tmp/measured``."""
     rng = np.random.default_rng([seed, sum(map(ord, cause))])
     h = None if cause == "none" else draw(cause, rng)
     effects = []
@@ -134,9 +121,7 @@ def measure(tmp: Path, cause: str, seed: int) -> tuple[Hypothesis | None, Path]:
         elif len(h.location) == 3:
             entry["location"], entry["directions"] = h.location[0], list(h.location[1:])
         effects.append(entry)
-    (tmp / "scenarios").mkdir()
-    truth = parse_kc_truth({"level": "kc", "scenarios": _campaign(tmp / "scenarios"), "duration_scale": 0.5,
-                            "effects": effects, "seed": seed}, "<test truth>")
+    truth = parse_kc_truth({"level": "kc", "duration_scale": 0.25, "effects": effects, "seed": seed}, "<test truth>")
     out = measure_kc(truth, tmp / "rig_output")
     copy = tmp / "measured"
     shutil.copytree(out, copy)
@@ -168,9 +153,14 @@ def check(result: dict, h: Hypothesis | None) -> None:
     assert result["location"] == h.location_json()
     assert _excess(result["heldout_error_after"]) <= 0.5 * _excess(result["heldout_error_before"])
     first = parameters(h.cause)[0]
-    fitted = result["parameters"][first.name]["value"]
+    fitted, hidden = result["parameters"][first.name]["value"], h.values[first.name]
+    if h.cause == "asymmetry":
+        # Symmetric cycles load a mirrored pair of bushings alike in compression and tension, so ±a
+        # differ only by the static shift of the channels, which the recordings' zero errors absorb:
+        # the magnitude is identified, not the side.
+        fitted, hidden = abs(fitted), abs(hidden)
     # the magnitude within 30 %: the fit takes the effect proportional to it between two runs
-    assert abs(fitted - h.values[first.name]) <= 0.3 * abs(h.values[first.name]), (fitted, h.values)
+    assert abs(fitted - hidden) <= 0.3 * abs(hidden), (fitted, h.values)
 
 
 def test_a_drawn_cause_is_named_at_its_place(tmp_path):

@@ -20,9 +20,10 @@ import math
 import os
 import shutil
 import tempfile
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any, Iterator, Sequence
 
 import numpy as np
 import yaml
@@ -115,11 +116,7 @@ def write_bench_dataset(directory: str | os.PathLike[str], part: str, records: S
     """Write a dataset as a whole: into a temporary folder renamed at the end, so that a reader
     never sees a partial one. Forces are written to 0.001 N, deflections to 0.1 nm."""
     root = Path(directory)
-    if root.exists() and not overwrite:
-        raise InputError("exists; pass --overwrite to replace it", source=str(root))
-    root.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{root.name}.", dir=root.parent))
-    try:
+    with whole_directory(root, overwrite=overwrite) as tmp:
         entries = []
         width = len(str(len(records)))
         for i, r in enumerate(records, start=1):
@@ -130,10 +127,26 @@ def write_bench_dataset(directory: str | os.PathLike[str], part: str, records: S
             entries.append({"file": name, "programme": r.programme, "rest_before_s": r.rest_before_s})
         manifest = {"level": "bench", "part": part, "quantity": "translation", "rig": rig, "records": entries}
         (tmp / RIG_FILE).write_text(yaml.safe_dump(manifest, sort_keys=False))
+    return root
+
+
+@contextmanager
+def whole_directory(root: Path, *, overwrite: bool = False) -> Iterator[Path]:
+    """A temporary folder next to ``root`` to write a dataset into, renamed to ``root`` when the block
+    ends without error (replacing it only if ``overwrite``) and removed otherwise: a reader never
+    sees a partial dataset. The folder has the usual permissions (umask), not mkdtemp's 0700."""
+    if root.exists() and not overwrite:
+        raise InputError("exists; pass --overwrite to replace it", source=str(root))
+    root.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{root.name}.", dir=root.parent))
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(tmp, 0o777 & ~umask)
+    try:
+        yield tmp
         if root.exists():
             shutil.rmtree(root)
         os.replace(tmp, root)
     finally:
         if tmp.exists():
             shutil.rmtree(tmp)
-    return root

@@ -267,8 +267,11 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, workers: int | N
                              mp_context=multiprocessing.get_context("fork")) as pool:
         def rows(vehicles: list[VehicleDefinition], tests: Sequence[int]) -> list[np.ndarray]:
             """The compared rows of each vehicle on ``tests`` (NaN elsewhere), the runs in parallel."""
-            flat = list(pool.map(_run_job, [j for v in vehicles for j in layout.jobs(v, tests)]))
-            n = len(tests)
+            n, flat = len(tests), []
+            for result in pool.map(_run_job, [j for v in vehicles for j in layout.jobs(v, tests)]):
+                flat.append(result)
+                if len(vehicles) > 1 and len(flat) % n == 0:
+                    say(f"  vehicle {len(flat) // n}/{len(vehicles)} run")
             return [layout.stack(flat[i * n:(i + 1) * n], tests) for i in range(len(vehicles))]
 
         say(f"baseline {vehicle.name} on {len(data.tests)} recordings, {len(layout.tests)} tests "
@@ -287,6 +290,9 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, workers: int | N
         say(f"the best {len(top)} on every test with their fitted magnitudes, then refitted along the effect they gave")
         _verify(top, rows([extended_vehicle(vehicle, [c.hypothesis]) for c in top], every), scorer)
         refit = [fit(c.hypothesis, c.simulated - base, base, scorer) for c in top]
+        for a, b in zip(top, refit):
+            # the linearised uncertainty ignores the model's nonlinearity; the refit's shift shows it
+            b.std = {k: max(s, abs(b.hypothesis.values[k] - a.hypothesis.values[k])) for k, s in b.std.items()}
         _verify(refit, rows([extended_vehicle(vehicle, [c.hypothesis]) for c in refit], every), scorer)
         top = sorted((min(a, b, key=lambda c: c.score) for a, b in zip(top, refit)), key=lambda c: c.score)
     best = top[0]

@@ -28,8 +28,6 @@ from __future__ import annotations
 
 import math
 import os
-import shutil
-import tempfile
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Callable, Mapping
@@ -47,7 +45,9 @@ from vehicle.diagnosis.kc_catalogue import (
     locations,
     parameters,
 )
+from vehicle.diagnosis.bench_data import whole_directory
 from vehicle.diagnosis.kc_data import write_kc_rig_yaml
+from vehicle.diagnosis.virtual_rig import parse_measurement
 from vehicle.scenarios import INPUT_CHANNELS, Scenario, load_scenario
 
 #: The K&C campaign the virtual rig plays when a truth names no scenarios, in this order.
@@ -228,15 +228,7 @@ def parse_kc_truth(data: Any, source: str, base_dir: Path | None = None) -> KCTr
         raise InputError(f"expected a list of {{cause: ID, location: ..., parameters}}, got {raw!r}", source=source,
                          key="effects")
     effects = tuple(_effect(entry, baseline, source, f"effects[{i}]") for i, entry in enumerate(raw))
-    measurement = dict(MEASUREMENT_DEFAULTS)
-    raw_m = data.get("measurement") or {}
-    if not isinstance(raw_m, Mapping):
-        raise InputError(f"expected a mapping, got {raw_m!r}", source=source, key="measurement")
-    for key, value in raw_m.items():
-        if key not in MEASUREMENT_DEFAULTS:
-            raise InputError(f"unknown key {key!r}; expected {', '.join(MEASUREMENT_DEFAULTS)}", source=source,
-                             key=f"measurement.{key}")
-        measurement[key] = _number(value, source, f"measurement.{key}", lower=0.0)
+    measurement = parse_measurement(data.get("measurement"), MEASUREMENT_DEFAULTS, source)
     seed = data.get("seed", 0)
     if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
         raise InputError(f"expected a whole number >= 0, got {seed!r}", source=source, key="seed")
@@ -284,8 +276,6 @@ def measure_kc(truth: KCTruth, output: str | os.PathLike[str], *, overwrite: boo
     from vehicle.runner import simulate
 
     root = Path(output)
-    if root.exists() and not overwrite:
-        raise InputError("exists; pass --overwrite to replace it", source=str(root))
     channels = measured_channels()
     m = truth.measurement
     rng = np.random.default_rng(truth.seed)
@@ -293,12 +283,7 @@ def measure_kc(truth: KCTruth, output: str | os.PathLike[str], *, overwrite: boo
                if name not in INPUT_CHANNELS}
     vehicle = truth.vehicle
     rig = rig_description(m)
-    root.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{root.name}.", dir=root.parent))
-    umask = os.umask(0)  # mkdtemp creates 0700; give the dataset the usual permissions
-    os.umask(umask)
-    os.chmod(tmp, 0o777 & ~umask)
-    try:
+    with whole_directory(root, overwrite=overwrite) as tmp:
         files = []
         for i, scenario in enumerate(truth.scenarios):
             if progress is not None:
@@ -321,12 +306,6 @@ def measure_kc(truth: KCTruth, output: str | os.PathLike[str], *, overwrite: boo
                                 duration_scale=truth.duration_scale, source=f"{scenario.path} on the virtual rig")
             files.append(file)
         write_kc_rig_yaml(tmp, _vehicle_text(truth.baseline), rig, files)
-        if root.exists():
-            shutil.rmtree(root)
-        os.replace(tmp, root)
-    finally:
-        if tmp.exists():
-            shutil.rmtree(tmp)
     return root
 
 

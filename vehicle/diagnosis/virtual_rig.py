@@ -136,21 +136,28 @@ def parse_truth(data: Any, source: str, base_dir: Path | None = None) -> Truth:
             raise InputError(f"{cause} does not apply to baseline {baseline.name} ({baseline.model})", source=source,
                              key=f"{key}.cause")
         effects.append((cause, values))
-    measurement = dict(MEASUREMENT_DEFAULTS)
-    raw_m = data.get("measurement") or {}
-    if not isinstance(raw_m, Mapping):
-        raise InputError(f"expected a mapping, got {raw_m!r}", source=source, key="measurement")
-    for key, value in raw_m.items():
-        if key not in MEASUREMENT_DEFAULTS:
-            raise InputError(f"unknown key {key!r}; expected {', '.join(MEASUREMENT_DEFAULTS)}", source=source,
-                             key=f"measurement.{key}")
-        measurement[key] = _number(value, source, f"measurement.{key}", 0.0)
+    measurement = parse_measurement(data.get("measurement"), MEASUREMENT_DEFAULTS, source)
     seed = data.get("seed", 0)
     if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
         raise InputError(f"expected a whole number >= 0, got {seed!r}", source=source, key="seed")
     truth = Truth(source, baseline, effects, measurement, seed, str(data.get("part", "bushing under test")))
     truth.model.channel()  # validate the combination now, naming this file
     return truth
+
+
+def parse_measurement(raw: Any, defaults: Mapping[str, float], source: str) -> dict[str, float]:
+    """A truth's ``measurement`` mapping over the rig's defaults: known keys, numbers >= 0."""
+    measurement = dict(defaults)
+    if raw is None:
+        return measurement
+    if not isinstance(raw, Mapping):
+        raise InputError(f"expected a mapping, got {raw!r}", source=source, key="measurement")
+    for key, value in raw.items():
+        if key not in defaults:
+            raise InputError(f"unknown key {key!r}; expected {', '.join(defaults)}", source=source,
+                             key=f"measurement.{key}")
+        measurement[key] = _number(value, source, f"measurement.{key}", 0.0)
+    return measurement
 
 
 def load_truth(path: Path) -> "Truth | KCTruth":
