@@ -323,8 +323,8 @@ def simulate(scenario: Scenario, vehicle: VehicleDefinition | None = None, *, du
     metadata = play.metadata()
     if vehicle is not None:
         metadata = replace(metadata, vehicle_yaml="", extra={**metadata.extra, "vehicle_file": "(in memory)"})
-    return Run(path=Path("(in memory)"), t_s=np.array(memory.t_s), signals={s.name: values[:, i] for i, s in
-                                                                          enumerate(specs)},
+    signals = {s.name: values[:, i] for i, s in enumerate(specs)}
+    return Run(path=Path("(in memory)"), t_s=np.array(memory.t_s), signals=signals,
                units={s.name: s.unit for s in specs}, groups={s.name: s.group for s in specs}, specs=specs,
                body_names=[], body_pos=np.empty((len(values), 0, 3)), body_quat_wxyz=np.empty((len(values), 0, 4)),
                geometry=[], metadata=metadata, complete=True, reason="")
