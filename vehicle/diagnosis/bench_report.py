@@ -139,8 +139,6 @@ def _ranking(d: BenchDiagnosis, out: Path) -> Path:
 
 def write_report(d: BenchDiagnosis, out_dir: Path) -> list[Path]:
     """Write report.md, its PNGs, diagnosis.json and (for a named cause) extended_model.yaml."""
-    import json
-
     out_dir.mkdir(parents=True, exist_ok=True)
     after = d.replay.simulate([d.best.model])[0] if d.named else None
     features = record_features(d)
@@ -172,8 +170,16 @@ def write_report(d: BenchDiagnosis, out_dir: Path) -> list[Path]:
     lines += ["", "## Loops and relaxations (held-out tests with the largest baseline error)", "",
               "![overlays](overlays.png)", "", "## Residual against speed, amplitude and static load", "",
               "![residuals](residuals.png)", ""]
+    return written + write_report_text(out_dir, lines, result) + ([model_path] if model_path else [])
+
+
+def write_report_text(out_dir: Path, lines: list[str], result: dict[str, Any]) -> list[Path]:
+    """``report.md`` (the markdown ``lines``) and ``diagnosis.json`` (``result``), each written atomically."""
+    import json
+
+    written = []
     for name, text in (("report.md", "\n".join(lines)), ("diagnosis.json", json.dumps(result, indent=2))):
         with atomic_output(out_dir / name) as tmp:
             tmp.write_text(text)
         written.append(out_dir / name)
-    return written + ([model_path] if model_path else [])
+    return written

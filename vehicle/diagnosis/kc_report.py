@@ -4,7 +4,6 @@ static load, and the ranking with its evidence."""
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 from typing import Any
@@ -15,6 +14,7 @@ from matplotlib.figure import Figure
 from bushings.bench import atomic_output
 from bushings.plots import save_figure
 from vehicle.definition import VehicleDefinition
+from vehicle.diagnosis.bench_report import write_report_text
 from vehicle.diagnosis.kc_catalogue import parameters
 from vehicle.diagnosis.kc_diagnosis import KCDiagnosis
 
@@ -171,8 +171,4 @@ def write_report(d: KCDiagnosis, baseline: VehicleDefinition, out_dir: Path, dat
     lines += ["", "## Channels with the largest mismatch (held-out test with the largest baseline error)", "",
               "![overlays](overlays.png)", "", "## Error against amplitude and static load", "",
               "![residuals](residuals.png)", ""]
-    for name, text in (("report.md", "\n".join(lines)), ("diagnosis.json", json.dumps(result, indent=2))):
-        with atomic_output(out_dir / name) as tmp:
-            tmp.write_text(text)
-        written.append(out_dir / name)
-    return written
+    return written + write_report_text(out_dir, lines, result)

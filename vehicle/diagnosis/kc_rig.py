@@ -26,7 +26,6 @@ displacements, forces and torques, rack) are the commanded values and are writte
 
 from __future__ import annotations
 
-import math
 import os
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -47,7 +46,7 @@ from vehicle.diagnosis.kc_catalogue import (
 )
 from vehicle.diagnosis.bench_data import whole_directory
 from vehicle.diagnosis.kc_data import write_kc_rig_yaml
-from vehicle.diagnosis.virtual_rig import parse_measurement
+from vehicle.diagnosis.virtual_rig import parse_measurement, quantise, truth_number
 from vehicle.scenarios import INPUT_CHANNELS, Scenario, load_scenario
 
 #: The K&C campaign the virtual rig plays when a truth names no scenarios, in this order.
@@ -93,15 +92,6 @@ class KCTruth:
     def vehicle(self) -> VehicleDefinition:
         """The truth: the baseline with every effect switched on."""
         return extended_vehicle(self.baseline, list(self.effects))
-
-
-def _number(value: Any, source: str, key: str, *, lower: float = -math.inf, positive: bool = False) -> float:
-    ok = (not isinstance(value, bool) and isinstance(value, (int, float)) and math.isfinite(value)
-          and (value > 0.0 if positive else value >= lower))
-    if not ok:
-        expected = "> 0" if positive else f">= {lower:g}" if lower > -math.inf else ""
-        raise InputError(f"expected a finite number {expected}".rstrip() + f", got {value!r}", source=source, key=key)
-    return float(value)
 
 
 def _path(value: Any, base_dir: Path | None) -> Path:
@@ -172,7 +162,7 @@ def _effect(entry: Any, baseline: VehicleDefinition, source: str, key: str) -> H
         raise InputError(f"missing {what} {missing[0]!r} for {cause}; expected {', '.join(allowed)}", source=source,
                          key=f"{key}.{missing[0]}")
     location = _location(entry, cause, baseline, source, key)
-    values = {p.name: _number(entry[p.name], source, f"{key}.{p.name}") for p in params}
+    values = {p.name: truth_number(entry[p.name], source, f"{key}.{p.name}") for p in params}
     hypothesis = Hypothesis(cause, location, values)
     try:
         extended_vehicle(baseline, [hypothesis])
@@ -222,7 +212,7 @@ def parse_kc_truth(data: Any, source: str, base_dir: Path | None = None) -> KCTr
     except InputError as exc:
         raise InputError(f"bad vehicle: {exc}", source=source, key="vehicle") from None
     scenarios = _scenarios(data.get("scenarios"), source, base_dir)
-    duration_scale = _number(data.get("duration_scale", 1.0), source, "duration_scale", positive=True)
+    duration_scale = truth_number(data.get("duration_scale", 1.0), source, "duration_scale", positive=True)
     raw = data.get("effects") or []
     if not isinstance(raw, list):
         raise InputError(f"expected a list of {{cause: ID, location: ..., parameters}}, got {raw!r}", source=source,
@@ -254,10 +244,6 @@ def rig_description(measurement: Mapping[str, float]) -> dict[str, Any]:
                      "zero error drawn once per dataset, Gaussian noise and the sensor's quantisation; the "
                      "rig inputs are written as commanded",
             "accuracy": {k: float(v) for k, v in measurement.items()}}
-
-
-def _quantise(x: np.ndarray, step: float) -> np.ndarray:
-    return np.round(x / step) * step if step > 0.0 else x
 
 
 def measure_kc(truth: KCTruth, output: str | os.PathLike[str], *, overwrite: bool = False,
@@ -296,7 +282,7 @@ def measure_kc(truth: KCTruth, output: str | os.PathLike[str], *, overwrite: boo
                 x = run.signals[name]
                 if name not in INPUT_CHANNELS:
                     noise, _, resolution = sensor(unit, m)
-                    x = _quantise(x + offsets[name] + rng.normal(0.0, noise, x.shape), resolution)
+                    x = quantise(x + offsets[name] + rng.normal(0.0, noise, x.shape), resolution)
                 signals[name] = x
             file = f"{i + 1:02d}_{scenario.name}.mcap"
             # The scenario file as seen from the dataset, so that a reader finds it wherever both are moved to.

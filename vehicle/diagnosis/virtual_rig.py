@@ -85,9 +85,13 @@ def truth_model(baseline: ParameterSet, effects: list[tuple[str, dict[str, float
     return model
 
 
-def _number(value: Any, source: str, key: str, lower: float = -math.inf) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value < lower:
-        raise InputError(f"expected a finite number >= {lower:g}, got {value!r}", source=source, key=key)
+def truth_number(value: Any, source: str, key: str, *, lower: float = -math.inf, positive: bool = False) -> float:
+    """A finite number of a truth file, ``>= lower`` (or ``> 0`` if ``positive``); errors name file and key."""
+    ok = (not isinstance(value, bool) and isinstance(value, (int, float)) and math.isfinite(value)
+          and (value > 0.0 if positive else value >= lower))
+    if not ok:
+        expected = "> 0" if positive else f">= {lower:g}" if lower > -math.inf else ""
+        raise InputError(f"expected a finite number {expected}".rstrip() + f", got {value!r}", source=source, key=key)
     return float(value)
 
 
@@ -131,7 +135,7 @@ def parse_truth(data: Any, source: str, base_dir: Path | None = None) -> Truth:
         if extra or missing:
             raise InputError(f"{'unknown' if extra else 'missing'} parameter {(extra or missing)[0]!r} for {cause}; "
                              f"expected {', '.join(sorted(names))}", source=source, key=f"{key}.{(extra or missing)[0]}")
-        values = {p.name: _number(entry[p.name], source, f"{key}.{p.name}") for p in params}
+        values = {p.name: truth_number(entry[p.name], source, f"{key}.{p.name}") for p in params}
         if cause in CAUSES and not CAUSES[cause].applies(baseline):
             raise InputError(f"{cause} does not apply to baseline {baseline.name} ({baseline.model})", source=source,
                              key=f"{key}.cause")
@@ -156,7 +160,7 @@ def parse_measurement(raw: Any, defaults: Mapping[str, float], source: str) -> d
         if key not in defaults:
             raise InputError(f"unknown key {key!r}; expected {', '.join(defaults)}", source=source,
                              key=f"measurement.{key}")
-        measurement[key] = _number(value, source, f"measurement.{key}", 0.0)
+        measurement[key] = truth_number(value, source, f"measurement.{key}", lower=0.0)
     return measurement
 
 
@@ -172,7 +176,8 @@ def load_truth(path: Path) -> "Truth | KCTruth":
     return parse_truth(data, str(path), path.parent)
 
 
-def _quantise(x: np.ndarray, step: float) -> np.ndarray:
+def quantise(x: np.ndarray, step: float) -> np.ndarray:
+    """``x`` on a sensor's resolution grid (unchanged for a zero step)."""
     return np.round(x / step) * step if step > 0.0 else x
 
 
@@ -197,9 +202,9 @@ def measure_bench(truth: Truth, output: Path, *, overwrite: bool = False, tests:
         t_fine, e_fine = test.signal(test.dt_s / OVERSAMPLING)
         force = bank.run(e_fine, test.dt_s / OVERSAMPLING)[:, 0]
         t, e, F = t_fine[::OVERSAMPLING], e_fine[::OVERSAMPLING], force[::OVERSAMPLING]
-        e_mm = _quantise(e * 1e3 + e_offset_mm + rng.normal(0.0, m["displacement_noise_mm"], len(e)),
+        e_mm = quantise(e * 1e3 + e_offset_mm + rng.normal(0.0, m["displacement_noise_mm"], len(e)),
                          m["displacement_resolution_mm"])
-        F_n = _quantise(F + force_offset + rng.normal(0.0, m["force_noise_n"], len(F)), m["force_resolution_n"])
+        F_n = quantise(F + force_offset + rng.normal(0.0, m["force_noise_n"], len(F)), m["force_resolution_n"])
         records.append(BenchTestRecord(test.name, test.programme, test.rest_before_s,
                                        BenchRecord(test.name, t, e_mm * 1e-3, F_n)))
     rig = {"name": "virtual bench", "sample_steps_s": sorted({t.dt_s for t in tests})}
