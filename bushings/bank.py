@@ -65,9 +65,7 @@ class BushingBank:
             for k, cc in zip(ch.maxwell_k, ch.maxwell_c):
                 self.MX[mx] = (k, cc)
                 mx += 1
-        max_cells = max([ch.n_cells for ch in self.channels] + [1])
-        self._work = np.zeros((7, max_cells))
-        self._iwork = np.zeros(max_cells, dtype=np.int64)
+        self._scratch = kn.scratch(max([ch.n_cells for ch in self.channels if not ch.continuous] + [1]))
         self._shapes = {"u": (max(n_nodes, 1),), "wprev": (max(n_nodes, 1),), "slope": (max(n_nodes, 1),), "q": (max(n_mx, 1),),
                         "eprev": (M,), "cs": (M, 2), "ck": (M,), "stack": (M, kn.STACK_SIZE, 2),
                         "diss": (M,), "nfail": (M,)}
@@ -120,7 +118,7 @@ class BushingBank:
         """The arrays :func:`bushings.kernel.step_bank` takes after (e, h), in its order, for
         compiled callers (e.g. a vehicle step loop) that call the kernel themselves."""
         return (self.P, self.I, self.MX, self.u, self.wprev, self.slope, self.q, self.eprev, self.cs,
-                self.ck, self.stack, self.diss, self.nfail, self.force, self.tangent, self._work, self._iwork)
+                self.ck, self.stack, self.diss, self.nfail, self.force, self.tangent, self._scratch)
 
     def run(self, e: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
         """Step through a deflection history e (T, M) or (T,) for one channel; returns forces and

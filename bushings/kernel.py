@@ -52,6 +52,12 @@ _LN2_HI = 6.93147180369123816490e-01
 _LN2_LO = 1.90821492927058770002e-10
 
 
+def scratch(n_cells: int) -> np.ndarray:
+    """Ladder scratch for ladders of up to ``n_cells`` nodes: the rows _KL.._DP, with the input and
+    ground columns and the nodes padded to a multiple of 4 (see _ladder_step)."""
+    return np.zeros((_NROWS, (n_cells + 3) // 4 * 4 + 2))
+
+
 @nb.njit(cache=True, inline="always", fastmath=_FAST)
 def _elastic(x, K0, nsup, ninf, ssup, sinf, psup, pinf):
     """Nonlinear elastic force and tangent (spec eq. 3.10 corrected)."""
@@ -442,17 +448,12 @@ def _continuous_step(x, Kpa, Ct, nroot, eps, stack, cs, ck):
 
 
 @nb.njit(cache=True, fastmath=_FAST)
-def step_bank(e, h, P, I, MX, u, wprev, slope, q, eprev, cs, ck, stack, diss, nfail, F, K, work, iwork):
+def step_bank(e, h, P, I, MX, u, wprev, slope, q, eprev, cs, ck, stack, diss, nfail, F, K, S):
     """Advance all channels of a bank by one step of h seconds to deflections e (in place).
 
-    ``work`` and ``iwork`` are no longer used (the ladder scratch, padded for vectorisation, is
-    allocated here once per call); they stay in the signature for existing callers.
+    ``S`` is the ladder scratch, ``scratch(largest ladder)`` (allocated once by the bank, not per call).
     """
     M = e.shape[0]
-    ncell = 0
-    for c in range(M):
-        ncell = max(ncell, I[c, I_NCELL])
-    S = np.empty((_NROWS, (ncell + 3) // 4 * 4 + 2))
     for c in range(M):
         x = e[c]
         f, k = _elastic(x, P[c, P_K0], P[c, P_NSUP], P[c, P_NINF], P[c, P_SSUP], P[c, P_SINF],

@@ -17,10 +17,11 @@ from tests.diagnosis_helpers import diagnose_fresh, measure
 from vehicle.diagnosis.catalogue import CAUSES
 
 BENCH_CAUSES = sorted(CAUSES)
-#: Seeds per cause in the default suite (one, for time: each diagnosis takes 15-30 s); the slow
-#: suite (``pytest -m slow``) runs SLOW_SEEDS more.
+#: Seeds per cause in the default suite (one, for time: each diagnosis takes 15-60 s); the slow
+#: suite (``pytest -m slow``) runs SLOW_SEEDS more (VSIM_SLOW_SEEDS=n runs the first n, for a
+#: partial measurement; the issue's figure is the full 20).
 SEEDS = [int(os.environ.get("VSIM_TEST_SEED", "1"))]
-SLOW_SEEDS = range(100, 120)
+SLOW_SEEDS = range(100, 100 + int(os.environ.get("VSIM_SLOW_SEEDS", "20")))
 
 
 def _check_named(result: dict, cause: str, effects: list[dict]) -> None:
@@ -100,8 +101,8 @@ def test_success_rate_over_many_seeds(tmp_path, cause):
             else:
                 _check_named(result, cause, effects)
             right += 1
-        except AssertionError:
-            pass
+        except AssertionError as exc:
+            print(f"\n{cause} seed {seed}: {exc}")
     rate = right / len(SLOW_SEEDS)
     print(f"\n{cause}: {right}/{len(SLOW_SEEDS)} diagnosed right ({rate:.0%})")
     assert rate >= 0.9
