@@ -26,6 +26,8 @@ class Parameter:
     bounds: tuple[float, float]        #: fit bounds
     draw: tuple[float, float]          #: realistic magnitude range the virtual rig draws from
     signed: bool = False               #: the virtual rig draws either sign
+    sided: bool = False                #: a signed parameter whose sign picks another effect, not the
+    #: opposite one (asymmetry: which side stiffens): a linear fit cannot cross zero
     log: bool = False                  #: fitted on a log scale (positive, spans decades)
     description: str = ""
 
@@ -111,13 +113,13 @@ CAUSES: dict[str, Cause] = {c.id: c for c in (
           "static load shifts the part's operating point along its nonlinear elastic law and leaves its "
           "hysteresis on a loading branch",
           "stiffness error that depends on static load, not on speed; loops not centred",
-          (Parameter("preload", "mm", (-5.0, 5.0), (1.5, 3.0), signed=True,
+          (Parameter("preload", "mm", (-5.0, 5.0), (1.5, 3.0), signed=True, sided=True,
                      description="deflection of the mounted part at the rig's zero (2-4 kN of static load)"),),
           _elastic_law, _effect("preload", "preload")),
     Cause("asymmetry",
           "tension/compression asymmetry beyond the elastic law: one side progressively stiffer",
           "loops not point-symmetric about their centre",
-          (Parameter("asymmetry", "1/mm", (-1.0, 1.0), (0.05, 0.15), signed=True,
+          (Parameter("asymmetry", "1/mm", (-1.0, 1.0), (0.05, 0.15), signed=True, sided=True,
                      description="extra tangent fraction of K0 per mm; > 0 stiffens compression"),),
           lambda b: b.values.get("K0", 0.0) > 0.0, _effect("asymmetry", "asymmetry")),
     Cause("mullins",

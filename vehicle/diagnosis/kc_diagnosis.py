@@ -7,8 +7,9 @@
    differences of the residual, which a smooth model error hardly affects); each channel's zero
    error in each recording is a nuisance, removed.
 2. Screening: every catalogue cause at every place it can sit (:mod:`vehicle.diagnosis.kc_catalogue`)
-   is run once on the training tests (every other one) at mid-range magnitude; its magnitude is
-   fitted by taking the effect proportional to it.
+   is run once on the training tests (every other one) at mid-range magnitude (a sided cause, whose
+   sign picks another effect, once per sign); its magnitude is fitted by taking the effect
+   proportional to it.
 3. The best few are run on every test with their fitted magnitudes, refitted once along the effect
    that run gave, run again, and scored on the held-out tests: the verdict rests on full vehicle
    simulations, never on the screening's linearisation.
@@ -240,8 +241,12 @@ def fit(h: Hypothesis, signature: np.ndarray, base: np.ndarray, scorer: _Scorer)
     s2 = float(np.dot(r, r)) / max(len(r) - 1, 1) * (1.0 + rho) / (1.0 - rho)
     std_alpha = math.sqrt(s2 / norm) if norm > 0.0 else math.inf
     x0 = math.log(at[first.name]) if first.log else at[first.name]
-    lo = first.bounds[0] if first.signed else max(first.bounds[0], 0.0)
-    value = float(np.clip(math.exp(alpha * x0) if first.log else alpha * x0, lo, first.bounds[1]))
+    lo, hi = first.bounds
+    if not first.signed or (first.sided and x0 > 0.0):
+        lo = max(lo, 0.0)
+    if first.sided and x0 < 0.0:
+        hi = min(hi, 0.0)
+    value = float(np.clip(math.exp(alpha * x0) if first.log else alpha * x0, lo, hi))
     scale = math.log(value) / x0 if first.log else value / x0
     std = {first.name: abs(value * x0) * std_alpha if first.log else abs(x0) * std_alpha}
     trained = float(math.sqrt(np.mean((mismatch - scale * effect) ** 2)))
@@ -249,8 +254,15 @@ def fit(h: Hypothesis, signature: np.ndarray, base: np.ndarray, scorer: _Scorer)
 
 
 def hypotheses(vehicle: VehicleDefinition) -> list[Hypothesis]:
-    """Every catalogue cause at every place it can sit in ``vehicle``."""
-    return [Hypothesis(c, loc) for c in (*BUSHING_CAUSES, *VEHICLE_CAUSES) for loc in locations(vehicle, c)]
+    """Every catalogue cause at every place it can sit in ``vehicle``, at mid-range values; a sided
+    cause once per sign."""
+    out = []
+    for c in (*BUSHING_CAUSES, *VEHICLE_CAUSES):
+        first, values = parameters(c)[0], _nominal(c)
+        signs = (1.0, -1.0) if first.sided else (1.0,)
+        out += [Hypothesis(c, loc, {**values, first.name: sign * values[first.name]})
+                for loc in locations(vehicle, c) for sign in signs]
+    return out
 
 
 def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, workers: int | None = None,
@@ -262,7 +274,7 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, workers: int | N
     every = range(len(layout.tests))
     heldout = split(len(layout.tests))
     training = [i for i in every if not heldout[i]]
-    candidates = [replace(h, values=_nominal(h.cause)) for h in hypotheses(vehicle)]
+    candidates = hypotheses(vehicle)
     with ProcessPoolExecutor(max_workers=workers or min(2, os.cpu_count() or 1),
                              mp_context=multiprocessing.get_context("fork")) as pool:
         def rows(vehicles: list[VehicleDefinition], tests: Sequence[int]) -> list[np.ndarray]:
