@@ -21,6 +21,7 @@ import pytest
 
 from bushings.errors import InputError
 from bushings.parameters import load_parameter_set
+from tests.diagnosis_helpers import SLOW_SEEDS, assert_success_rate
 from vehicle.definition import load_vehicle, with_extensions
 from vehicle.diagnosis.kc_catalogue import (OBSERVABLE, Hypothesis, draw, extended_vehicle, extended_vehicle_yaml,
                                             locations, parameters)
@@ -30,10 +31,8 @@ from vehicle.runner import run_scenario, simulate
 from vehicle.scenarios import load_scenario
 
 KC_CAUSES = sorted(c for c in OBSERVABLE if c != "backlash")
-#: The default suite diagnoses one draw (about 2 min); the slow suite 20 per cause (VSIM_SLOW_SEEDS=n
-#: runs the first n, for a partial measurement).
+#: The default suite diagnoses one draw (about 2 min); the slow suite SLOW_SEEDS per cause.
 SEED = int(os.environ.get("VSIM_TEST_SEED", "0"))
-SLOW_SEEDS = range(100, 100 + int(os.environ.get("VSIM_SLOW_SEEDS", "20")))
 
 
 # -- the pieces ----------------------------------------------------------------------------------
@@ -208,17 +207,9 @@ def test_report_of_a_one_scenario_dataset(tmp_path):
 @pytest.mark.parametrize("cause", KC_CAUSES + ["none", "backlash"])
 def test_success_rate_over_many_seeds(tmp_path, cause):
     """At least 90 % of the draws per cause diagnosed right (20; 10 for none; the rate is printed)."""
-    seeds = SLOW_SEEDS[:max(len(SLOW_SEEDS) // 2, 1)] if cause == "none" else SLOW_SEEDS
-    right = 0
-    for seed in seeds:
-        case = tmp_path / str(seed)
-        case.mkdir()
+    def attempt(case: Path, seed: int) -> None:
         h, measured = measure(case, cause, seed)
-        try:
-            check(diagnose_fresh(measured), h)
-            right += 1
-        except AssertionError as exc:
-            print(f"\n{cause} seed {seed}: {exc}")
-    rate = right / len(seeds)
-    print(f"\n{cause}: {right}/{len(seeds)} diagnosed right ({rate:.0%})")
-    assert rate >= 0.9
+        check(diagnose_fresh(measured), h)
+
+    seeds = SLOW_SEEDS[:max(len(SLOW_SEEDS) // 2, 1)] if cause == "none" else SLOW_SEEDS
+    assert_success_rate(cause, seeds, tmp_path, attempt)

@@ -38,8 +38,7 @@ def weak(cause: str) -> list[dict[str, float]]:
     """The cause's values at the weak end of its range: the first parameter at the low end of its
     draw (of either sign, for a sided cause), the others mid-range."""
     first = parameters(cause)[0]
-    signs = (1.0, -1.0) if first.sided else (1.0,)
-    return [{**_nominal(cause), first.name: sign * first.draw[0]} for sign in signs]
+    return [{**_nominal(cause), first.name: sign * first.draw[0]} for sign in first.signs]
 
 
 def floor(cause: str, excess_at_weak_end: float) -> float:

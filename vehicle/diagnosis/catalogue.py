@@ -31,6 +31,11 @@ class Parameter:
     log: bool = False                  #: fitted on a log scale (positive, spans decades)
     description: str = ""
 
+    @property
+    def signs(self) -> tuple[float, ...]:
+        """The signs a hypothesis must be tried with: both for a sided parameter, else +1."""
+        return (1.0, -1.0) if self.sided else (1.0,)
+
 
 @dataclass(frozen=True)
 class Cause:

@@ -259,9 +259,8 @@ def hypotheses(vehicle: VehicleDefinition) -> list[Hypothesis]:
     out = []
     for c in (*BUSHING_CAUSES, *VEHICLE_CAUSES):
         first, values = parameters(c)[0], _nominal(c)
-        signs = (1.0, -1.0) if first.sided else (1.0,)
         out += [Hypothesis(c, loc, {**values, first.name: sign * values[first.name]})
-                for loc in locations(vehicle, c) for sign in signs]
+                for loc in locations(vehicle, c) for sign in first.signs]
     return out
 
 
