@@ -17,9 +17,23 @@ import numpy as np
 from vehicle.diagnosis.catalogue import CAUSES, draw
 from vehicle.diagnosis.virtual_rig import OUTSIDE, measure_bench, parse_truth
 
-#: Seeds of the slow suites' success-rate tests, 20 per cause (VSIM_SLOW_SEEDS=n runs the first n,
-#: for a partial measurement; the issue's figure is the full 20).
-SLOW_SEEDS = range(100, 100 + int(os.environ.get("VSIM_SLOW_SEEDS", "20")))
+
+def _slow_seeds(spec: str) -> range:
+    """Seeds 100 + i for i in ``spec``: "n" is the first n, "a:b" is a..b−1 (to spread a slow
+    measurement over several runs and add up the per-seed lines they print)."""
+    first, _, last = spec.rpartition(":")
+    try:
+        seeds = range(100 + int(first or 0), 100 + int(last))
+    except ValueError:
+        seeds = range(0)
+    if len(seeds) == 0:
+        raise ValueError(f"VSIM_SLOW_SEEDS={spec!r}: expected n or a:b with a < b")
+    return seeds
+
+
+#: Seeds of the slow suites' success-rate tests, 20 per cause (VSIM_SLOW_SEEDS, see _slow_seeds, runs
+#: a part of them; the issue's figure is the full 20).
+SLOW_SEEDS = _slow_seeds(os.environ.get("VSIM_SLOW_SEEDS", "20"))
 #: The success rate over all draws that the slow suites require.
 MIN_SUCCESS_RATE = 0.9
 #: The bench baseline each cause is hidden in: the viscoelastic causes need an STS or RT baseline.
@@ -72,8 +86,9 @@ def assert_success_rate(cause: str, seeds: range, tmp: Path, attempt: Callable[[
         try:
             attempt(case, seed)
             right += 1
+            print(f"\n{cause} seed {seed}: right")
         except AssertionError as exc:
-            print(f"\n{cause} seed {seed}: {exc}")
+            print(f"\n{cause} seed {seed}: wrong: {exc}")
     rate = right / len(seeds)
     print(f"\n{cause}: {right}/{len(seeds)} diagnosed right ({rate:.0%})")
     assert rate >= MIN_SUCCESS_RATE
