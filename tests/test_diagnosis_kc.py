@@ -25,6 +25,7 @@ from tests.diagnosis_helpers import SLOW_SEEDS, assert_success_rate
 from vehicle.definition import load_vehicle, with_extensions
 from vehicle.diagnosis.kc_catalogue import (OBSERVABLE, Hypothesis, draw, extended_vehicle, extended_vehicle_yaml,
                                             locations, parameters)
+from vehicle.diagnosis.kc_diagnosis import Layout, Test, _nominal, _Scorer, fit, split
 from vehicle.diagnosis.kc_rig import DEFAULT_SCENARIOS, measure_kc, parse_kc_truth
 from vehicle.io import load_run
 from vehicle.runner import run_scenario, simulate
@@ -94,6 +95,27 @@ def test_places_and_draws():
             assert low * (1 - 1e-12) <= x <= first.draw[1] * (1 + 1e-12), (h, low)
     signs = {math.copysign(1.0, draw("asymmetry", np.random.default_rng(s)).values["asymmetry"]) for s in range(20)}
     assert signs == {1.0, -1.0}
+
+
+def test_the_screening_fit_scales_the_effect_and_clips_a_hopeless_one_at_its_bound():
+    """A log parameter's effect is taken proportional to its logarithm: 1.5 times the nominal run's
+    effect is nominal^1.5; a hypothesis with almost no effect is clipped at its bound (it overflowed)."""
+    rng = np.random.default_rng(3)
+    t = np.linspace(0.0, 1.0, 2000)
+    shape = np.column_stack([np.sin(2 * np.pi * t), np.cos(3 * np.pi * t)])
+    base = np.zeros_like(shape)
+    measured = 1.5 * shape + 0.2 * rng.standard_normal(shape.shape)
+    tests = [Test(name, None, rows) for name, rows in (("a", np.arange(1000)), ("b", np.arange(1000, 2000)))]
+    layout = Layout(["c_x", "c_y"], measured, np.zeros(2000, dtype=int), np.repeat([0, 1], 1000), tests)
+    scorer = _Scorer(layout, base, split(2))
+    h = Hypothesis("broad_relaxation", ("e1_front", "y"), _nominal("broad_relaxation"))
+    k1 = parameters("broad_relaxation")[0]
+    fitted = fit(h, shape, base, scorer)
+    exponent = math.log(fitted.hypothesis.values["k1"]) / math.log(h.values["k1"])
+    assert exponent == pytest.approx(1.5, abs=0.03)   # about 4 standard deviations of the noise
+    assert fitted.screened_error == pytest.approx(1.0, abs=0.1)   # what is left is the noise
+    hopeless = fit(h, 1e-6 * shape, base, scorer)
+    assert hopeless.hypothesis.values["k1"] == pytest.approx(k1.bounds[1], rel=1e-12)
 
 
 def test_simulate_gives_the_recorded_run(tmp_path):

@@ -246,7 +246,8 @@ def fit(h: Hypothesis, signature: np.ndarray, base: np.ndarray, scorer: _Scorer)
         lo = max(lo, 0.0)
     if first.sided and x0 < 0.0:
         hi = min(hi, 0.0)
-    value = float(np.clip(math.exp(alpha * x0) if first.log else alpha * x0, lo, hi))
+    # a log parameter clipped before exp: a hypothesis with almost no effect gets a huge alpha
+    value = float(np.clip(math.exp(min(alpha * x0, math.log(hi))) if first.log else alpha * x0, lo, hi))
     scale = math.log(value) / x0 if first.log else value / x0
     std = {first.name: abs(value * x0) * std_alpha if first.log else abs(x0) * std_alpha}
     trained = float(math.sqrt(np.mean((mismatch - scale * effect) ** 2)))
