@@ -15,6 +15,7 @@ import subprocess
 import sys
 from dataclasses import replace
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -25,7 +26,8 @@ from tests.diagnosis_helpers import SLOW_SEEDS, assert_success_rate
 from vehicle.definition import load_vehicle, with_extensions
 from vehicle.diagnosis.kc_catalogue import (OBSERVABLE, Hypothesis, draw, extended_vehicle, extended_vehicle_yaml,
                                             locations, parameters)
-from vehicle.diagnosis.kc_diagnosis import Layout, Test, _nominal, _Scorer, fit, split
+from vehicle.diagnosis.kc_diagnosis import Candidate, Layout, Test, _nominal, _Scorer, fit, split
+from vehicle.diagnosis.kc_report import _parameters
 from vehicle.diagnosis.kc_rig import DEFAULT_SCENARIOS, measure_kc, parse_kc_truth
 from vehicle.io import load_run
 from vehicle.runner import run_scenario, simulate
@@ -118,6 +120,16 @@ def test_the_screening_fit_scales_the_effect_and_clips_a_hopeless_one_at_its_bou
     assert hopeless.hypothesis.values["k1"] == pytest.approx(k1.bounds[1], rel=1e-12)
 
 
+def test_the_verdict_says_which_parameters_the_kc_fit_held():
+    """Only the first parameter is fitted at K&C: the others are reported as held, with no uncertainty,
+    in valid JSON (the uncertainty was NaN)."""
+    h = Hypothesis("broad_relaxation", ("e1_front", "y"), {"k1": 60.0, "alpha": 0.16})
+    out = _parameters(SimpleNamespace(named=True, best=Candidate(h, 1.0, {"k1": 5.0})))
+    assert out["k1"] == {"value": 60.0, "std": 5.0, "unit": "N/mm", "fitted": True}
+    assert out["alpha"] == {"value": 0.16, "std": None, "unit": "-", "fitted": False}
+    json.dumps(out, allow_nan=False)
+
+
 def test_simulate_gives_the_recorded_run(tmp_path):
     scenario = load_scenario(DEFAULT_SCENARIOS[0])
     scenario = replace(scenario, cases=scenario.cases[:1])
@@ -193,9 +205,16 @@ def check(result: dict, h: Hypothesis | None) -> None:
     assert result["location"] == h.location_json()
     assert _excess(result["heldout_error_after"]) <= 0.5 * _excess(result["heldout_error_before"])
     first = parameters(h.cause)[0]
+    assert result["parameters"][first.name]["fitted"]
     fitted, hidden = result["parameters"][first.name]["value"], h.values[first.name]
-    # the magnitude (and sign) within 30 %: the fit takes the effect proportional to it between two runs
-    assert abs(fitted - hidden) <= 0.3 * abs(hidden), (fitted, h.values)
+    # the magnitude (and sign) within 30 %: the fit takes the effect proportional to it between two runs;
+    # within a factor of 2 where a second parameter is held at mid-range, which the first absorbs (a
+    # damper Co·v^pw fitted with the wrong pw matches the force at the rig's node speeds, not Co)
+    assert fitted * hidden > 0.0, (fitted, h.values)
+    if len(parameters(h.cause)) == 1:
+        assert abs(fitted - hidden) <= 0.3 * abs(hidden), (fitted, h.values)
+    else:
+        assert 0.5 <= fitted / hidden <= 2.0, (fitted, h.values)
 
 
 def test_a_drawn_cause_is_named_at_its_place(tmp_path):

@@ -4,7 +4,6 @@ static load, and the ranking with its evidence."""
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 from typing import Any
 
@@ -23,10 +22,12 @@ OVERLAYS = 4
 
 
 def _parameters(d: KCDiagnosis) -> dict[str, Any]:
+    """The named cause's parameters; at the K&C level only the first is fitted, the others are held
+    at mid-range (``"fitted": false``, no uncertainty), and the first is fitted given them."""
     if not d.named:
         return {}
-    return {p.name: {"value": d.best.hypothesis.values[p.name], "std": d.best.std.get(p.name, math.nan),
-                     "unit": p.unit} for p in parameters(d.best.hypothesis.cause)}
+    return {p.name: {"value": d.best.hypothesis.values[p.name], "std": d.best.std.get(p.name), "unit": p.unit,
+                     "fitted": p.name in d.best.std} for p in parameters(d.best.hypothesis.cause)}
 
 
 def summary(d: KCDiagnosis) -> dict[str, Any]:
@@ -65,7 +66,8 @@ def verdict_sentence(d: KCDiagnosis) -> str:
     if d.verdict == "unexplained":
         return (f"The mismatch is real ({before:.2f} × the noise on held-out tests) but no catalogue cause explains "
                 f"it; the best, {best.hypothesis.label}, only brings it to {best.heldout_error:.2f}.")
-    values = ", ".join(f"{k} = {v['value']:.4g} ± {v['std']:.2g} {v['unit']}" for k, v in _parameters(d).items())
+    values = ", ".join(f"{k} = {v['value']:.4g} ± {v['std']:.2g} {v['unit']}" if v["fitted"] else
+                       f"{k} = {v['value']:.4g} {v['unit']} (held at mid-range)" for k, v in _parameters(d).items())
     return (f"Cause: **{d.verdict}** at {_where(d)} ({values}); held-out error {before:.2f} → {after:.2f} "
             f"× the measurement noise.")
 
