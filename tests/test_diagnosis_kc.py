@@ -100,8 +100,9 @@ def test_places_and_draws():
 
 
 def test_the_screening_fit_scales_the_effect_and_clips_a_hopeless_one_at_its_bound():
-    """A log parameter's effect is taken proportional to its logarithm: 1.5 times the nominal run's
-    effect is nominal^1.5; a hypothesis with almost no effect is clipped at its bound (it overflowed)."""
+    """The effect is taken proportional to the first parameter (a stiffness k1: 1.5 times the nominal
+    run's effect is 1.5 k1), to its logarithm for a factor (the beam's torsion scale s: s^1.5); a
+    hypothesis with almost no effect is clipped at its bound (a factor's overflowed exp)."""
     rng = np.random.default_rng(3)
     t = np.linspace(0.0, 1.0, 2000)
     shape = np.column_stack([np.sin(2 * np.pi * t), np.cos(3 * np.pi * t)])
@@ -110,14 +111,16 @@ def test_the_screening_fit_scales_the_effect_and_clips_a_hopeless_one_at_its_bou
     tests = [Test(name, None, rows) for name, rows in (("a", np.arange(1000)), ("b", np.arange(1000, 2000)))]
     layout = Layout(["c_x", "c_y"], measured, np.zeros(2000, dtype=int), np.repeat([0, 1], 1000), tests)
     scorer = _Scorer(layout, base, split(2))
-    h = Hypothesis("broad_relaxation", ("e1_front", "y"), _nominal("broad_relaxation"))
-    k1 = parameters("broad_relaxation")[0]
-    fitted = fit(h, shape, base, scorer)
-    exponent = math.log(fitted.hypothesis.values["k1"]) / math.log(h.values["k1"])
-    assert exponent == pytest.approx(1.5, abs=0.03)   # about 4 standard deviations of the noise
-    assert fitted.screened_error == pytest.approx(1.0, abs=0.1)   # what is left is the noise
-    hopeless = fit(h, 1e-6 * shape, base, scorer)
-    assert hopeless.hypothesis.values["k1"] == pytest.approx(k1.bounds[1], rel=1e-12)
+    for h, name, as_fitted in ((Hypothesis("broad_relaxation", ("e1_front", "y"), _nominal("broad_relaxation")),
+                                "k1", lambda x, x0: x / x0),
+                               (Hypothesis("beam_torsion", (), _nominal("beam_torsion")),
+                                "beam_torsion_scale", lambda x, x0: math.log(x) / math.log(x0))):
+        fitted = fit(h, shape, base, scorer)
+        # about 4 standard deviations of the noise
+        assert as_fitted(fitted.hypothesis.values[name], h.values[name]) == pytest.approx(1.5, abs=0.03)
+        assert fitted.screened_error == pytest.approx(1.0, abs=0.1)   # what is left is the noise
+        hopeless = fit(h, 1e-6 * shape, base, scorer)
+        assert hopeless.hypothesis.values[name] == pytest.approx(parameters(h.cause)[0].bounds[1], rel=1e-12)
 
 
 def test_the_verdict_says_which_parameters_the_kc_fit_held():

@@ -29,6 +29,8 @@ class Parameter:
     sided: bool = False                #: a signed parameter whose sign picks another effect, not the
     #: opposite one (asymmetry: which side stiffens): a linear fit cannot cross zero
     log: bool = False                  #: fitted on a log scale (positive, spans decades)
+    factor: bool = False               #: a factor on a design value (1: no effect), whose effect grows
+    #: with its logarithm (a log parameter otherwise has no effect at 0 and an effect growing with it)
     description: str = ""
 
     @property
@@ -112,7 +114,8 @@ CAUSES: dict[str, Cause] = {c.id: c for c in (
           "ladder node, dampers scaled",
           "simulated loops too round; measured hysteresis persists at low speed",
           (Parameter("Ff", "N", (0.0, 200.0), (5.0, 15.0), description="slider threshold added at every node"),
-           Parameter("co_scale", "-", (0.02, 3.0), (0.4, 0.8), log=True, description="factor on the damper Co")),
+           Parameter("co_scale", "-", (0.02, 3.0), (0.4, 0.8), log=True, factor=True,
+                     description="factor on the damper Co")),
           lambda b: _ladder(b) and b.values.get("Co", 0.0) > 0.0, _friction),
     Cause("preload",
           "static load shifts the part's operating point along its nonlinear elastic law and leaves its "

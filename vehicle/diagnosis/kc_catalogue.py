@@ -56,7 +56,7 @@ VEHICLE_CAUSES: dict[str, VehicleCause] = {c.id: c for c in (
                  located=False),
     VehicleCause("beam_torsion", "the twist beam's torsional stiffness differs from the design value",
                  "roll gradient and rear roll steer error without any change of loop width",
-                 (Parameter("beam_torsion_scale", "-", (0.2, 5.0), (1.3, 2.0), log=True,
+                 (Parameter("beam_torsion_scale", "-", (0.2, 5.0), (1.3, 2.0), log=True, factor=True,
                             description="factor on the design torsional stiffness (drawn above or below 1)"),),
                  located=False),
 )}

@@ -9,7 +9,7 @@
 2. Screening: every catalogue cause at every place it can sit (:mod:`vehicle.diagnosis.kc_catalogue`)
    is run once on the training tests (every other one) at mid-range magnitude (a sided cause, whose
    sign picks another effect, once per sign); its magnitude is fitted by taking the effect
-   proportional to it.
+   proportional to it (to its logarithm for a factor on a design value).
 3. The best few are run on every test with their fitted magnitudes, refitted once along the effect
    that run gave, run again, and scored on the held-out tests: the verdict rests on full vehicle
    simulations, never on the screening's linearisation.
@@ -225,7 +225,7 @@ def _nominal(cause: str) -> dict[str, float]:
 
 def fit(h: Hypothesis, signature: np.ndarray, base: np.ndarray, scorer: _Scorer) -> Candidate:
     """Fit the magnitude of ``h`` on the training tests, its effect taken proportional to its first
-    parameter (to its logarithm for a log parameter) from the ``signature``: the rows of a vehicle
+    parameter (to its logarithm for a factor) from the ``signature``: the rows of a vehicle
     run with ``h.values`` minus the baseline's. Scored by its training error (``screened_error``)."""
     first = parameters(h.cause)[0]
     at = dict(h.values)
@@ -240,16 +240,16 @@ def fit(h: Hypothesis, signature: np.ndarray, base: np.ndarray, scorer: _Scorer)
     rho = float(np.clip(np.dot(r[1:], r[:-1]) / max(np.dot(r, r), 1e-300), 0.0, 0.999))
     s2 = float(np.dot(r, r)) / max(len(r) - 1, 1) * (1.0 + rho) / (1.0 - rho)
     std_alpha = math.sqrt(s2 / norm) if norm > 0.0 else math.inf
-    x0 = math.log(at[first.name]) if first.log else at[first.name]
+    x0 = math.log(at[first.name]) if first.factor else at[first.name]
     lo, hi = first.bounds
     if not first.signed or (first.sided and x0 > 0.0):
         lo = max(lo, 0.0)
     if first.sided and x0 < 0.0:
         hi = min(hi, 0.0)
-    # a log parameter clipped before exp: a hypothesis with almost no effect gets a huge alpha
-    value = float(np.clip(math.exp(min(alpha * x0, math.log(hi))) if first.log else alpha * x0, lo, hi))
-    scale = math.log(value) / x0 if first.log else value / x0
-    std = {first.name: abs(value * x0) * std_alpha if first.log else abs(x0) * std_alpha}
+    # a factor clipped before exp: a hypothesis with almost no effect gets a huge alpha
+    value = float(np.clip(math.exp(min(alpha * x0, math.log(hi))) if first.factor else alpha * x0, lo, hi))
+    scale = math.log(value) / x0 if first.factor else value / x0
+    std = {first.name: abs(value * x0) * std_alpha if first.factor else abs(x0) * std_alpha}
     trained = float(math.sqrt(np.mean((mismatch - scale * effect) ** 2)))
     return Candidate(replace(h, values={**at, first.name: value}), math.nan, std, screened_error=trained)
 
