@@ -43,10 +43,11 @@ def weak(cause: str) -> list[dict[str, float]]:
 
 def floor(cause: str, excess_at_weak_end: float) -> float:
     """The first parameter's magnitude at which the cause's excess reaches MIN_EXCESS, taking the
-    effect proportional to it."""
+    effect proportional to it as the diagnosis's fit does (:meth:`Parameter.effect`)."""
     if excess_at_weak_end <= 1e-3 * MIN_EXCESS:
         return math.inf
-    return parameters(cause)[0].draw[0] * MIN_EXCESS / excess_at_weak_end
+    first = parameters(cause)[0]
+    return first.from_effect(first.effect(first.draw[0]) * MIN_EXCESS / excess_at_weak_end)
 
 
 def campaign(vehicle: VehicleDefinition, duration_scale: float) -> list[dict[str, np.ndarray]]:

@@ -8,6 +8,7 @@ by ``vsim bushing run`` and by a vehicle.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any, Callable, Mapping
 
@@ -37,6 +38,15 @@ class Parameter:
     def signs(self) -> tuple[float, ...]:
         """The signs a hypothesis must be tried with: both for a sided parameter, else +1."""
         return (1.0, -1.0) if self.sided else (1.0,)
+
+    def effect(self, value: float) -> float:
+        """The coordinate the parameter's effect is taken proportional to: its logarithm for a factor,
+        else the value itself."""
+        return math.log(value) if self.factor else value
+
+    def from_effect(self, x: float) -> float:
+        """The value at effect coordinate ``x`` (the inverse of :meth:`effect`)."""
+        return math.exp(x) if self.factor else x
 
 
 @dataclass(frozen=True)

@@ -81,7 +81,7 @@ OBSERVABLE: dict[str, dict[tuple[str, ...], float]] = {
     "broad_relaxation": {("e1_front", "y"): 50.0},
     "coupling": {("e1_rear", "x", "y"): 27.6, ("e1_rear", "x", "z"): 43.6},
     "strut_friction": {(): 27.2},
-    "beam_torsion": {(): 0.5},
+    "beam_torsion": {(): 1.106},
     "backlash": {("e1_front", "y"): 0.049, ("e1_rear", "x"): 0.103, ("e1_rear", "y"): 0.057},
 }
 #: Outside the catalogue: a dead band in one bushing direction.

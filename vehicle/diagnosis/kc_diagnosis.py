@@ -240,15 +240,15 @@ def fit(h: Hypothesis, signature: np.ndarray, base: np.ndarray, scorer: _Scorer)
     rho = float(np.clip(np.dot(r[1:], r[:-1]) / max(np.dot(r, r), 1e-300), 0.0, 0.999))
     s2 = float(np.dot(r, r)) / max(len(r) - 1, 1) * (1.0 + rho) / (1.0 - rho)
     std_alpha = math.sqrt(s2 / norm) if norm > 0.0 else math.inf
-    x0 = math.log(at[first.name]) if first.factor else at[first.name]
+    x0 = first.effect(at[first.name])
     lo, hi = first.bounds
     if not first.signed or (first.sided and x0 > 0.0):
         lo = max(lo, 0.0)
     if first.sided and x0 < 0.0:
         hi = min(hi, 0.0)
-    # a factor clipped before exp: a hypothesis with almost no effect gets a huge alpha
-    value = float(np.clip(math.exp(min(alpha * x0, math.log(hi))) if first.factor else alpha * x0, lo, hi))
-    scale = math.log(value) / x0 if first.factor else value / x0
+    # clipped before from_effect: a hypothesis with almost no effect gets a huge alpha (a factor's exp overflowed)
+    value = float(np.clip(first.from_effect(min(alpha * x0, first.effect(hi))), lo, hi))
+    scale = first.effect(value) / x0
     std = {first.name: abs(value * x0) * std_alpha if first.factor else abs(x0) * std_alpha}
     trained = float(math.sqrt(np.mean((mismatch - scale * effect) ** 2)))
     return Candidate(replace(h, values={**at, first.name: value}), math.nan, std, screened_error=trained)
