@@ -24,7 +24,12 @@ def read_yaml(path: Path, missing: str) -> Any:
     (with the message ``missing``) or is not valid YAML."""
     if not path.is_file():
         raise InputError(missing, source=str(path))
+    return parse_yaml(path.read_text(), str(path))
+
+
+def parse_yaml(text: str, source: str) -> Any:
+    """The parsed YAML ``text``; InputError naming ``source`` when it is not valid YAML."""
     try:
-        return yaml.safe_load(path.read_text())
+        return yaml.safe_load(text)
     except yaml.YAMLError as exc:
-        raise InputError(f"not valid YAML: {exc}", source=str(path)) from exc
+        raise InputError(f"not valid YAML: {exc}", source=source) from exc

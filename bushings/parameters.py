@@ -7,6 +7,8 @@ Everything downstream (kernels, bank, vehicle) is SI: N, m, s or N·m, rad, s.
 
 from __future__ import annotations
 
+import copy
+import functools
 import math
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -15,7 +17,7 @@ from typing import TYPE_CHECKING, Any, Mapping
 import yaml
 
 
-from bushings.errors import InputError, read_yaml
+from bushings.errors import InputError, parse_yaml
 
 if TYPE_CHECKING:
     from bushings.effects import Effects
@@ -246,9 +248,17 @@ def load_parameter_set(name_or_path: str | Path) -> ParameterSet:
     path = Path(name_or_path)
     if path.suffix not in (".yaml", ".yml"):
         path = PARAMETER_SET_DIR / f"{name_or_path}.yaml"
-    known = ", ".join(sorted(p.stem for p in PARAMETER_SET_DIR.glob("*.yaml")))
-    data = read_yaml(path, f"no parameter set {str(name_or_path)!r}; known sets: {known}")
-    return parse_parameter_set(data, str(path), name=path.stem)
+    if not path.is_file():
+        known = ", ".join(sorted(p.stem for p in PARAMETER_SET_DIR.glob("*.yaml")))
+        raise InputError(f"no parameter set {str(name_or_path)!r}; known sets: {known}", source=str(path))
+    # a vehicle build reads the same few files once per bushing direction: parsed once per content;
+    # a copy keeps the cached set intact
+    return copy.deepcopy(_parsed(str(path), path.read_text()))
+
+
+@functools.lru_cache(maxsize=128)
+def _parsed(path: str, text: str) -> ParameterSet:
+    return parse_parameter_set(parse_yaml(text, path), path, name=Path(path).stem)
 
 
 def save_parameter_set(pset: ParameterSet, path: str | Path) -> Path:

@@ -71,3 +71,13 @@ def test_bad_set_files(tmp_path):
         load_parameter_set(bad)
     with pytest.raises(InputError, match="no parameter set 'nope'; known sets: .*fig5_9"):
         load_parameter_set("nope")
+
+
+def test_a_set_file_edited_between_loads_is_read_again_and_loads_do_not_share_state(tmp_path):
+    path = tmp_path / "edited.yaml"
+    path.write_text("model: sts\nparams: {K0: 1, Kpa: 1, Kr: 1, Ff: 1}\n")
+    first = load_parameter_set(path)
+    first.values["K0"] = 99.0                      # a caller's change stays with its copy
+    assert load_parameter_set(path).values["K0"] == 1
+    path.write_text("model: sts\nparams: {K0: 2, Kpa: 1, Kr: 1, Ff: 1}\n")  # same size, same instant
+    assert load_parameter_set(path).values["K0"] == 2

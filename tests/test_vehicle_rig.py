@@ -152,3 +152,24 @@ def test_compiled_steps_match_the_python_loop(vehicle):
         mujoco.mj_step(m, d)
     assert np.array_equal(rigs[0].data.qpos, d.qpos)
     assert np.array_equal(rigs[0].coupling.bushings.forces(), rigs[1].coupling.bushings.forces())
+
+
+def test_played_inputs_match_the_setters_step_by_step(vehicle):
+    """rig.play (each row set inside the compiled loop) = the Python setters then one step per row,
+    bit for bit; a ramp's inputs follow its linear law."""
+    rigs = [KCRig(vehicle) for _ in range(2)]
+    t = np.arange(1, 201) * 1e-3
+    rows = np.column_stack([np.outer(np.sin(20 * t), [0.01, 0.012, -0.01, -0.008]),
+                            np.outer(t, [100.0, 0, 0, -100.0]), np.outer(np.cos(30 * t), [300.0] * 4),
+                            np.outer(t, [10.0, -10.0, 5.0, -5.0]), 0.004 * t])
+    rigs[0].play(rows)
+    for u in rows:
+        rigs[1].set_pads(u[0:4])
+        rigs[1].set_pad_loads(fx=u[4:8], fy=u[8:12], mz=u[12:16])
+        rigs[1].set_rack(u[16])
+        rigs[1].step()
+    assert np.array_equal(rigs[0].data.qpos, rigs[1].data.qpos)
+    assert np.array_equal(rigs[0].data.xfrc_applied, rigs[1].data.xfrc_applied)
+    rigs[0].ramp(0.05, pads=([0.0] * 4, [0.02, 0.01, 0.0, -0.01]))
+    assert np.allclose(rigs[0].model.eq_data[rigs[0].pad_eq, 0], [0.02, 0.01, 0.0, -0.01], rtol=0, atol=1e-15)
+    assert rigs[0].model.eq_data[rigs[0].rack_eq, 0] == rows[-1, 16]  # the ramp holds the rack

@@ -24,8 +24,11 @@ from vehicle.definition import VehicleDefinition
 from vehicle.kinematics import wheel_angles
 from vehicle.statics import resolve_preloads
 
-_NO_INPUT = np.zeros(16)
-_INACTIVE = np.zeros(4, dtype=bool)
+_NO_INPUTS = np.zeros((0, 17))
+_INACTIVE = np.zeros(5, dtype=bool)
+_ALL_ACTIVE = np.ones(5, dtype=bool)
+# a plain int: comparing an array with the pybind enum goes element by element through Python (100 µs)
+_EQUALITY_ROW = int(mujoco.mjtConstraint.mjCNSTR_EQUALITY)
 _SIGN = {"front_left": 1.0, "front_right": -1.0, "rear_left": 1.0, "rear_right": -1.0}
 
 
@@ -119,13 +122,19 @@ class KCRig:
 
     # -- running -----------------------------------------------------------------------------
     def step(self, n: int = 1) -> None:
-        """Advance ``n`` time steps with the coupling called before each (compiled loop)."""
-        self._run(n)
+        """Advance ``n`` time steps with the inputs held (compiled loop, the coupling called before each step)."""
+        self._run(n, _NO_INPUTS, _INACTIVE)
 
-    def _run(self, n: int, i0: int = 0, n_ramp: int = 1, start=_NO_INPUT, end=_NO_INPUT, active=_INACTIVE) -> None:
-        """``n`` compiled steps (vehicle.stepping.run), inputs ramped as ``run`` documents."""
+    def play(self, inputs: np.ndarray) -> None:
+        """Advance one time step per row of ``inputs`` (rig inputs in the order of
+        ``vehicle.scenarios.INPUT_CHANNELS``, SI), each row set before its step."""
+        inputs = np.ascontiguousarray(inputs, dtype=float)
+        self._run(len(inputs), inputs, _ALL_ACTIVE)
+
+    def _run(self, n: int, inputs: np.ndarray, active: np.ndarray) -> None:
+        """``n`` compiled steps (vehicle.stepping.run) with ``inputs`` and ``active`` as it documents."""
         m, d = self.model, self.data
-        stepping.run(n, i0, n_ramp, start, end, active, m.eq_data, self.pad_eq, d.xfrc_applied, self.carriage_body,
+        stepping.run(n, inputs, active, m.eq_data, self.pad_eq, self.rack_eq, d.xfrc_applied, self.carriage_body,
                      self.wheel_body, m._address, d._address, m.opt.timestep, *self.coupling.kernel_arrays())
         b = self.coupling.bushings
         if b.bank is not None:
@@ -150,14 +159,15 @@ class KCRig:
         n = max(1, int(round(duration / h)))
         every = max(1, n // samples) if samples else n + 1
         groups = (pads, fx, fy, mz)
-        active = np.array([g is not None for g in groups])
-        start = np.concatenate([np.zeros(4) if g is None else np.asarray(g[0], float) for g in groups])
-        end = np.concatenate([np.zeros(4) if g is None else np.asarray(g[1], float) for g in groups])
+        active = np.array([g is not None for g in groups] + [False])  # the rack is held
+        start = np.concatenate([np.zeros(4) if g is None else np.asarray(g[0], float) for g in groups] + [[0.0]])
+        end = np.concatenate([np.zeros(4) if g is None else np.asarray(g[1], float) for g in groups] + [[0.0]])
         out = []
         done = 0
         while done < n:
             k = min(every - done % every, n - done)
-            self._run(k, done, n, start, end, active)
+            f = (done + np.arange(1, k + 1)) / n
+            self._run(k, start + (end - start) * f[:, None], active)
             done += k
             if done % every == 0:
                 out.append(self.measure())
@@ -167,7 +177,7 @@ class KCRig:
     def _eq_first_rows(self, ids: np.ndarray) -> np.ndarray:
         """Index in ``efc_*`` of the first row of each equality ``ids`` (its rows are consecutive)."""
         d = self.data
-        rows = np.flatnonzero(d.efc_type[: d.nefc] == mujoco.mjtConstraint.mjCNSTR_EQUALITY)
+        rows = np.flatnonzero(d.efc_type[: d.nefc] == _EQUALITY_ROW)
         first = np.full(self.model.neq, -1)
         eq, at = np.unique(d.efc_id[rows], return_index=True)
         first[eq] = rows[at]

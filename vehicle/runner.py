@@ -403,8 +403,6 @@ def _run_case(rig: KCRig, scenario: Scenario, case: Case, number: int, when: Cas
     hold(1)
     for _ in range(when.steps[2] // every):
         u = case.inputs((step - input_start + np.arange(1, every + 1)) * dt / duration_scale)
-        for row in u:
-            apply_inputs(rig, row)
-            rig.step()
+        rig.play(u)
         step += every
         record(step, 2, u[-1])

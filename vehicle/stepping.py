@@ -103,27 +103,31 @@ def coupling_step(h, qpos, qvel, qfrc, ten_length, ten_velocity, ten_J, ten_J_ro
 
 
 @nb.njit(cache=True)
-def _run(mj_step, n, i0, n_ramp, start, end, active, eq_data, pad_eq, xfrc, carriage, wheel, m_addr, d_addr, h,
+def _run(mj_step, n, inputs, active, eq_data, pad_eq, rack_eq, xfrc, carriage, wheel, m_addr, d_addr, h,
         qpos, qvel, qfrc, ten_length, ten_velocity, ten_J, ten_J_rowadr, ten_J_rownnz, ten_J_colind, jnt_stiffness,
         dof_damping, tendon_damping, bush, bank, cross, damp, spring):
-    """Advance ``n`` steps; rig inputs move linearly from ``start`` to ``end`` over ``n_ramp`` steps.
+    """Advance ``n`` steps, row i of ``inputs`` set before step i (none if ``inputs`` has no rows).
 
-    Inputs (16 values): pad heights [m], Fx, Fy [N] at the carriages, Mz [N·m] at the wheels, four
-    corners each; ``active[g]`` says whether group g is driven (else left as is). Step ``i0 + i``
-    of the ramp (1-based) sets start + (end − start)·(i0 + i)/n_ramp. ``mj_step`` is MuJoCo's,
-    passed as a ctypes function so that the compiled code can be cached.
+    A row holds the rig inputs in the order of ``vehicle.scenarios.INPUT_CHANNELS`` (17 values):
+    pad heights [m], Fx, Fy [N] at the carriages, Mz [N·m] at the wheels, four corners each, then
+    the rack [m]; ``active[g]`` says whether group g (pads, Fx, Fy, Mz, rack) is driven (else left
+    as is). ``mj_step`` is MuJoCo's, passed as a ctypes function so that the compiled code can be
+    cached.
     """
-    for i in range(1, n + 1):
-        f = (i0 + i) / n_ramp
-        for c in range(4):
-            if active[0]:
-                eq_data[pad_eq[c], 0] = start[c] + (end[c] - start[c]) * f
-            if active[1]:
-                xfrc[carriage[c], 0] = start[4 + c] + (end[4 + c] - start[4 + c]) * f
-            if active[2]:
-                xfrc[carriage[c], 1] = start[8 + c] + (end[8 + c] - start[8 + c]) * f
-            if active[3]:
-                xfrc[wheel[c], 5] = start[12 + c] + (end[12 + c] - start[12 + c]) * f
+    for i in range(n):
+        if inputs.shape[0]:
+            u = inputs[i]
+            for c in range(4):
+                if active[0]:
+                    eq_data[pad_eq[c], 0] = u[c]
+                if active[1]:
+                    xfrc[carriage[c], 0] = u[4 + c]
+                if active[2]:
+                    xfrc[carriage[c], 1] = u[8 + c]
+                if active[3]:
+                    xfrc[wheel[c], 5] = u[12 + c]
+            if active[4]:
+                eq_data[rack_eq, 0] = u[16]
         coupling_step(h, qpos, qvel, qfrc, ten_length, ten_velocity, ten_J, ten_J_rowadr, ten_J_rownnz, ten_J_colind,
                       jnt_stiffness, dof_damping, tendon_damping, bush, bank, cross, damp, spring)
         mj_step(m_addr, d_addr)
