@@ -11,8 +11,10 @@
    sign picks another effect, once per sign); its magnitude is fitted by taking the effect
    proportional to it (to its logarithm for a factor on a design value).
 3. The best few are run on every test with their fitted magnitudes, refitted once along the effect
-   that run gave, run again, and scored on the held-out tests: the verdict rests on full vehicle
-   simulations, never on the screening's linearisation.
+   that run gave (a cause with a second parameter, such as a damper's exponent, also along the
+   effect of one more run with that parameter moved: both are fitted), run again, and scored on the
+   held-out tests: the verdict rests on full vehicle simulations, never on the screening's
+   linearisation.
 
 Why not the cheaper screen of replaying each bushing's recorded deflections through the extended
 law and mapping the force change through the response to a probe force: in a hysteretic direction
@@ -223,35 +225,64 @@ def _nominal(cause: str) -> dict[str, float]:
             for p in parameters(cause)}
 
 
-def fit(h: Hypothesis, signature: np.ndarray, base: np.ndarray, scorer: _Scorer) -> Candidate:
-    """Fit the magnitude of ``h`` on the training tests, its effect taken proportional to its first
-    parameter (to its logarithm for a factor) from the ``signature``: the rows of a vehicle
-    run with ``h.values`` minus the baseline's. Scored by its training error (``screened_error``)."""
-    first = parameters(h.cause)[0]
+def fit(h: Hypothesis, signature: np.ndarray, base: np.ndarray, scorer: _Scorer,
+        slope: np.ndarray | None = None) -> Candidate:
+    """Fit ``h`` on the training tests: its first parameter with the effect taken proportional to it
+    (to its logarithm for a factor) from the ``signature`` (the rows of a vehicle run with
+    ``h.values`` minus the baseline's); given ``slope`` (the rows' derivative with respect to the
+    second parameter at ``h.values``), the second too, linearly along it. Each parameter fitted gets
+    its uncertainty in ``std``; the candidate is scored by its training error (``screened_error``)."""
+    params = parameters(h.cause)
+    first = params[0]
     at = dict(h.values)
     train = ~scorer.held_rows
-    mismatch = scorer.residual(base, train)
-    effect = mismatch - scorer.residual(base + signature, train)     # the signature in noise units
-    norm = float(np.sum(effect ** 2))
-    alpha = float(np.sum(effect * mismatch)) / norm if norm > 0.0 else 0.0
+    mismatch = scorer.residual(base, train).ravel()
+    # the signature and the slope in noise units (the residual is affine in the prediction)
+    columns = [mismatch - scorer.residual(base + d, train).ravel() for d in (signature, slope) if d is not None]
+    gram = np.array([[float(np.dot(a, b)) for b in columns] for a in columns])
+    if len(columns) == 2 and np.linalg.det(gram) <= 1e-9 * gram[0, 0] * gram[1, 1]:
+        columns, gram = columns[:1], gram[:1, :1]   # the second parameter changes nothing the first does not
+    coef = np.linalg.solve(gram, [float(np.dot(c, mismatch)) for c in columns]) if gram[0, 0] > 0.0 \
+        else np.zeros(len(columns))
+    std = {}
+    if len(columns) == 2:
+        second = params[1]
+        moved = float(np.clip(at[second.name] + coef[1], *second.bounds))
+        coef[1] = moved - at[second.name]
+        coef[0] = float(np.dot(columns[0], mismatch - coef[1] * columns[1])) / gram[0, 0]
+        at[second.name] = moved
     # the residual variance, inflated for sample-to-sample correlation (a smooth model error is not
     # white noise: n samples are worth n(1 − ρ)/(1 + ρ))
-    r = (mismatch - alpha * effect).ravel()
+    r = mismatch - sum(c * x for c, x in zip(coef, columns))
     rho = float(np.clip(np.dot(r[1:], r[:-1]) / max(np.dot(r, r), 1e-300), 0.0, 0.999))
-    s2 = float(np.dot(r, r)) / max(len(r) - 1, 1) * (1.0 + rho) / (1.0 - rho)
-    std_alpha = math.sqrt(s2 / norm) if norm > 0.0 else math.inf
+    s2 = float(np.dot(r, r)) / max(len(r) - len(columns), 1) * (1.0 + rho) / (1.0 - rho)
+    var = np.diag(np.linalg.inv(gram)) * s2 if gram[0, 0] > 0.0 else np.full(len(columns), math.inf)
+    if len(columns) == 2:
+        std[params[1].name] = math.sqrt(var[1])
     x0 = first.effect(at[first.name])
     lo, hi = first.bounds
     if not first.signed or (first.sided and x0 > 0.0):
         lo = max(lo, 0.0)
     if first.sided and x0 < 0.0:
         hi = min(hi, 0.0)
-    # clipped before from_effect: a hypothesis with almost no effect gets a huge alpha (a factor's exp overflowed)
-    value = float(np.clip(first.from_effect(min(alpha * x0, first.effect(hi))), lo, hi))
+    # clipped before from_effect: a hypothesis with almost no effect gets a huge coefficient (a factor's exp overflowed)
+    value = float(np.clip(first.from_effect(min(coef[0] * x0, first.effect(hi))), lo, hi))
     scale = first.effect(value) / x0
-    std = {first.name: abs(value * x0) * std_alpha if first.factor else abs(x0) * std_alpha}
-    trained = float(math.sqrt(np.mean((mismatch - scale * effect) ** 2)))
+    std_first = math.sqrt(var[0])
+    std[first.name] = abs(value * x0) * std_first if first.factor else abs(x0) * std_first
+    rest = sum(c * x for c, x in zip(coef[1:], columns[1:]))
+    trained = float(math.sqrt(np.mean((mismatch - scale * columns[0] - rest) ** 2)))
     return Candidate(replace(h, values={**at, first.name: value}), math.nan, std, screened_error=trained)
+
+
+def nudged(h: Hypothesis) -> tuple[Hypothesis, float]:
+    """``h`` with its second parameter moved by a quarter of its realistic range (inwards from a
+    bound), and the move: the run that gives the rows' slope along that parameter."""
+    second = parameters(h.cause)[1]
+    value, step = h.values[second.name], 0.25 * (second.draw[1] - second.draw[0])
+    if value + step > second.bounds[1]:
+        step = -step
+    return replace(h, values={**h.values, second.name: value + step}), step
 
 
 def hypotheses(vehicle: VehicleDefinition) -> list[Hypothesis]:
@@ -301,7 +332,14 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, workers: int | N
         top = screened[:VERIFIED]
         say(f"the best {len(top)} on every test with their fitted magnitudes, then refitted along the effect they gave")
         _verify(top, rows([extended_vehicle(vehicle, [c.hypothesis]) for c in top], every), scorer)
-        refit = [fit(c.hypothesis, c.simulated - base, base, scorer) for c in top]
+        # a cause with a second parameter: one more run with it moved, on the training tests, for its slope
+        two = [c for c in top if len(parameters(c.hypothesis.cause)) > 1]
+        moves = [nudged(c.hypothesis) for c in two]
+        if two:
+            say(f"  {len(two)} with a second parameter: run with it moved, to fit it too")
+        moved = rows([extended_vehicle(vehicle, [h]) for h, _ in moves], training) if two else []
+        slopes = {id(c): (m - c.simulated) / step for c, m, (_, step) in zip(two, moved, moves)}
+        refit = [fit(c.hypothesis, c.simulated - base, base, scorer, slopes.get(id(c))) for c in top]
         for a, b in zip(top, refit):
             # the linearised uncertainty ignores the model's nonlinearity; the refit's shift shows it
             b.std = {k: max(s, abs(b.hypothesis.values[k] - a.hypothesis.values[k])) for k, s in b.std.items()}

@@ -22,8 +22,9 @@ OVERLAYS = 4
 
 
 def _parameters(d: KCDiagnosis) -> dict[str, Any]:
-    """The named cause's parameters; at the K&C level only the first is fitted, the others are held
-    at mid-range (``"fitted": false``, no uncertainty), and the first is fitted given them."""
+    """The named cause's parameters, each with its uncertainty if it was fitted: the screening fits
+    only the first, with a second held at mid-range (``"fitted": false``, no uncertainty); the refit
+    fits both."""
     if not d.named:
         return {}
     return {p.name: {"value": d.best.hypothesis.values[p.name], "std": d.best.std.get(p.name), "unit": p.unit,
