@@ -243,18 +243,21 @@ def _ladder_step(e, de, h, n, Kpa, Kr, Ff, Co, pw, tol_x, u, wprev, slope, S):
     S[_POS, 0] = e
     # Predictor: one Newton step from the last increment with the last converged slopes (no
     # transcendental calls): the residual of w = wprev at the new step is Kpa·Δe·δ_i1 − (K·wprev)_i.
+    nprev = 0
     for j in range(1, n + 1):
         S[_W, j] = wprev[j - 1]
         S[_SG, j] = 0.0 if wprev[j - 1] == 0.0 else (1.0 if wprev[j - 1] > 0.0 else -1.0)
         S[_DFL, j] = slope[j - 1]
-    for j in range(1, m + 1):
-        r = -((S[_KL, j] + Kr) * S[_W, j] - Kr * S[_W, j - 1] - Kr * S[_W, j + 1])
-        S[_RHS, j] = r if S[_SG, j] != 0.0 else 0.0
-    S[_RHS, 1] += Kpa * de if S[_SG, 1] != 0.0 else 0.0
-    _solve_active(n, m, S, Kr)
-    for j in range(1, m + 1):
-        wn = S[_W, j] + S[_RHS, j]
-        S[_W, j] = wn if wn * S[_SG, j] > 0.0 else S[_W, j]
+        nprev += 0 if wprev[j - 1] == 0.0 else 1
+    if nprev > 0:  # else every node stuck: the step would move none
+        for j in range(1, m + 1):
+            r = -((S[_KL, j] + Kr) * S[_W, j] - Kr * S[_W, j - 1] - Kr * S[_W, j + 1])
+            S[_RHS, j] = r if S[_SG, j] != 0.0 else 0.0
+        S[_RHS, 1] += Kpa * de if S[_SG, 1] != 0.0 else 0.0
+        _solve_active(n, m, S, Kr)
+        for j in range(1, m + 1):
+            wn = S[_W, j] + S[_RHS, j]
+            S[_W, j] = wn if wn * S[_SG, j] > 0.0 else S[_W, j]
     ok = False
     for _ in range(_MAX_NEWTON):
         for j in range(1, n + 1):
