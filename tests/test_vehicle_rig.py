@@ -170,6 +170,8 @@ def test_played_inputs_match_the_setters_step_by_step(vehicle):
         rigs[1].step()
     assert np.array_equal(rigs[0].data.qpos, rigs[1].data.qpos)
     assert np.array_equal(rigs[0].data.xfrc_applied, rigs[1].data.xfrc_applied)
+    with pytest.raises(ValueError, match=r"shape \(steps, 17\)"):
+        rigs[0].play(rows[:, :16])
     rigs[0].ramp(0.05, pads=([0.0] * 4, [0.02, 0.01, 0.0, -0.01]))
     assert np.allclose(rigs[0].model.eq_data[rigs[0].pad_eq, 0], [0.02, 0.01, 0.0, -0.01], rtol=0, atol=1e-15)
     assert rigs[0].model.eq_data[rigs[0].rack_eq, 0] == rows[-1, 16]  # the ramp holds the rack

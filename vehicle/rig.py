@@ -129,6 +129,8 @@ class KCRig:
         """Advance one time step per row of ``inputs`` (rig inputs in the order of
         ``vehicle.scenarios.INPUT_CHANNELS``, SI), each row set before its step."""
         inputs = np.ascontiguousarray(inputs, dtype=float)
+        if inputs.ndim != 2 or inputs.shape[1] != _NO_INPUTS.shape[1]:  # the compiled loop does not check
+            raise ValueError(f"expected rig inputs of shape (steps, {_NO_INPUTS.shape[1]}), got {inputs.shape}")
         self._run(len(inputs), inputs, _ALL_ACTIVE)
 
     def _run(self, n: int, inputs: np.ndarray, active: np.ndarray) -> None:
