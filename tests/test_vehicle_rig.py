@@ -164,9 +164,7 @@ def test_played_inputs_match_the_setters_step_by_step(vehicle):
                             np.outer(t, [10.0, -10.0, 5.0, -5.0]), 0.004 * t])
     rigs[0].play(rows)
     for u in rows:
-        rigs[1].set_pads(u[0:4])
-        rigs[1].set_pad_loads(fx=u[4:8], fy=u[8:12], mz=u[12:16])
-        rigs[1].set_rack(u[16])
+        rigs[1].set_inputs(u)
         rigs[1].step()
     assert np.array_equal(rigs[0].data.qpos, rigs[1].data.qpos)
     assert np.array_equal(rigs[0].data.xfrc_applied, rigs[1].data.xfrc_applied)

@@ -99,6 +99,13 @@ class KCRig:
         d.xfrc_applied[self.carriage_body, 1] = fy
         d.xfrc_applied[self.wheel_body, 5] = mz
 
+    def set_inputs(self, u: np.ndarray) -> None:
+        """Set every rig input at once from ``u`` (SI, in the order of ``vehicle.scenarios.INPUT_CHANNELS``,
+        as :meth:`play` reads its rows)."""
+        self.set_pads(u[0:4])
+        self.set_pad_loads(fx=u[4:8], fy=u[8:12], mz=u[12:16])
+        self.set_rack(u[16])
+
     def reset(self) -> None:
         """Back to the design pose at rest: virgin bushings, pads and rack at zero, no loads."""
         mujoco.mj_resetData(self.model, self.data)

@@ -180,13 +180,6 @@ def is_rotation(channel: str) -> bool:
 
 
 # -- the rig ----------------------------------------------------------------------------------------
-def apply_inputs(rig: KCRig, u: np.ndarray) -> None:
-    """Set the rig inputs ``u`` (SI, INPUT_CHANNELS order)."""
-    rig.set_pads(u[0:4])
-    rig.set_pad_loads(fx=u[4:8], fy=u[8:12], mz=u[12:16])
-    rig.set_rack(u[16])
-
-
 def check_divergence(rig: KCRig, o: RigOutputs, scenario: Scenario, time_s: float, case: str) -> None:
     """Raise :class:`DivergenceError` if the state of ``rig`` left its valid range."""
     names = o.bushing_names
@@ -396,7 +389,7 @@ def _run_case(rig: KCRig, scenario: Scenario, case: Case, number: int, when: Cas
             step += every
             record(step, phase, rest)
 
-    apply_inputs(rig, rest)
+    rig.set_inputs(rest)
     with rig.bushing_laws_off():
         record(step, 0, rest)
         hold(0)

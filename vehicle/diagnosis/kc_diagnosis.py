@@ -333,13 +333,13 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, workers: int | N
         say(f"the best {len(top)} on every test with their fitted magnitudes, then refitted along the effect they gave")
         _verify(top, rows([extended_vehicle(vehicle, [c.hypothesis]) for c in top], every), scorer)
         # a cause with a second parameter: one more run with it moved, on the training tests, for its slope
-        two = [c for c in top if len(parameters(c.hypothesis.cause)) > 1]
-        moves = [nudged(c.hypothesis) for c in two]
-        if two:
-            say(f"  {len(two)} with a second parameter: run with it moved, to fit it too")
-        moved = rows([extended_vehicle(vehicle, [h]) for h, _ in moves], training) if two else []
-        slopes = {id(c): (m - c.simulated) / step for c, m, (_, step) in zip(two, moved, moves)}
-        refit = [fit(c.hypothesis, c.simulated - base, base, scorer, slopes.get(id(c))) for c in top]
+        moves = [nudged(c.hypothesis) if len(parameters(c.hypothesis.cause)) > 1 else None for c in top]
+        if any(moves):
+            say(f"  {sum(map(bool, moves))} with a second parameter: run with it moved, to fit it too")
+        moved = iter(rows([extended_vehicle(vehicle, [m[0]]) for m in moves if m], training))
+        refit = [fit(c.hypothesis, c.simulated - base, base, scorer,
+                     None if m is None else (next(moved) - c.simulated) / m[1])
+                 for c, m in zip(top, moves)]
         for a, b in zip(top, refit):
             # the linearised uncertainty ignores the model's nonlinearity; the refit's shift shows it
             b.std = {k: max(s, abs(b.hypothesis.values[k] - a.hypothesis.values[k])) for k, s in b.std.items()}
