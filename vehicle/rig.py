@@ -183,17 +183,15 @@ class KCRig:
         return out
 
     # -- outputs -----------------------------------------------------------------------------
-    def _eq_first_rows(self, ids: np.ndarray) -> np.ndarray:
-        """Index in ``efc_*`` of the first row of each equality ``ids`` (its rows are consecutive)."""
+    def _eq_first_rows(self) -> np.ndarray:
+        """Index in ``efc_*`` of the first row of every equality, -1 where inactive (an equality's
+        rows are consecutive)."""
         d = self.data
         rows = np.flatnonzero(d.efc_type[: d.nefc] == _EQUALITY_ROW)
         first = np.full(self.model.neq, -1)
         eq, at = np.unique(d.efc_id[rows], return_index=True)
         first[eq] = rows[at]
-        return first[ids]
-
-    def _eq_forces(self, ids: np.ndarray, rows: int) -> np.ndarray:
-        return self.data.efc_force[self._eq_first_rows(ids)[:, None] + np.arange(rows)]
+        return first
 
     def ride_height(self) -> float:
         """Height of the body's ride-height point above the ground (pads at zero) [m]."""
@@ -203,10 +201,11 @@ class KCRig:
         point = d.xpos[body] + d.xmat[body].reshape(3, 3) @ np.asarray(self.vehicle.body.ride_height_point)
         return float(point[2])
 
-    def closure_error(self) -> float:
-        """Largest position error of the loop closures [m] (connect, weld position, tie-rod length)."""
+    def _closure_error(self, first_rows: np.ndarray) -> float:
+        """Largest position error of the loop closures [m] (connect, weld position, tie-rod length),
+        from the equalities' first rows (:meth:`_eq_first_rows`)."""
         d = self.data
-        rows = self._eq_first_rows(self.closure_eq)[:, None] + np.arange(3)
+        rows = first_rows[self.closure_eq][:, None] + np.arange(3)
         used = np.arange(3) < self.closure_rows[:, None]  # 3 position rows, 1 for a tendon length
         pos = np.where(used, d.efc_pos[np.minimum(rows, d.nefc - 1)], 0.0)
         return float(np.sqrt((pos * pos).sum(axis=1)).max())
@@ -215,7 +214,8 @@ class KCRig:
         """The rig's outputs at the current state."""
         m, d = self.model, self.data
         mujoco.mj_forward(m, d)
-        fz = self._eq_forces(self.pad_eq, 1)[:, 0]
+        first_rows = self._eq_first_rows()
+        fz = d.efc_force[first_rows[self.pad_eq]]
         wheels = {}
         for k, corner in enumerate(CORNERS):
             sign = _SIGN[corner]
@@ -234,4 +234,4 @@ class KCRig:
             bushing_deflection=c.bushings.deflections(), bushing_force=c.bushings.forces(),
             spring_force=dict(zip((e.name for e in c.springs), c.spring_forces().tolist())),
             damper_force=dict(zip((e.name for e in c.dampers), c.damper_forces().tolist())),
-            closure_error=self.closure_error())
+            closure_error=self._closure_error(first_rows))
