@@ -155,8 +155,9 @@ def test_the_refit_fits_a_second_parameter_along_its_slope_and_keeps_it_in_bound
 
 
 def test_the_verdict_says_which_parameters_the_kc_fit_held():
-    """Only the first parameter is fitted at K&C: the others are reported as held, with no uncertainty,
-    in valid JSON (the uncertainty was NaN)."""
+    """A parameter the K&C fit held (the screen's second parameter, or the refit's when its slope
+    changes nothing the first does not) is reported as held, with no uncertainty, in valid JSON (the
+    uncertainty was NaN)."""
     h = Hypothesis("broad_relaxation", ("e1_front", "y"), {"k1": 60.0, "alpha": 0.16})
     out = _parameters(SimpleNamespace(named=True, best=Candidate(h, 1.0, {"k1": 5.0})))
     assert out["k1"] == {"value": 60.0, "std": 5.0, "unit": "N/mm", "fitted": True}
