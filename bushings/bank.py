@@ -27,7 +27,7 @@ class BushingBank:
     forces [N or N·m] and tangent stiffnesses dF/de. One compiled call serves the whole bank.
     """
 
-    _STATE = ("u", "wprev", "slope", "q", "eprev", "cs", "ck", "stack", "diss", "nfail")
+    _STATE = ("ladder", "q", "eprev", "cs", "ck", "stack", "diss", "nfail")
 
     def __init__(self, channels: Sequence[ChannelParams], tolerance: float = 1e-9):
         """``tolerance`` [m or rad]: the implicit ladder solve stops when every node's force
@@ -36,10 +36,9 @@ class BushingBank:
         M = len(self.channels)
         self.P = np.zeros((M, kn.N_PCOLS))
         self.I = np.zeros((M, kn.N_ICOLS), dtype=np.int64)
-        n_nodes = sum(ch.n_cells for ch in self.channels if not ch.continuous)
         n_mx = sum(len(ch.maxwell_k) for ch in self.channels)
         self.MX = np.zeros((max(n_mx, 1), 2))
-        node, mx = 0, 0
+        mx = 0
         for c, ch in enumerate(self.channels):
             self.P[c, kn.P_K0] = ch.K0
             self.P[c, kn.P_C] = ch.C
@@ -58,17 +57,13 @@ class BushingBank:
                 self.P[c, kn.P_EPS] = 1e-3 * _hysteresis_length(ch)
             else:
                 self.I[c, kn.I_NCELL] = ch.n_cells
-                self.I[c, kn.I_NODE_OFF] = node
-                node += ch.n_cells
             self.I[c, kn.I_MX_N] = len(ch.maxwell_k)
             self.I[c, kn.I_MX_OFF] = mx
             for k, cc in zip(ch.maxwell_k, ch.maxwell_c):
                 self.MX[mx] = (k, cc)
                 mx += 1
-        self._scratch = kn.scratch(max([ch.n_cells for ch in self.channels if not ch.continuous] + [1]))
-        self._shapes = {"u": (max(n_nodes, 1),), "wprev": (max(n_nodes, 1),), "slope": (max(n_nodes, 1),), "q": (max(n_mx, 1),),
-                        "eprev": (M,), "cs": (M, 2), "ck": (M,), "stack": (M, kn.STACK_SIZE, 2),
-                        "diss": (M,), "nfail": (M,)}
+        self._shapes = {"q": (max(n_mx, 1),), "eprev": (M,), "cs": (M, 2), "ck": (M,),
+                        "stack": (M, kn.STACK_SIZE, 2), "diss": (M,), "nfail": (M,)}
         self.force = np.zeros(M)
         self.tangent = np.zeros(M)
         self.reset()
@@ -90,9 +85,9 @@ class BushingBank:
 
     def reset(self) -> None:
         """Return every channel to its virgin, unloaded state at zero deflection."""
-        for name in self._STATE:
-            dtype = np.int64 if name in ("ck", "nfail") else float
-            setattr(self, name, np.zeros(self._shapes[name], dtype=dtype))
+        self.ladder = kn.ladders(self.P, self.I)
+        for name, shape in self._shapes.items():
+            setattr(self, name, np.zeros(shape, dtype=np.int64 if name in ("ck", "nfail") else float))
 
     def snapshot(self) -> BankState:
         """A copy of the internal state."""
@@ -117,8 +112,8 @@ class BushingBank:
     def kernel_args(self) -> tuple[np.ndarray, ...]:
         """The arrays :func:`bushings.kernel.step_bank` takes after (e, h), in its order, for
         compiled callers (e.g. a vehicle step loop) that call the kernel themselves."""
-        return (self.P, self.I, self.MX, self.u, self.wprev, self.slope, self.q, self.eprev, self.cs,
-                self.ck, self.stack, self.diss, self.nfail, self.force, self.tangent, self._scratch)
+        return (self.P, self.I, self.MX, self.ladder, self.q, self.eprev, self.cs, self.ck, self.stack,
+                self.diss, self.nfail, self.force, self.tangent)
 
     def run(self, e: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
         """Step through a deflection history e (T, M) or (T,) for one channel; returns forces and

@@ -27,8 +27,8 @@ P_K0, P_C, P_NSUP, P_NINF, P_SSUP, P_SINF, P_PSUP, P_PINF, P_KPA, P_KR, P_FF, P_
     P_EPS, P_TOL = range(17)
 N_PCOLS = 17
 # Columns of the int parameter matrix I.
-I_KIND, I_NCELL, I_NODE_OFF, I_MX_N, I_MX_OFF = range(5)
-N_ICOLS = 5
+I_KIND, I_NCELL, I_MX_N, I_MX_OFF = range(4)
+N_ICOLS = 4
 KIND_LADDER, KIND_CONTINUOUS = 0, 1
 #: Turning points kept per continuous-STS channel (nested minor loops beyond this are merged).
 STACK_SIZE = 64
@@ -40,22 +40,32 @@ _MAX_NEWTON = 80
 _R_GROW = 0.02
 # Fast-math without 'nnan'/'ninf', so the solver's NaN checks keep working.
 _FAST = {"nsz", "arcp", "contract", "afn", "reassoc"}
-# Rows of the ladder scratch: left spring stiffness of each node (a row rather than a test on the
-# node index, which would make LLVM peel the loops instead of vectorising them), node slips w, slip
-# directions (±1, 0 = stuck), positions u_old + w, power-law forces and slopes, residuals / Newton
-# steps, zero-slip imbalances a0, relative Newton steps, and for the solve: diagonal mantissas and
-# powers of 2 (see _scale_diagonal), reciprocal pivots.
-_KL, _W, _SG, _POS, _PSI, _DFL, _RHS, _A0, _RR, _AP, _SC, _DP = range(12)
-_NROWS = 12
+# Rows of a channel's ladder array, its state and the solver's work rows side by side, so that a
+# step copies nothing in or out: left spring stiffness of each node (a row rather than a test on
+# the node index, which would make LLVM peel the loops instead of vectorising them), node slips w
+# (the last step's on entry), slip directions (±1, 0 = stuck), positions u_old + w, power-law
+# forces and slopes (the last step's on entry, on slipping nodes), residuals / Newton steps,
+# zero-slip imbalances a0, relative Newton steps, for the solve: diagonal mantissas and powers of 2
+# (see _scale_diagonal), reciprocal pivots; and the node positions u.
+_KL, _W, _SG, _POS, _PSI, _DFL, _RHS, _A0, _RR, _AP, _SC, _DP, _U = range(13)
+_NROWS = 13
 # ln 2 split so that k·_LN2_HI is exact for |k| < 2^20.
 _LN2_HI = 6.93147180369123816490e-01
 _LN2_LO = 1.90821492927058770002e-10
 
 
-def scratch(n_cells: int) -> np.ndarray:
-    """Ladder scratch for ladders of up to ``n_cells`` nodes: the rows _KL.._DP, with the input and
-    ground columns and the nodes padded to a multiple of 4 (see _ladder_step)."""
-    return np.zeros((_NROWS, (n_cells + 3) // 4 * 4 + 2))
+def ladders(P: np.ndarray, I: np.ndarray) -> np.ndarray:
+    """The ladder arrays (M, rows, columns) of a bank with parameters P, I, unloaded: one per
+    channel (unused by non-ladder channels), node i in column i + 1, with the input and ground
+    columns and the nodes padded to a multiple of 4 (see _ladder_step)."""
+    n_max = int(I[:, I_NCELL].max(initial=1))
+    L = np.zeros((len(P), _NROWS, (n_max + 3) // 4 * 4 + 2))
+    for c in range(len(P)):
+        n = I[c, I_NCELL]
+        L[c, _KL, 1] = P[c, P_KPA]
+        L[c, _KL, 2:n + 1] = P[c, P_KR]  # padding nodes: no spring to their left, never loaded
+    L[:, _SC] = 1.0
+    return L
 
 
 @nb.njit(cache=True, inline="always", fastmath=_FAST)
@@ -218,37 +228,26 @@ def _grow(n, S, Kr, pw):
 
 
 @nb.njit(cache=True, fastmath=_FAST, error_model="numpy")
-def _ladder_step(e, de, h, n, Kpa, Kr, Ff, Co, pw, tol_x, u, wprev, slope, S):
+def _ladder_step(e, de, h, n, Kpa, Kr, Ff, Co, pw, tol_x, S):
     """Advance one ladder of n nodes to deflection e; returns (F_ladder, dF/de, energy dissipated, ok).
 
     Converged when every node's force residual is below tol_x·(Kpa + 2·Kr), i.e. the nodes are
-    placed to about tol_x [m or rad]. ``S`` is scratch (rows _KL.._DP); node i is column i + 1, and
-    columns 0 and n + 1 onwards hold the boundaries (input, ground), so the node loops need no
-    branches and, run to a multiple of 4 nodes, vectorise whole.
+    placed to about tol_x [m or rad]. ``S`` is the channel's ladder array (see :func:`ladders`);
+    node i is column i + 1, and columns 0 and n + 1 onwards hold the boundaries (input, ground), so
+    the node loops need no branches and, run to a multiple of 4 nodes, vectorise whole. Work rows
+    are written before they are read, except the boundary columns, which stay 0 (1 for _SC).
     """
     # Sliders are released at their threshold to round-off, whatever tol_x: the stick–slip pattern
     # is exact, and a Coulomb ladder (one linear solve per active set) is solved to round-off.
     tol_stick = 1e-13 * (Kpa + 2.0 * Kr)
     tol = tol_x * (Kpa + 2.0 * Kr) if Co > 0.0 else tol_stick
     m = (n + 3) // 4 * 4
-    for j in range(m + 2):
-        S[_KL, j] = Kr if j <= n else 0.0  # padding nodes: no spring to their left, never loaded
-        S[_W, j] = 0.0
-        S[_SG, j] = 0.0
-        S[_POS, j] = 0.0
-        S[_RHS, j] = 0.0
-        S[_SC, j] = 1.0
-        S[_DP, j] = 0.0
-    S[_KL, 1] = Kpa
     S[_POS, 0] = e
     # Predictor: one Newton step from the last increment with the last converged slopes (no
     # transcendental calls): the residual of w = wprev at the new step is Kpa·Δe·δ_i1 − (K·wprev)_i.
     nprev = 0
-    for j in range(1, n + 1):
-        S[_W, j] = wprev[j - 1]
-        S[_SG, j] = 0.0 if wprev[j - 1] == 0.0 else (1.0 if wprev[j - 1] > 0.0 else -1.0)
-        S[_DFL, j] = slope[j - 1]
-        nprev += 0 if wprev[j - 1] == 0.0 else 1
+    for j in range(1, m + 1):
+        nprev += 0 if S[_SG, j] == 0.0 else 1
     if nprev > 0:  # else every node stuck: the step would move none
         for j in range(1, m + 1):
             r = -((S[_KL, j] + Kr) * S[_W, j] - Kr * S[_W, j - 1] - Kr * S[_W, j + 1])
@@ -261,7 +260,7 @@ def _ladder_step(e, de, h, n, Kpa, Kr, Ff, Co, pw, tol_x, u, wprev, slope, S):
     ok = False
     for _ in range(_MAX_NEWTON):
         for j in range(1, n + 1):
-            S[_POS, j] = u[j - 1] + S[_W, j]
+            S[_POS, j] = S[_U, j] + S[_W, j]
         # Spring imbalance ΔF_i = k_left(u_{i-1} − u_i) − Kr(u_i − u_{i+1}) at u = u_old + w, the
         # power law Co·|w/h|^pw and its slope (junk where w = 0, never used), residuals of the
         # slipping nodes; a0 = ΔF + (k_left + Kr)·w: the imbalance the node would have if it did
@@ -352,12 +351,9 @@ def _ladder_step(e, de, h, n, Kpa, Kr, Ff, Co, pw, tol_x, u, wprev, slope, S):
     # slopes of the converged pass. Only the run of slipping nodes from node 1 couples to the input.
     diss = 0.0
     for j in range(1, n + 1):
-        sg = S[_SG, j]
-        if sg != 0.0:
+        if S[_SG, j] != 0.0:
             diss += (Ff + S[_PSI, j]) * abs(S[_W, j])
-        u[j - 1] += S[_W, j]
-        wprev[j - 1] = S[_W, j]
-        slope[j - 1] = S[_DFL, j] if sg != 0.0 else 0.0
+        S[_U, j] += S[_W, j]
     du1 = 0.0
     if S[_SG, 1] != 0.0:
         b = 1
@@ -370,7 +366,7 @@ def _ladder_step(e, de, h, n, Kpa, Kr, Ff, Co, pw, tol_x, u, wprev, slope, S):
         for j in range(b, 0, -1):
             d2, d1 = d1, S[_AP, j] * d1 - (S[_SC, j] * S[_SC, j + 1]) * d2
         du1 = Kpa * d2 / d1 * (S[_SC, 1] / Kr)
-    return Kpa * (e - u[0]), Kpa * (1.0 - du1), diss, ok
+    return Kpa * (e - S[_U, 1]), Kpa * (1.0 - du1), diss, ok
 
 
 @nb.njit(cache=True, inline="always", fastmath=_FAST)
@@ -451,10 +447,10 @@ def _continuous_step(x, Kpa, Ct, nroot, eps, stack, cs, ck):
 
 
 @nb.njit(cache=True, fastmath=_FAST)
-def step_bank(e, h, P, I, MX, u, wprev, slope, q, eprev, cs, ck, stack, diss, nfail, F, K, S):
+def step_bank(e, h, P, I, MX, L, q, eprev, cs, ck, stack, diss, nfail, F, K):
     """Advance all channels of a bank by one step of h seconds to deflections e (in place).
 
-    ``S`` is the ladder scratch, ``scratch(largest ladder)`` (allocated once by the bank, not per call).
+    ``L`` holds the channels' ladders (:func:`ladders`).
     """
     M = e.shape[0]
     for c in range(M):
@@ -470,10 +466,8 @@ def step_bank(e, h, P, I, MX, u, wprev, slope, q, eprev, cs, ck, stack, diss, nf
         if I[c, I_KIND] == KIND_LADDER:
             n = I[c, I_NCELL]
             if n > 0:
-                o = I[c, I_NODE_OFF]
                 fl, kl, dl, ok = _ladder_step(
-                    x, de, h, n, P[c, P_KPA], P[c, P_KR], P[c, P_FF], P[c, P_CO], P[c, P_PW], P[c, P_TOL],
-                    u[o:o + n], wprev[o:o + n], slope[o:o + n], S)
+                    x, de, h, n, P[c, P_KPA], P[c, P_KR], P[c, P_FF], P[c, P_CO], P[c, P_PW], P[c, P_TOL], L[c])
                 f += fl
                 k += kl
                 diss[c] += dl
