@@ -244,7 +244,8 @@ def _ladder_step(e, de, h, n, Kpa, Kr, Ff, Co, pw, tol_x, S):
     m = (n + 3) // 4 * 4
     S[_POS, 0] = e
     # Predictor: one Newton step from the last increment with the last converged slopes (no
-    # transcendental calls): the residual of w = wprev at the new step is Kpa·Δe·δ_i1 − (K·wprev)_i.
+    # transcendental calls): the residual of the last step's slips w_prev (row _W on entry) at the new
+    # step is Kpa·Δe·δ_i1 − (K·w_prev)_i.
     nprev = 0
     for j in range(1, m + 1):
         nprev += 0 if S[_SG, j] == 0.0 else 1
