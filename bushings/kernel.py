@@ -234,8 +234,10 @@ def _ladder_step(e, de, h, n, Kpa, Kr, Ff, Co, pw, tol_x, S):
     Converged when every node's force residual is below tol_x·(Kpa + 2·Kr), i.e. the nodes are
     placed to about tol_x [m or rad]. ``S`` is the channel's ladder array (see :func:`ladders`);
     node i is column i + 1, and columns 0 and n + 1 onwards hold the boundaries (input, ground), so
-    the node loops need no branches and, run to a multiple of 4 nodes, vectorise whole. Work rows
-    are written before they are read, except the boundary columns, which stay 0 (1 for _SC).
+    the node loops need no branches and, run to a multiple of 4 nodes, vectorise whole. The rows
+    carried from step to step are _KL, _W, _SG, _U and _DFL (the predictor reads the last slopes;
+    on stuck nodes they are junk, which the solve never uses); the others are written before they
+    are read, except the boundary columns, which stay 0 (1 for _SC).
     """
     # Sliders are released at their threshold to round-off, whatever tol_x: the stick–slip pattern
     # is exact, and a Coulomb ladder (one linear solve per active set) is solved to round-off.
