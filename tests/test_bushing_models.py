@@ -2,6 +2,11 @@
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
+from pathlib import Path
+
 import numba
 import numpy as np
 import pytest
@@ -277,3 +282,36 @@ def test_continuous_sts_first_loading_and_masing():
     Fb = simulate(ch, np.concatenate([x, back]), 1e-3)[x.size:]
     s = 1.0 * MM - back
     np.testing.assert_allclose(Fb, F[-1] - ch.K0 * s - 2 * (np.sqrt(Ct * (s / 2 + A)) - B), rtol=1e-10, atol=1e-8)
+
+
+_FRESH_OR_CACHED = """
+import sys
+import numpy as np
+from bushings import BushingBank, available_parameter_sets, load_parameter_set
+from bushings import kernel
+channels = [load_parameter_set(name).channel() for name in available_parameter_sets()] * 2
+t = np.arange(0.0, 0.5, 1e-3)[:, None]
+phase = np.linspace(0.0, 2.0 * np.pi, len(channels), endpoint=False)
+e = 1.5e-3 * np.sin(2.0 * np.pi * t + phase) + 0.3e-3 * np.sin(20.0 * np.pi * t + 3.0 * phase)
+forces, tangents = BushingBank(channels).run(e, 1e-3)
+np.save(sys.argv[1], np.stack([forces, tangents]))
+print(len(kernel.step_bank.stats.cache_hits))
+"""
+
+
+def test_kernel_gives_the_same_bits_compiled_fresh_or_loaded_from_cache(tmp_path):
+    """Reproducibility: a run must not depend on whether numba compiled the kernel in this process
+    or loaded it from its cache. Under fast-math the two need not agree: a variant of the ladder
+    solve (eliminating from the ground up) gave results that differed in the last bits between
+    the run that compiled it and the runs after, which a vehicle run would then carry. Every
+    shipped set (all models), in two fresh processes sharing their own numba cache."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"))
+    hits = []
+    for run in ("fresh", "cached"):
+        out = subprocess.run([sys.executable, "-c", _FRESH_OR_CACHED, str(tmp_path / f"{run}.npy")], env=env,
+                             cwd=Path(__file__).parents[1], capture_output=True, text=True, check=True)
+        hits.append(int(out.stdout.split()[-1]))
+    assert hits == [0, 1]  # compiled, then loaded
+    fresh, cached = np.load(tmp_path / "fresh.npy"), np.load(tmp_path / "cached.npy")
+    assert np.abs(fresh[0]).max() > 100.0  # really loaded
+    assert np.array_equal(fresh, cached)
