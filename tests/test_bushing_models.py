@@ -289,11 +289,10 @@ import sys
 import numpy as np
 from bushings import BushingBank, available_parameter_sets, load_parameter_set
 from bushings import kernel
-channels = [load_parameter_set(name).channel() for name in available_parameter_sets()] * 2
-t = np.arange(0.0, 0.5, 1e-3)[:, None]
-phase = np.linspace(0.0, 2.0 * np.pi, len(channels), endpoint=False)
-e = 1.5e-3 * np.sin(2.0 * np.pi * t + phase) + 0.3e-3 * np.sin(20.0 * np.pi * t + 3.0 * phase)
-forces, tangents = BushingBank(channels).run(e, 1e-3)
+from bushings.programmes import multisine
+channels = [load_parameter_set(name).channel() for name in available_parameter_sets()]
+_, e = multisine([1.5e-3, 0.3e-3], [1.0, 10.0], 0.5, 1e-3)  # the thesis's bi-sine, 1.5x
+forces, tangents = BushingBank(channels).run(np.repeat(e[:, None], len(channels), axis=1), 1e-3)
 np.save(sys.argv[1], np.stack([forces, tangents]))
 print(len(kernel.step_bank.stats.cache_hits))
 """
