@@ -36,6 +36,8 @@ def _slow_seeds(spec: str) -> range:
 SLOW_SEEDS = _slow_seeds(os.environ.get("VSIM_SLOW_SEEDS", "20"))
 #: The success rate over all draws that the slow suites require.
 MIN_SUCCESS_RATE = 0.9
+#: The user property in which a success-rate test records its tally (cause, right, draws, wrong seeds).
+TALLY = "diagnosis_tally"
 #: The bench baseline each cause is hidden in: the viscoelastic causes need an STS or RT baseline.
 BASELINES = {"viscoelasticity_missing": "fig5_6_progressive", "viscoelasticity_excess": "fig5_8_progressive"}
 DEFAULT_BASELINE = "fig5_9_progressive"
@@ -75,11 +77,13 @@ def diagnose_fresh(directory: Path, baseline: str, report: Path | None = None) -
     return json.loads(done.stdout)
 
 
-def assert_success_rate(cause: str, seeds: range, tmp: Path, attempt: Callable[[Path, int], None]) -> None:
+def assert_success_rate(cause: str, seeds: range, tmp: Path, attempt: Callable[[Path, int], None],
+                        record: Callable[[str, object], None]) -> None:
     """``attempt(directory, seed)`` for every seed, in a fresh directory each: an AssertionError is a
-    wrong diagnosis (printed with its seed); the rate is printed for the record and must reach
-    MIN_SUCCESS_RATE."""
-    right = 0
+    wrong diagnosis (printed with its seed as it comes); the rate must reach MIN_SUCCESS_RATE.
+    ``record`` is pytest's ``record_property``: the tally goes to the run's summary (tests/conftest.py),
+    which ``pytest -n`` does not swallow as it does what tests print."""
+    right, wrong = 0, []
     for seed in seeds:
         case = tmp / str(seed)
         case.mkdir()
@@ -88,7 +92,9 @@ def assert_success_rate(cause: str, seeds: range, tmp: Path, attempt: Callable[[
             right += 1
             print(f"\n{cause} seed {seed}: right")
         except AssertionError as exc:
+            wrong.append(seed)
             print(f"\n{cause} seed {seed}: wrong: {exc}")
+    record(TALLY, {"cause": cause, "right": right, "draws": len(seeds), "wrong": wrong})
     rate = right / len(seeds)
     print(f"\n{cause}: {right}/{len(seeds)} diagnosed right ({rate:.0%})")
     assert rate >= MIN_SUCCESS_RATE

@@ -86,8 +86,8 @@ def test_mullins_first_loading_is_the_virgin_curve_and_reloading_is_softer():
 
 @pytest.mark.slow
 @pytest.mark.parametrize("cause", BENCH_CAUSES + ["none"])
-def test_success_rate_over_many_seeds(tmp_path, cause):
-    """At least 90 % of 20 draws per cause diagnosed right (the rate is printed for the record)."""
+def test_success_rate_over_many_seeds(tmp_path, record_property, cause):
+    """At least 90 % of 20 draws per cause diagnosed right (the tally goes to the run's summary)."""
     def attempt(case: Path, seed: int) -> None:
         baseline, effects, measured = measure(case, cause, seed)
         result = diagnose_fresh(measured, baseline)
@@ -96,4 +96,4 @@ def test_success_rate_over_many_seeds(tmp_path, cause):
         else:
             _check_named(result, cause, effects)
 
-    assert_success_rate(cause, SLOW_SEEDS, tmp_path, attempt)
+    assert_success_rate(cause, SLOW_SEEDS, tmp_path, attempt, record_property)
