@@ -22,6 +22,8 @@ import math
 import numba as nb
 import numpy as np
 
+from bushings.parameters import MAX_CELLS
+
 # Columns of the float parameter matrix P (one row per channel, SI).
 P_K0, P_C, P_NSUP, P_NINF, P_SSUP, P_SINF, P_PSUP, P_PINF, P_KPA, P_KR, P_FF, P_CO, P_PW, P_CT, P_NROOT, \
     P_EPS, P_TOL = range(17)
@@ -43,28 +45,36 @@ _FAST = {"nsz", "arcp", "contract", "afn", "reassoc"}
 # Rows of a channel's ladder array, its state and the solver's work rows side by side, so that a
 # step copies nothing in or out: left spring stiffness of each node (a row rather than a test on
 # the node index, which would make LLVM peel the loops instead of vectorising them), node slips w
-# (the last step's on entry), slip directions (±1, 0 = stuck), positions u_old + w, power-law
-# forces and slopes (the last step's on entry, on slipping nodes), residuals / Newton steps,
-# zero-slip imbalances a0, relative Newton steps, for the solve: diagonal mantissas and powers of 2
-# (see _scale_diagonal), reciprocal pivots; and the node positions u.
-_KL, _W, _SG, _POS, _PSI, _DFL, _RHS, _A0, _RR, _AP, _SC, _DP, _U = range(13)
-_NROWS = 13
+# (the last step's on entry), slip directions (±1, 0 = stuck), power-law forces and slopes (the
+# last step's on entry, on slipping nodes), residuals / Newton steps, zero-slip imbalances a0,
+# relative Newton steps, for the solve: diagonal mantissas and powers of 2 (see _scale_diagonal),
+# back-substitution factors (see _solve_active); and the node positions u (column 0: the input e).
+#
+# The rows lie _ST apart in one flat array per channel, as offsets added to the node index. A stride
+# known at compile time lets LLVM prove that the rows never overlap (with the runtime stride of a 2-D
+# array it tested every pair of rows before each vector loop); at least 256 elements keeps its
+# store-to-load-forwarding heuristic from narrowing the vectors for the j ± 1 neighbour reads.
+_NROWS = 12
+_ST = 260  # ≥ 256, and ≥ MAX_CELLS padded to a multiple of 4, plus the input and ground columns
+_KL, _W, _SG, _PSI, _DFL, _RHS, _A0, _RR, _AP, _SC, _DP, _U = range(0, _NROWS * _ST, _ST)
+assert (MAX_CELLS + 3) // 4 * 4 + 2 <= _ST, "a row must hold the longest ladder (ladders() writes past it)"
 # ln 2 split so that k·_LN2_HI is exact for |k| < 2^20.
 _LN2_HI = 6.93147180369123816490e-01
 _LN2_LO = 1.90821492927058770002e-10
 
 
 def ladders(P: np.ndarray, I: np.ndarray) -> np.ndarray:
-    """The ladder arrays (M, rows, columns) of a bank with parameters P, I, unloaded: one per
-    channel (unused by non-ladder channels), node i in column i + 1, with the input and ground
+    """The ladder arrays (M, rows × _ST) of a bank with parameters P, I, unloaded: one per channel
+    (unused by non-ladder channels), node i in column i + 1 of each row, with the input and ground
     columns and the nodes padded to a multiple of 4 (see _ladder_step)."""
-    n_max = int(I[:, I_NCELL].max(initial=1))
-    L = np.zeros((len(P), _NROWS, (n_max + 3) // 4 * 4 + 2))
+    if len(I) and I[:, I_NCELL].max() > MAX_CELLS:
+        raise ValueError(f"ladder models take at most {MAX_CELLS} cells, got {I[:, I_NCELL].max()}")
+    L = np.zeros((len(P), _NROWS * _ST))
     for c in range(len(P)):
         n = I[c, I_NCELL]
-        L[c, _KL, 1] = P[c, P_KPA]
-        L[c, _KL, 2:n + 1] = P[c, P_KR]  # padding nodes: no spring to their left, never loaded
-    L[:, _SC] = 1.0
+        L[c, _KL + 1] = P[c, P_KPA]
+        L[c, _KL + 2:_KL + n + 1] = P[c, P_KR]  # padding nodes: no spring to their left, never loaded
+    L[:, _SC:_SC + _ST] = 1.0
     return L
 
 
@@ -162,9 +172,9 @@ def _scale_diagonal(m, S, Kr):
     """Diagonal of K + diag S[_DFL] over Kr (≥ 1), split exactly as S[_AP]·2^e, S[_AP] in [1, 2),
     S[_SC] = 2^-e, on nodes 1..m (K: the ladder stiffness, diagonal k_left + Kr)."""
     for j in range(1, m + 1):
-        b = np.float64((S[_KL, j] + Kr + S[_DFL, j]) / Kr).view(np.int64)
-        S[_AP, j] = np.int64((b & 0x000FFFFFFFFFFFFF) | 0x3FF0000000000000).view(np.float64)
-        S[_SC, j] = np.int64(0x7FE0000000000000 - (b & 0x7FF0000000000000)).view(np.float64)
+        b = np.float64((S[_KL + j] + Kr + S[_DFL + j]) / Kr).view(np.int64)
+        S[_AP + j] = np.int64((b & 0x000FFFFFFFFFFFFF) | 0x3FF0000000000000).view(np.float64)
+        S[_SC + j] = np.int64(0x7FE0000000000000 - (b & 0x7FF0000000000000)).view(np.float64)
 
 
 @nb.njit(cache=True, inline="always", fastmath=_FAST, error_model="numpy")
@@ -175,34 +185,35 @@ def _solve_active(n, m, S, Kr):
     leading minors of each block of slipping nodes: the minors' recurrence chains only multiply-adds,
     and the divisions, off the chain, overlap (a chain of divisions was most of the solve's time).
     The minors are scaled by Kr and by the diagonal's powers of 2, which bounds them within
-    [~4^-n, 2^n] whatever the slopes. The reciprocal pivots are kept in S[_DP] (0 on stuck nodes,
-    which decouples their neighbours), so the back substitution does not divide.
+    [~4^-n, 2^n] whatever the slopes. The forward sweep leaves x_j = S[_DP]·x_{j+1} + S[_RHS] (Kr
+    times the reciprocal pivot, and the eliminated right-hand side over the pivot; 0 on stuck nodes,
+    which decouples their neighbours), so the back substitution's chain is one multiply-add per node.
     """
     _scale_diagonal(m, S, Kr)
     kri = 1.0 / Kr
-    # Recurrences carried in locals, not re-read from S (whose rows LLVM cannot tell apart).
+    # Recurrences carried in locals, not re-read from S.
     d2, d1 = 0.0, 1.0  # minors before node j; (0, 1) starts a block
-    sc = 1.0  # S[_SC, j - 1]
+    sc = 1.0  # S[_SC + j - 1]
     q = 0.0  # reciprocal pivot of node j - 1
     y = 0.0  # eliminated right-hand side of node j - 1
     for j in range(1, n + 1):
-        if S[_SG, j] == 0.0:
-            S[_DP, j] = 0.0
+        if S[_SG + j] == 0.0:
+            S[_DP + j] = 0.0
             d2, d1 = 0.0, 1.0
             q = 0.0
             continue
-        scj = S[_SC, j]
-        d = S[_AP, j] * d1 - (scj * sc) * d2
-        y = S[_RHS, j] + Kr * q * y
+        scj = S[_SC + j]
+        d = S[_AP + j] * d1 - (scj * sc) * d2
+        y = S[_RHS + j] + Kr * q * y
         q = d1 / d * (scj * kri)
-        S[_DP, j] = q
-        S[_RHS, j] = y
+        S[_DP + j] = Kr * q
+        S[_RHS + j] = q * y
         d2, d1 = d1, d
         sc = scj
     x = 0.0
     for j in range(n, 0, -1):
-        x = (Kr * S[_DP, j]) * x + S[_DP, j] * S[_RHS, j]
-        S[_RHS, j] = x
+        x = S[_DP + j] * x + S[_RHS + j]
+        S[_RHS + j] = x
 
 
 @nb.njit(cache=True, inline="always", fastmath=_FAST, error_model="numpy")
@@ -217,14 +228,14 @@ def _grow(n, S, Kr, pw):
     springs alone would take (its damper force can only grow).
     """
     for j in range(1, n + 1):
-        r = S[_RR, j]
-        if S[_SG, j] == 0.0 or r < _R_GROW:
+        r = S[_RR + j]
+        if S[_SG + j] == 0.0 or r < _R_GROW:
             continue
-        dfl = S[_DFL, j]
-        ks = S[_KL, j] + Kr
+        dfl = S[_DFL + j]
+        ks = S[_KL + j] + Kr
         theta = dfl / (ks + dfl)
         g = (1.0 - theta) * r + theta * (math.exp(math.log1p(pw * r) / pw) - 1.0)
-        S[_W, j] *= 1.0 + min(g, r * (ks + dfl) / ks)
+        S[_W + j] *= 1.0 + min(g, r * (ks + dfl) / ks)
 
 
 @nb.njit(cache=True, fastmath=_FAST, error_model="numpy")
@@ -237,33 +248,31 @@ def _ladder_step(e, de, h, n, Kpa, Kr, Ff, Co, pw, tol_x, S):
     the node loops need no branches and, run to a multiple of 4 nodes, vectorise whole. The rows
     carried from step to step are _KL, _W, _SG, _U and _DFL (the predictor reads the last slopes;
     on stuck nodes they are junk, which the solve never uses); the others are written before they
-    are read, except the boundary columns, which stay 0 (1 for _SC).
+    are read, except the boundary columns, which stay 0 (1 for _SC; column 0 of _U takes e).
     """
     # Sliders are released at their threshold to round-off, whatever tol_x: the stick–slip pattern
     # is exact, and a Coulomb ladder (one linear solve per active set) is solved to round-off.
     tol_stick = 1e-13 * (Kpa + 2.0 * Kr)
     tol = tol_x * (Kpa + 2.0 * Kr) if Co > 0.0 else tol_stick
     m = (n + 3) // 4 * 4
-    S[_POS, 0] = e
+    S[_U + 0] = e  # the input: column 0 of the positions u_old + w (w = 0 there)
     # Predictor: one Newton step from the last increment with the last converged slopes (no
     # transcendental calls): the residual of the last step's slips w_prev (row _W on entry) at the new
     # step is Kpa·Δe·δ_i1 − (K·w_prev)_i.
     nprev = 0
     for j in range(1, m + 1):
-        nprev += 0 if S[_SG, j] == 0.0 else 1
+        nprev += 0 if S[_SG + j] == 0.0 else 1
     if nprev > 0:  # else every node stuck: the step would move none
         for j in range(1, m + 1):
-            r = -((S[_KL, j] + Kr) * S[_W, j] - Kr * S[_W, j - 1] - Kr * S[_W, j + 1])
-            S[_RHS, j] = r if S[_SG, j] != 0.0 else 0.0
-        S[_RHS, 1] += Kpa * de if S[_SG, 1] != 0.0 else 0.0
+            r = -((S[_KL + j] + Kr) * S[_W + j] - Kr * S[_W + j - 1] - Kr * S[_W + j + 1])
+            S[_RHS + j] = r if S[_SG + j] != 0.0 else 0.0
+        S[_RHS + 1] += Kpa * de if S[_SG + 1] != 0.0 else 0.0
         _solve_active(n, m, S, Kr)
         for j in range(1, m + 1):
-            wn = S[_W, j] + S[_RHS, j]
-            S[_W, j] = wn if wn * S[_SG, j] > 0.0 else S[_W, j]
+            wn = S[_W + j] + S[_RHS + j]
+            S[_W + j] = wn if wn * S[_SG + j] > 0.0 else S[_W + j]
     ok = False
     for _ in range(_MAX_NEWTON):
-        for j in range(1, n + 1):
-            S[_POS, j] = S[_U, j] + S[_W, j]
         # Spring imbalance ΔF_i = k_left(u_{i-1} − u_i) − Kr(u_i − u_{i+1}) at u = u_old + w, the
         # power law Co·|w/h|^pw and its slope (junk where w = 0, never used), residuals of the
         # slipping nodes; a0 = ΔF + (k_left + Kr)·w: the imbalance the node would have if it did
@@ -271,16 +280,17 @@ def _ladder_step(e, de, h, n, Kpa, Kr, Ff, Co, pw, tol_x, S):
         nslip = 0  # slipping nodes whose residual is above tol (or NaN)
         nstuck = 0  # stuck nodes whose imbalance is above the slider threshold
         for j in range(1, m + 1):
-            kl = S[_KL, j]
-            df = kl * (S[_POS, j - 1] - S[_POS, j]) - Kr * (S[_POS, j] - S[_POS, j + 1])
-            S[_A0, j] = df + (kl + Kr) * S[_W, j]
-            aw = abs(S[_W, j]) if S[_W, j] != 0.0 else h
+            kl = S[_KL + j]
+            pos = S[_U + j] + S[_W + j]
+            df = kl * ((S[_U + j - 1] + S[_W + j - 1]) - pos) - Kr * (pos - (S[_U + j + 1] + S[_W + j + 1]))
+            S[_A0 + j] = df + (kl + Kr) * S[_W + j]
+            aw = abs(S[_W + j]) if S[_W + j] != 0.0 else h
             f = Co * _pow(aw / h, pw) if Co > 0.0 else 0.0
-            S[_PSI, j] = f
-            S[_DFL, j] = pw * f / aw
-            sg = S[_SG, j]
+            S[_PSI + j] = f
+            S[_DFL + j] = pw * f / aw
+            sg = S[_SG + j]
             r = df - sg * (Ff + f)
-            S[_RHS, j] = r if sg != 0.0 else 0.0
+            S[_RHS + j] = r if sg != 0.0 else 0.0
             nslip += 0 if sg == 0.0 or abs(r) <= tol else 1
             nstuck += 0 if sg != 0.0 or abs(df) <= Ff + tol_stick else 1  # padding: unloaded
         if nslip + nstuck == 0:
@@ -292,17 +302,17 @@ def _ladder_step(e, de, h, n, Kpa, Kr, Ff, Co, pw, tol_x, S):
             nreleased = 0
             dwl = 0.0
             for j in range(1, n + 1):
-                if S[_SG, j] != 0.0:
+                if S[_SG + j] != 0.0:
                     dwl = 0.0
                     continue
-                df = S[_A0, j] + Kr * dwl
+                df = S[_A0 + j] + Kr * dwl
                 dwl = 0.0
                 if abs(df) > Ff + tol_stick:
                     sg = 1.0 if df > 0.0 else -1.0
-                    wr = sg * _release(df, S[_KL, j] + Kr, h, Ff, Co, pw)
+                    wr = sg * _release(df, S[_KL + j] + Kr, h, Ff, Co, pw)
                     if wr != 0.0:  # else: slip below float range, the node is stuck for all purposes
-                        S[_W, j] = wr
-                        S[_SG, j] = sg
+                        S[_W + j] = wr
+                        S[_SG + j] = sg
                         nreleased += 1
                         dwl = wr
             if nreleased > 0:
@@ -314,23 +324,23 @@ def _ladder_step(e, de, h, n, Kpa, Kr, Ff, Co, pw, tol_x, S):
             # to within the solve's round-off, sticks and is re-checked (and released if it must)
             # at the next pass. (Left slipping at a round-off speed, it would creep.)
             for j in range(1, m + 1):
-                w = S[_W, j]
-                r = S[_RHS, j] / (w if w != 0.0 else 1.0)
-                S[_W, j] = w + S[_RHS, j] if r > -1.0 + 1e-10 else 0.0
-                S[_SG, j] = S[_SG, j] if r > -1.0 + 1e-10 else 0.0
+                w = S[_W + j]
+                r = S[_RHS + j] / (w if w != 0.0 else 1.0)
+                S[_W + j] = w + S[_RHS + j] if r > -1.0 + 1e-10 else 0.0
+                S[_SG + j] = S[_SG + j] if r > -1.0 + 1e-10 else 0.0
             continue
         nfix = 0
         for j in range(1, m + 1):
-            w = S[_W, j]
-            d = S[_RHS, j]
+            w = S[_W + j]
+            d = S[_RHS + j]
             r = d / (w if w != 0.0 else 1.0)
-            S[_RR, j] = r
+            S[_RR + j] = r
             # Growing: Newton's step, or _grow's if large. Shrinking: where the power law dominates
             # the node's stiffness (weight theta), step towards log|w| (w·e^r, here its Padé
             # form), which does not overshoot towards zero as the linear step (w·(1 + r)) does.
-            theta = S[_DFL, j] / (S[_KL, j] + Kr + S[_DFL, j])
+            theta = S[_DFL + j] / (S[_KL + j] + Kr + S[_DFL + j])
             wp = w * (1.0 + r * (1.0 - 0.5 * theta)) / (1.0 - 0.5 * theta * r)
-            S[_W, j] = (w + d if r < _R_GROW else w) if r >= 0.0 else wp
+            S[_W + j] = (w + d if r < _R_GROW else w) if r >= 0.0 else wp
             nfix += 1 if r >= _R_GROW or r <= -0.9 else 0  # one counter: with two, no vectorising
         if nfix == 0:
             continue
@@ -339,37 +349,37 @@ def _ladder_step(e, de, h, n, Kpa, Kr, Ff, Co, pw, tol_x, S):
         # replace their step by the one-node return map with the neighbours held, which sticks
         # the node, restarts it in the other direction, or gives a slip inside the bracket.
         for j in range(1, n + 1):
-            if S[_SG, j] == 0.0 or S[_RR, j] > -0.9:
+            if S[_SG + j] == 0.0 or S[_RR + j] > -0.9:
                 continue
-            a0 = S[_A0, j]
-            S[_W, j] = 0.0
-            S[_SG, j] = 0.0
+            a0 = S[_A0 + j]
+            S[_W + j] = 0.0
+            S[_SG + j] = 0.0
             if abs(a0) > Ff + tol_stick:
                 sg = 1.0 if a0 > 0.0 else -1.0
-                wr = sg * _release(a0, S[_KL, j] + Kr, h, Ff, Co, pw)
+                wr = sg * _release(a0, S[_KL + j] + Kr, h, Ff, Co, pw)
                 if wr != 0.0:
-                    S[_W, j] = wr
-                    S[_SG, j] = sg
+                    S[_W + j] = wr
+                    S[_SG + j] = sg
     # Consistent tangent: du_1/de = Kpa·[A⁻¹]_11 on the final slipping set, with the damper
     # slopes of the converged pass. Only the run of slipping nodes from node 1 couples to the input.
     diss = 0.0
     for j in range(1, n + 1):
-        if S[_SG, j] != 0.0:
-            diss += (Ff + S[_PSI, j]) * abs(S[_W, j])
-        S[_U, j] += S[_W, j]
+        if S[_SG + j] != 0.0:
+            diss += (Ff + S[_PSI + j]) * abs(S[_W + j])
+        S[_U + j] += S[_W + j]
     du1 = 0.0
-    if S[_SG, 1] != 0.0:
+    if S[_SG + 1] != 0.0:
         b = 1
-        while b < n and S[_SG, b + 1] != 0.0:
+        while b < n and S[_SG + b + 1] != 0.0:
             b += 1
         # [A⁻¹]_11 = (minor of nodes 2..b)/(minor of nodes 1..b), the minors from the bottom up,
         # scaled as in _solve_active.
         _scale_diagonal(m, S, Kr)
         d2, d1 = 0.0, 1.0
         for j in range(b, 0, -1):
-            d2, d1 = d1, S[_AP, j] * d1 - (S[_SC, j] * S[_SC, j + 1]) * d2
-        du1 = Kpa * d2 / d1 * (S[_SC, 1] / Kr)
-    return Kpa * (e - S[_U, 1]), Kpa * (1.0 - du1), diss, ok
+            d2, d1 = d1, S[_AP + j] * d1 - (S[_SC + j] * S[_SC + j + 1]) * d2
+        du1 = Kpa * d2 / d1 * (S[_SC + 1] / Kr)
+    return Kpa * (e - S[_U + 1]), Kpa * (1.0 - du1), diss, ok
 
 
 @nb.njit(cache=True, inline="always", fastmath=_FAST)

@@ -27,6 +27,8 @@ PARAMETER_SET_DIR = Path(__file__).resolve().parent.parent / "models" / "bushing
 
 #: Number of ladder cells when a set does not say (the thesis's choice for 0.05–2 mm).
 DEFAULT_CELLS = 15
+#: Most ladder cells a channel may have (the kernel's ladder rows are sized for it).
+MAX_CELLS = 200
 
 # Each parameter's dimension as (power of length) so that value_SI = value_user * L**power, where
 # L is the length unit in SI (1e-3 m per mm, pi/180 rad per deg). Force units need no conversion
@@ -141,8 +143,8 @@ def to_si(model: str, values: Mapping[str, Any], quantity: str = "translation",
             continue
         value = _number(raw, source, key)
         if key == "N":
-            if value != int(value) or not 1 <= value <= 200:
-                raise InputError(f"expected a whole number of cells in 1..200, got {raw!r}",
+            if value != int(value) or not 1 <= value <= MAX_CELLS:
+                raise InputError(f"expected a whole number of cells in 1..{MAX_CELLS}, got {raw!r}",
                                  source=source, key=key)
             si["n_cells"] = int(value)
             continue

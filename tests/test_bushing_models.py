@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import numba
@@ -12,14 +13,18 @@ import numpy as np
 import pytest
 
 from bushings import BushingBank
+from bushings.parameters import MAX_CELLS
 from bushings.reference import explicit_reference
 from tests.bushing_helpers import channel, inline, simulate, sts_first_loading, triangle
 
 MM = 1e-3
 
 
-def test_sts_first_loading_and_branch_match_closed_form():
+@pytest.mark.parametrize("cells", [None, MAX_CELLS])
+def test_sts_first_loading_and_branch_match_closed_form(cells):
     ch = channel("fig3_14")
+    if cells:  # the longest ladder a channel may have, with every slider slipping by 0.8 mm
+        ch = replace(ch, n_cells=cells, Ff=0.04)
     path = triangle([1.5 * MM, -1.0 * MM], n_per_mm=3000)
     F = simulate(ch, path, 1e-3)
     k = int(np.argmax(path))
@@ -29,6 +34,11 @@ def test_sts_first_loading_and_branch_match_closed_form():
     xr, fr = path[k], F[k]
     down = fr - 2.0 * sts_first_loading(ch, (xr - path[k:]) / 2.0)
     assert np.max(np.abs(F[k:] - down) / np.maximum(np.abs(F[k:]), 1.0)) < 1e-6
+
+
+def test_ladders_longer_than_the_kernel_takes_are_refused():
+    with pytest.raises(ValueError, match=f"at most {MAX_CELLS} cells"):
+        BushingBank([replace(channel("fig3_14"), n_cells=MAX_CELLS + 1)])
 
 
 def test_sts_tangents_follow_c8():
