@@ -67,8 +67,9 @@ def ladders(P: np.ndarray, I: np.ndarray) -> np.ndarray:
     """The ladder arrays (M, rows × _ST) of a bank with parameters P, I, unloaded: one per channel
     (unused by non-ladder channels), node i in column i + 1 of each row, with the input and ground
     columns and the nodes padded to a multiple of 4 (see _ladder_step)."""
-    if len(I) and I[:, I_NCELL].max() > MAX_CELLS:
-        raise ValueError(f"ladder models take at most {MAX_CELLS} cells, got {I[:, I_NCELL].max()}")
+    n_max = int(I[:, I_NCELL].max(initial=0))
+    if n_max > MAX_CELLS:
+        raise ValueError(f"ladder models take at most {MAX_CELLS} cells, got {n_max}")
     L = np.zeros((len(P), _NROWS * _ST))
     for c in range(len(P)):
         n = I[c, I_NCELL]
