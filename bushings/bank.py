@@ -34,10 +34,13 @@ class BushingBank:
         residual is below tolerance·(Kpa + 2·Kr), i.e. nodes are placed to about this distance."""
         self.channels: tuple[ChannelParams, ...] = tuple(channels)
         M = len(self.channels)
-        self.P = np.zeros((M, kn.N_PCOLS))
-        self.I = np.zeros((M, kn.N_ICOLS), dtype=np.int64)
-        n_mx = sum(len(ch.maxwell_k) for ch in self.channels)
-        self.MX = np.zeros((max(n_mx, 1), 2))
+        n_mx = max(sum(len(ch.maxwell_k) for ch in self.channels), 1)
+        cells = np.array([0 if ch.continuous else ch.n_cells for ch in self.channels], dtype=np.int64)
+        ladder_at, ladder_size = kn.place_ladders(cells)
+        self._shapes = {"P": (M, kn.N_PCOLS), "I": (M, kn.N_ICOLS), "MX": (n_mx, 2), "ladder": (ladder_size,),
+                        "q": (n_mx,), "eprev": (M,), "cs": (M, 2), "ck": (M,), "stack": (M, kn.STACK_SIZE, 2),
+                        "diss": (M,), "nfail": (M,), "force": (M,), "tangent": (M,)}
+        self._allocate()
         mx = 0
         for c, ch in enumerate(self.channels):
             self.P[c, kn.P_K0] = ch.K0
@@ -55,18 +58,20 @@ class BushingBank:
                 self.I[c, kn.I_KIND] = kn.KIND_CONTINUOUS
                 # Micro-reversal filter: 1e-3 of the length over which the branch slope halves.
                 self.P[c, kn.P_EPS] = 1e-3 * _hysteresis_length(ch)
-            else:
-                self.I[c, kn.I_NCELL] = ch.n_cells
+            self.I[c, kn.I_NCELL] = cells[c]
+            self.I[c, kn.I_LADDER] = ladder_at[c]
             self.I[c, kn.I_MX_N] = len(ch.maxwell_k)
             self.I[c, kn.I_MX_OFF] = mx
             for k, cc in zip(ch.maxwell_k, ch.maxwell_c):
                 self.MX[mx] = (k, cc)
                 mx += 1
-        self._shapes = {"q": (max(n_mx, 1),), "eprev": (M,), "cs": (M, 2), "ck": (M,),
-                        "stack": (M, kn.STACK_SIZE, 2), "diss": (M,), "nfail": (M,)}
-        self.force = np.zeros(M)
-        self.tangent = np.zeros(M)
         self.reset()
+
+    def _allocate(self) -> None:
+        """New arrays of step_bank, as views of the two buffers that a step passes to the kernel."""
+        self._fbuf, self._ibuf, arrays = kn.pack_bank(self._shapes)
+        for name, array in arrays.items():
+            setattr(self, name, array)
 
     @property
     def size(self) -> int:
@@ -85,9 +90,13 @@ class BushingBank:
 
     def reset(self) -> None:
         """Return every channel to its virgin, unloaded state at zero deflection."""
-        self.ladder = kn.ladders(self.P, self.I)
-        for name, shape in self._shapes.items():
-            setattr(self, name, np.zeros(shape, dtype=np.int64 if name in ("ck", "nfail") else float))
+        # New arrays rather than zeroing in place, as before the arrays were packed: a compiled caller
+        # that kept the old ones (the vehicle's coupling caches kernel_args()) steps on with them.
+        params = {name: getattr(self, name) for name in ("P", "I", "MX")}
+        self._allocate()
+        for name, values in params.items():
+            getattr(self, name)[...] = values
+        kn.reset_ladders(self.ladder, self.P, self.I)
 
     def snapshot(self) -> BankState:
         """A copy of the internal state."""
@@ -106,7 +115,7 @@ class BushingBank:
         """
         if not dt > 0.0:
             raise ValueError(f"time step must be positive, got {dt!r}")
-        kn.step_bank(np.ascontiguousarray(e, dtype=float), float(dt), *self.kernel_args())
+        kn.step_packed(np.ascontiguousarray(e, dtype=float), float(dt), self._fbuf, self._ibuf)
         return self.force, self.tangent
 
     def kernel_args(self) -> tuple[np.ndarray, ...]:

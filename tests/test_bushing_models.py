@@ -12,7 +12,7 @@ import numba
 import numpy as np
 import pytest
 
-from bushings import BushingBank
+from bushings import BushingBank, kernel
 from bushings.parameters import MAX_CELLS
 from bushings.reference import explicit_reference
 from tests.bushing_helpers import channel, inline, simulate, sts_first_loading, triangle
@@ -208,9 +208,11 @@ def test_large_steps_are_stable(name, amp_mm, freq_hz):
 
 
 def test_mixed_bank_equals_separate_banks():
+    # The long ladders do not fit beside the others in one block of the ladder array.
     chans = [channel("fig5_9"), channel("fig3_14"), channel("fig5_8"), channel("table3_2"),
              channel("fig3_14", "sts_continuous"), inline("linear", K0=300.0, C=0.5),
-             inline("tvs", K0=500.0, Kpa=1000.0, Kr=3000.0, Ff=20.0, maxwell_k=[100.0, 50.0], maxwell_c=[1.0, 10.0])]
+             inline("tvs", K0=500.0, Kpa=1000.0, Kr=3000.0, Ff=20.0, maxwell_k=[100.0, 50.0], maxwell_c=[1.0, 10.0]),
+             replace(channel("fig5_9"), n_cells=150), replace(channel("fig5_8"), n_cells=MAX_CELLS), channel("fig5_8")]
     t = np.arange(0.0, 1.0, 1e-3)
     e = np.stack([(0.5 + 0.2 * i) * MM * np.sin(2 * np.pi * (1 + i) * t) for i in range(len(chans))], axis=1)
     F, K = BushingBank(chans).run(e, 1e-3)
@@ -218,6 +220,29 @@ def test_mixed_bank_equals_separate_banks():
         Fi, Ki = BushingBank([ch]).run(e[:, i], 1e-3)
         np.testing.assert_array_equal(F[:, i], Fi)
         np.testing.assert_array_equal(K[:, i], Ki)
+
+
+def test_ladders_are_placed_side_by_side_without_overlap():
+    cells = [15, 0, 3, 200, 15, 150, 1, 200, 0] + [15] * 30
+    offsets, size = kernel.place_ladders(np.array(cells))
+    block = kernel._NROWS * kernel._ST
+    spans = sorted((o, o + kernel._width(n), n) for o, n in zip(offsets, cells) if n > 0)
+    for (_, end, _), (start, _, _) in zip(spans, spans[1:]):
+        assert end <= start
+    for start, end, n in spans:
+        assert end - start >= (n + 3) // 4 * 4 + 2  # input column, nodes padded to 4, ground column
+        assert start % block + (end - start) <= kernel._ST  # in its block's first row; the others follow
+    assert spans[-1][1] <= size <= 6 * block  # 37 ladders in 6 blocks, rather than one each
+
+
+def test_a_step_with_the_wrong_number_of_deflections_is_refused():
+    bank = BushingBank([channel("fig5_9")] * 3)
+    bank.step(np.full(3, 0.5 * MM), 1e-3)
+    before = bank.snapshot()
+    with pytest.raises(ValueError, match="one entry per channel"):
+        bank.step(np.zeros(2), 1e-3)
+    for name, array in before.arrays.items():  # nothing stepped
+        np.testing.assert_array_equal(getattr(bank, name), array)
 
 
 @pytest.mark.parametrize("name,model", [("fig5_9", None), ("fig5_8", None), ("fig3_14", None),
@@ -304,7 +329,7 @@ channels = [load_parameter_set(name).channel() for name in available_parameter_s
 _, e = multisine([1.5e-3, 0.3e-3], [1.0, 10.0], 0.5, 1e-3)  # the thesis's bi-sine, 1.5x
 forces, tangents = BushingBank(channels).run(np.repeat(e[:, None], len(channels), axis=1), 1e-3)
 np.save(sys.argv[1], np.stack([forces, tangents]))
-print(len(kernel.step_bank.stats.cache_hits))
+print(len(kernel.step_packed.stats.cache_hits))
 """
 
 
