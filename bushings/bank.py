@@ -121,8 +121,7 @@ class BushingBank:
     def kernel_args(self) -> tuple[np.ndarray, ...]:
         """The arrays :func:`bushings.kernel.step_bank` takes after (e, h), in its order, for
         compiled callers (e.g. a vehicle step loop) that call the kernel themselves."""
-        return (self.P, self.I, self.MX, self.ladder, self.q, self.eprev, self.cs, self.ck, self.stack,
-                self.diss, self.nfail, self.force, self.tangent)
+        return tuple(getattr(self, name) for name, _, _ in kn.BANK_ARRAYS)
 
     def run(self, e: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
         """Step through a deflection history e (T, M) or (T,) for one channel; returns forces and

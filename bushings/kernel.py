@@ -515,8 +515,8 @@ def step_bank(e, h, P, I, MX, L, q, eprev, cs, ck, stack, diss, nfail, F, K):
         if I[c, I_KIND] == KIND_LADDER:
             n = I[c, I_NCELL]
             if n > 0:
-                fl, kl, dl, ok = _ladder_step(
-                    x, de, h, n, P[c, P_KPA], P[c, P_KR], P[c, P_FF], P[c, P_CO], P[c, P_PW], P[c, P_TOL], L[I[c, I_LADDER]:])
+                fl, kl, dl, ok = _ladder_step(x, de, h, n, P[c, P_KPA], P[c, P_KR], P[c, P_FF], P[c, P_CO],
+                                              P[c, P_PW], P[c, P_TOL], L[I[c, I_LADDER]:])
                 f += fl
                 k += kl
                 diss[c] += dl
