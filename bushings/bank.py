@@ -37,10 +37,12 @@ class BushingBank:
         n_mx = max(sum(len(ch.maxwell_k) for ch in self.channels), 1)
         cells = np.array([0 if ch.continuous else ch.n_cells for ch in self.channels], dtype=np.int64)
         ladder_at, ladder_size = kn.place_ladders(cells)
-        self._shapes = {"P": (M, kn.N_PCOLS), "I": (M, kn.N_ICOLS), "MX": (n_mx, 2), "ladder": (ladder_size,),
-                        "q": (n_mx,), "eprev": (M,), "cs": (M, 2), "ck": (M,), "stack": (M, kn.STACK_SIZE, 2),
-                        "diss": (M,), "nfail": (M,), "force": (M,), "tangent": (M,)}
-        self._allocate()
+        shapes = {"P": (M, kn.N_PCOLS), "I": (M, kn.N_ICOLS), "MX": (n_mx, 2), "ladder": (ladder_size,),
+                  "q": (n_mx,), "eprev": (M,), "cs": (M, 2), "ck": (M,), "stack": (M, kn.STACK_SIZE, 2),
+                  "diss": (M,), "nfail": (M,), "force": (M,), "tangent": (M,)}
+        self._fbuf, self._ibuf, arrays = kn.pack_bank(shapes)
+        for name, array in arrays.items():
+            setattr(self, name, array)
         mx = 0
         for c, ch in enumerate(self.channels):
             self.P[c, kn.P_K0] = ch.K0
@@ -67,12 +69,6 @@ class BushingBank:
                 mx += 1
         self.reset()
 
-    def _allocate(self) -> None:
-        """New arrays of step_bank, as views of the two buffers that a step passes to the kernel."""
-        self._fbuf, self._ibuf, arrays = kn.pack_bank(self._shapes)
-        for name, array in arrays.items():
-            setattr(self, name, array)
-
     @property
     def size(self) -> int:
         """Number of channels M."""
@@ -90,12 +86,9 @@ class BushingBank:
 
     def reset(self) -> None:
         """Return every channel to its virgin, unloaded state at zero deflection."""
-        # New arrays rather than zeroing in place, as before the arrays were packed: a compiled caller
-        # that kept the old ones (the vehicle's coupling caches kernel_args()) steps on with them.
-        params = {name: getattr(self, name) for name in ("P", "I", "MX")}
-        self._allocate()
-        for name, values in params.items():
-            getattr(self, name)[...] = values
+        # In place: compiled callers keep the arrays of kernel_args() (the vehicle's coupling does).
+        for name in self._STATE + ("force", "tangent"):
+            getattr(self, name)[...] = 0
         kn.reset_ladders(self.ladder, self.P, self.I)
 
     def snapshot(self) -> BankState:
