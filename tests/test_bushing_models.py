@@ -245,6 +245,30 @@ def test_a_step_with_the_wrong_number_of_deflections_is_refused():
         np.testing.assert_array_equal(getattr(bank, name), array)
 
 
+def test_reset_returns_the_arrays_compiled_callers_hold_to_the_virgin_state():
+    """A compiled caller (the vehicle's step loop) keeps the arrays of kernel_args(); after reset()
+    the steps it takes with them are those of a new bank (STVS ladder, continuous STS memory,
+    Maxwell branches), whereas the same path run on without reset gives other forces."""
+    tvs = inline("tvs", K0=500.0, Kpa=1000.0, Kr=3000.0, Ff=20.0, maxwell_k=[100.0, 50.0], maxwell_c=[1.0, 10.0])
+    channels = [channel("fig5_9"), channel("fig3_14", "sts_continuous"), tvs]
+    path = np.outer(np.sin(np.linspace(0.0, 3.0 * np.pi, 200)), [1.0, -0.6, 0.8]) * MM
+
+    def forces(args: tuple) -> np.ndarray:
+        out = []
+        for e in path:
+            kernel.step_bank(e, 1e-3, *args)
+            out.append(args[-2].copy())  # the force array
+        return np.array(out)
+
+    bank = BushingBank(channels)
+    held = bank.kernel_args()
+    fresh = forces(held)
+    continued = forces(held)
+    bank.reset()
+    np.testing.assert_array_equal(forces(held), fresh)
+    assert (np.abs(continued - fresh).max(axis=0) > 0.1).all()  # N: every channel remembers the first run
+
+
 @pytest.mark.parametrize("name,model", [("fig5_9", None), ("fig5_8", None), ("fig3_14", None),
                                         ("table3_2", None), ("fig3_14", "sts_continuous")])
 def test_tangent_is_the_derivative_of_the_step(name, model):
