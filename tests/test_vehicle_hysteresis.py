@@ -1,9 +1,10 @@
 """STVS camber loops in pumping (issue 3): non-zero width that changes with speed; none when linear.
 
 Pumping triangle 0 → +60 → −60 → +60 mm (vehicle.kc.run_triangle) at 1.5 and 15 mm/s and at
-0.1 Hz (24 mm/s), the loop width taken at design height. The strut dampers are removed: their viscous loop, of opposite
-orientation, is as wide as the bushings' rate-dependent part at 15 mm/s (1.3e-3 deg measured) and
-would hide it. h = 5 ms: quasi-static, and the branches move < 0.001 deg from h = 1 ms (measured).
+0.1 Hz (24 mm/s), the loop width taken at design height. The strut dampers are removed: their
+viscous loop (1.3e-3 deg measured at 15 mm/s) is wider than the change the bushings' rate
+dependence makes (4e-4 deg at the front) and would hide it. h = 5 ms: quasi-static, and the
+branches move < 0.001 deg from h = 1 ms (measured).
 """
 
 from __future__ import annotations
