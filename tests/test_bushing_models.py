@@ -18,6 +18,8 @@ from bushings.reference import explicit_reference
 from tests.bushing_helpers import channel, inline, simulate, sts_first_loading, triangle
 
 MM = 1e-3
+#: A TVS channel: a ladder with two Maxwell branches beside it.
+TVS = inline("tvs", K0=500.0, Kpa=1000.0, Kr=3000.0, Ff=20.0, maxwell_k=[100.0, 50.0], maxwell_c=[1.0, 10.0])
 
 
 @pytest.mark.parametrize("cells", [None, MAX_CELLS])
@@ -211,7 +213,7 @@ def test_mixed_bank_equals_separate_banks():
     # The long ladders do not fit beside the others in one block of the ladder array.
     chans = [channel("fig5_9"), channel("fig3_14"), channel("fig5_8"), channel("table3_2"),
              channel("fig3_14", "sts_continuous"), inline("linear", K0=300.0, C=0.5),
-             inline("tvs", K0=500.0, Kpa=1000.0, Kr=3000.0, Ff=20.0, maxwell_k=[100.0, 50.0], maxwell_c=[1.0, 10.0]),
+             TVS,
              replace(channel("fig5_9"), n_cells=150), replace(channel("fig5_8"), n_cells=MAX_CELLS), channel("fig5_8")]
     t = np.arange(0.0, 1.0, 1e-3)
     e = np.stack([(0.5 + 0.2 * i) * MM * np.sin(2 * np.pi * (1 + i) * t) for i in range(len(chans))], axis=1)
@@ -249,8 +251,7 @@ def test_reset_returns_the_arrays_compiled_callers_hold_to_the_virgin_state():
     """A compiled caller (the vehicle's step loop) keeps the arrays of kernel_args(); after reset()
     the steps it takes with them are those of a new bank (STVS ladder, continuous STS memory,
     Maxwell branches), whereas the same path run on without reset gives other forces."""
-    tvs = inline("tvs", K0=500.0, Kpa=1000.0, Kr=3000.0, Ff=20.0, maxwell_k=[100.0, 50.0], maxwell_c=[1.0, 10.0])
-    channels = [channel("fig5_9"), channel("fig3_14", "sts_continuous"), tvs]
+    channels = [channel("fig5_9"), channel("fig3_14", "sts_continuous"), TVS]
     path = np.outer(np.sin(np.linspace(0.0, 3.0 * np.pi, 200)), [1.0, -0.6, 0.8]) * MM
 
     def forces(args: tuple) -> np.ndarray:
