@@ -26,7 +26,7 @@ import numpy as np
 from numba.core import caching
 
 from bushings import kernel as kn
-from bushings.bank import BushingBank
+from bushings.bank import DEFAULT_TOLERANCE, BushingBank
 from bushings.errors import InputError
 from bushings.parameters import LENGTH_UNIT_SI, ChannelParams
 
@@ -230,7 +230,7 @@ class ExtendedBank:
     """
 
     def __init__(self, channels: Sequence[ChannelParams], effects: Sequence[Effects] | None = None,
-                 tolerance: float = 1e-9):
+                 tolerance: float = DEFAULT_TOLERANCE):
         self.bank = BushingBank(channels, tolerance)
         effects = list(effects) if effects is not None else [NO_EFFECTS] * self.bank.size
         if len(effects) != self.bank.size:

@@ -196,6 +196,24 @@ def test_implicit_converges_to_explicit_reference_at_least_linearly():
     assert np.all(ratios > 1.7), (errs, ratios)  # halving the step at least (nearly) halves the error
 
 
+def test_default_solver_tolerance_errs_far_less_than_the_time_step():
+    """At h = 1 ms under the benchmark's load, the default tolerance (nodes placed to 10 nm) moves
+    the force by less than a fifteenth of the step's own discretisation error, and the solver's
+    error shrinks with its tolerance."""
+    ch = channel("fig5_9")
+    h, sub = 1e-3, 20
+    t = np.arange(0.0, 1.0 + h / (2 * sub), h / sub)
+    e = 1e-3 * np.sin(2 * np.pi * t) + 0.2e-3 * np.sin(2 * np.pi * 10 * t)
+    fine = BushingBank([ch], tolerance=1e-12).run(e, h / sub)[0][::sub]
+    exact_solve = BushingBank([ch], tolerance=1e-12).run(e[::sub], h)[0]
+    step_error = np.max(np.abs(exact_solve - fine))
+    solver_error = {tol: np.max(np.abs(BushingBank([ch], tolerance=tol).run(e[::sub], h)[0] - exact_solve))
+                    for tol in (1e-8, 1e-9)}
+    assert BushingBank([ch]).P[0, kernel.P_TOL] == 1e-8
+    assert solver_error[1e-8] < step_error / 15, (solver_error, step_error)
+    assert solver_error[1e-9] < solver_error[1e-8] / 5, solver_error
+
+
 @pytest.mark.parametrize("name", ["fig3_14", "fig5_8", "fig5_9"])
 @pytest.mark.parametrize("amp_mm,freq_hz", [(0.1, 100.0), (5.0, 1.0)])
 def test_large_steps_are_stable(name, amp_mm, freq_hz):
@@ -289,9 +307,9 @@ def test_tangent_is_the_derivative_of_the_step(name, model):
 
 
 def test_power_law_kernel_meets_its_error_bound():
-    """The solver's branch-free x**p: relative error < 7e-13 + 2e-16·p·|ln x| against an extended-
-    precision reference, from 1e-300 to 1e300, over the slip rates the solver passes it (1e-6 to
-    1e3 m/s) and around 1."""
+    """The solver's branch-free x**p: relative error < 3e-10 + 7.2e-10·p + 2e-16·p·|ln x| against
+    an extended-precision reference, from 1e-300 to 1e300, over the slip rates the solver passes it
+    (1e-6 to 1e3 m/s) and around 1."""
     from bushings.kernel import _pow
 
     @numba.njit
@@ -307,7 +325,8 @@ def test_power_law_kernel_meets_its_error_bound():
     powers(x, p, out)
     exact = np.exp(p.astype(np.longdouble) * np.log(x.astype(np.longdouble)))
     rel = np.abs(out / exact - 1.0).astype(float)
-    assert np.all(rel < 7e-13 + 2e-16 * p * np.abs(np.log(x)))
+    assert np.all(rel < 3e-10 + 7.2e-10 * p + 2e-16 * p * np.abs(np.log(x)))
+    assert rel.max() > 2e-10  # the bound is tight: the series were cut where it says
 
 
 def test_elastic_law_is_smooth_and_asymmetric():
