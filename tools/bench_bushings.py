@@ -18,6 +18,7 @@ from __future__ import annotations
 import argparse
 import json
 import time
+import timeit
 from typing import Callable
 
 import numpy as np
@@ -109,9 +110,9 @@ def accuracy_match(e1: np.ndarray) -> dict[str, float]:
         F, n_sub = explicit_reference(ch, e1, H_S, safety=safety)
         err = float(np.max(np.abs(F - truth)))
         if err <= err_implicit:
-            t0 = time.perf_counter()
-            explicit_reference(ch, e1, H_S, safety=safety)
-            wall = time.perf_counter() - t0
+            # The best of REPEATS runs, as the implicit step's figures are bests.
+            wall = min(timeit.repeat(lambda: explicit_reference(ch, e1, H_S, safety=safety), number=1,
+                                     repeat=REPEATS))
             result.update(explicit_max_error_n=err, explicit_safety=safety,
                           explicit_substeps_per_step=n_sub / (len(e1) - 1),
                           explicit36_us_per_step=wall / (len(e1) - 1) * CHANNELS * 1e6)
