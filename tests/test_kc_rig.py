@@ -178,9 +178,10 @@ def test_beam_torsion_changes_the_rear_and_leaves_the_front(where, tmp_path):
     diff = {n: np.abs(stiff[n] - base[n]).max() for n in measured_channels()}
     front = [n for n in diff if n.endswith(("_fl", "_fr"))]
     assert max(diff[n] for n in front if not n.startswith("pad_fz")) < 1e-8     # mm, deg (~3e-9: solver round-off)
-    # N, of ~5000 N: the front bushings see the same deflections to round-off, and their implicit
-    # solve places its nodes to 1e-9 m, i.e. forces to ~1e-3 N (measured: 1.5e-6, then 5e-5 N once
-    # the predictor's second-order correction took fewer passes); a leak of the rear cause is ≥ 1 N.
+    # N, of ~5000 N: the front bushings see the same deflections to round-off, so their implicit
+    # solves differ only where round-off changes a Newton pass, which places the nodes to the bank's
+    # tolerance, 1e-8 m (measured: 1.5e-6 N; 5e-5 N with an earlier predictor); a leak of the rear
+    # cause is ≥ 1 N.
     assert max(diff[n] for n in front if n.startswith("pad_fz")) < 1e-3
     for tag in ("rl", "rr"):
         assert diff[f"pad_fz_{tag}"] > 300.0      # a stiffer beam carries more of the roll moment at the rear
