@@ -4,7 +4,7 @@ A :class:`BushingBank` steps many 1-D channels at once with an implicit, uncondi
 scheme and returns each channel's force and tangent stiffness. All quantities are SI.
 """
 
-from bushings.errors import InputError
+from vsim_core.errors import InputError
 from bushings.parameters import (ChannelParams, ParameterSet, available_parameter_sets,
                                  load_parameter_set, to_si)
 from bushings.bank import BushingBank

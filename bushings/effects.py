@@ -27,7 +27,7 @@ from numba.core import caching
 
 from bushings import kernel as kn
 from bushings.bank import DEFAULT_TOLERANCE, BushingBank
-from bushings.errors import InputError
+from vsim_core.errors import InputError
 from bushings.parameters import LENGTH_UNIT_SI, ChannelParams
 
 # Columns of the effect parameter matrix (one row per channel) and of the effect state.

@@ -19,7 +19,7 @@ import numpy as np
 from scipy.special import gamma
 
 from bushings.bank import BushingBank
-from bushings.errors import InputError
+from vsim_core.errors import InputError
 from bushings.parameters import ChannelParams
 
 

@@ -17,13 +17,13 @@ from typing import TYPE_CHECKING, Any, Mapping
 import yaml
 
 
-from bushings.errors import InputError, parse_yaml
+from vsim_core.errors import InputError, parse_yaml
+from vsim_core.shipped import PARAMETER_SET_DIR
 
 if TYPE_CHECKING:
     from bushings.effects import Effects
 
 #: The folder holding the named parameter sets shipped with the project.
-PARAMETER_SET_DIR = Path(__file__).resolve().parent.parent / "models" / "bushings"
 
 #: Number of ladder cells when a set does not say (the thesis's choice for 0.05–2 mm).
 DEFAULT_CELLS = 15
@@ -266,7 +266,7 @@ def _parsed(path: str, text: str) -> ParameterSet:
 def save_parameter_set(pset: ParameterSet, path: str | Path) -> Path:
     """Write a parameter set in the format of ``models/bushings/*.yaml`` (read back by
     :func:`load_parameter_set`), atomically."""
-    from bushings.bench import atomic_output  # bench builds on this module
+    from bushings.bench.bench_file import atomic_output  # bench builds on this module
 
     def plain(v: Any) -> Any:
         if isinstance(v, (list, tuple)):

@@ -13,9 +13,9 @@ import pytest
 import yaml
 
 from bushings import InputError
-from bushings.bench import atomic_output, load_bench, parse_bench, run_bench
-from bushings.programmes import firtree, multisine, parse_programme, read_csv_record, sine, step, triangle
-from vehicle.cli import build_parser, main
+from bushings.bench.bench_file import atomic_output, load_bench, parse_bench, run_bench
+from bushings.bench.programmes import firtree, multisine, parse_programme, read_csv_record, sine, step, triangle
+from vsim_cli.main import build_parser, main
 
 MM = 1e-3
 BENCH_DIR = Path(__file__).resolve().parent.parent / "models" / "bushings" / "benches"
@@ -221,9 +221,9 @@ def test_bushing_group_has_run_and_takes_fit_from_identification_cli(monkeypatch
     def add_fit_command(subparsers: argparse._SubParsersAction) -> None:
         subparsers.add_parser("fit").set_defaults(func=lambda a: 0)
 
-    fake = types.ModuleType("bushings.identification_cli")
+    fake = types.ModuleType("vsim_cli.bushing_fit")
     fake.add_fit_command = add_fit_command
-    monkeypatch.setitem(sys.modules, "bushings.identification_cli", fake)
+    monkeypatch.setitem(sys.modules, "vsim_cli.bushing_fit", fake)
     assert build_parser().parse_args(["bushing", "fit"]).bushing_command == "fit"
 
 

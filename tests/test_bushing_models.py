@@ -368,7 +368,7 @@ import sys
 import numpy as np
 from bushings import BushingBank, available_parameter_sets, load_parameter_set
 from bushings import kernel
-from bushings.programmes import multisine
+from bushings.bench.programmes import multisine
 channels = [load_parameter_set(name).channel() for name in available_parameter_sets()]
 _, e = multisine([1.5e-3, 0.3e-3], [1.0, 10.0], 0.5, 1e-3)  # the thesis's bi-sine, 1.5x
 forces, tangents = BushingBank(channels).run(np.repeat(e[:, None], len(channels), axis=1), 1e-3)

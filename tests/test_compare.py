@@ -1,4 +1,4 @@
-"""`vsim compare` (vehicle/compare.py) and the metric functions it shares (vehicle/run_metrics.py):
+"""`vsim compare` (vsim_analysis/compare.py) and the metric functions it shares (vsim_analysis/run_metrics.py):
 exact metrics on synthetic signals, a run against itself, against a copy with scaled camber and
 against a resampled bodiless copy written as a file, the CLI's outputs, and every input error."""
 
@@ -13,15 +13,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from bushings.errors import InputError
-from vehicle import cli
-from vehicle.compare import compare_runs, format_table
-from vehicle.definition import DEFAULT_VEHICLE
-from vehicle.io import Run, load_run
-from vehicle.recording import RunWriter
-from vehicle.run_metrics import dynamic_stiffness, loop_area, relaxation_amplitude, rms_error
-from vehicle.runner import run_scenario
-from vehicle.scenarios import load_scenario
+from vsim_core.errors import InputError
+from vsim_cli import main as cli
+from vsim_analysis.compare import compare_runs, format_table
+from vehicle.model.definition import DEFAULT_VEHICLE
+from vsim_recordings.run_reader import Run, load_run
+from vsim_recordings.run_writer import RunWriter
+from vsim_analysis.run_metrics import dynamic_stiffness, loop_area, relaxation_amplitude, rms_error
+from vehicle.simulation.runner import run_scenario
+from vehicle.scenarios.scenario_file import load_scenario
 
 #: Two pumping cases at 2 Hz, a triangle and a sine (which has a dynamic stiffness).
 PUMPING = """\

@@ -15,7 +15,7 @@ import pytest
 from bushings.effects import ExtendedBank, broad_relaxation_branches
 from bushings.parameters import load_parameter_set
 from tests.diagnosis_helpers import SLOW_SEEDS, assert_success_rate, diagnose_fresh, measure
-from vehicle.diagnosis.catalogue import CAUSES
+from vsim_diagnosis.causes import CAUSES
 
 BENCH_CAUSES = sorted(CAUSES)
 #: Seeds per cause in the default suite (one, for time: each diagnosis takes 15-60 s); the slow

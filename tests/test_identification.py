@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 from bushings import InputError, load_parameter_set
-from bushings.identification import (CycleMeasures, fit, identify_sts, measure_cycle, sts_cycle_measures,
+from bushings.bench.identification import (CycleMeasures, fit, identify_sts, measure_cycle, sts_cycle_measures,
                                      sts_from_measures, stvs_initial)
-from bushings.identification_cli import add_fit_command
-from bushings.records import BenchRecord, read_bench_csv, simulate_record
+from vsim_cli.bushing_fit import add_fit_command
+from bushings.bench.records import BenchRecord, read_bench_csv, simulate_record
 
 MM = 1e-3
 

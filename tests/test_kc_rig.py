@@ -13,11 +13,11 @@ import numpy as np
 import pytest
 import yaml
 
-from bushings.errors import InputError
-from vehicle.cli import main as vsim
-from vehicle.definition import DEFAULT_VEHICLE
-from vehicle.diagnosis.kc_data import read_kc_dataset
-from vehicle.diagnosis.kc_rig import (
+from vsim_core.errors import InputError
+from vsim_cli.main import main as vsim
+from vehicle.model.definition import DEFAULT_VEHICLE
+from vsim_recordings.kc_dataset import read_kc_dataset
+from vsim_diagnosis.virtual_kc_rig import (
     DEFAULT_SCENARIOS,
     MEASUREMENT_DEFAULTS,
     KCTruth,
@@ -25,12 +25,12 @@ from vehicle.diagnosis.kc_rig import (
     parse_kc_truth,
     sensor,
 )
-from vehicle.diagnosis.virtual_rig import load_truth
-from vehicle.io import load_run
-from vehicle.recording import RunWriter
-from vehicle.rig_data import DERIVED, measured_channels
-from vehicle.runner import simulate
-from vehicle.scenarios import INPUT_CHANNELS
+from vsim_diagnosis.virtual_bench import load_truth
+from vsim_recordings.run_reader import load_run
+from vsim_recordings.run_writer import RunWriter
+from vsim_recordings.rig_recordings import DERIVED, measured_channels
+from vehicle.simulation.runner import simulate
+from vehicle.scenarios.scenario_file import INPUT_CHANNELS
 
 SCALE = 0.2
 PUMPING = """name: tiny_pumping

@@ -17,10 +17,10 @@ import rerun.chunk
 from foxglove.messages import FrameTransform, FrameTransforms, Quaternion, Timestamp, Vector3
 from mcap.reader import make_reader
 
-from bushings.errors import InputError
-from vehicle import view_cli
-from vehicle.io import load_run
-from vehicle.recording import (
+from vsim_core.errors import InputError
+from vsim_cli import view as view_cli
+from vsim_recordings.run_reader import load_run
+from vsim_recordings.run_writer import (
     FrameTransformsLayout,
     RunMetadata,
     RunWriter,

@@ -12,14 +12,14 @@ import pytest
 import yaml
 from mcap.reader import make_reader
 
-from bushings.errors import InputError
-from vehicle import cli
-from vehicle.io import Run, load_run
-from vehicle.recording import RUN_RECORD, TF_TOPIC, RunMetadata, RunWriter, SignalSpec
-from vehicle.rig_cli import UNITS, import_csv
-from vehicle.rig_data import measured_channels, write_rig_recording
-from vehicle.runner import run_scenario
-from vehicle.scenarios import load_scenario
+from vsim_core.errors import InputError
+from vsim_cli import main as cli
+from vsim_recordings.run_reader import Run, load_run
+from vsim_recordings.run_writer import RUN_RECORD, TF_TOPIC, RunMetadata, RunWriter, SignalSpec
+from vsim_cli.rig import UNITS, import_csv
+from vsim_recordings.rig_recordings import measured_channels, write_rig_recording
+from vehicle.simulation.runner import run_scenario
+from vehicle.scenarios.scenario_file import load_scenario
 
 ROOT = Path(__file__).resolve().parent.parent
 PUMPING = ROOT / "scenarios/pumping.yaml"

@@ -1,7 +1,7 @@
-"""K&C metrics of a recorded run (vehicle/run_metrics.py): agreement with `vsim kc`, exact recovery
+"""K&C metrics of a recorded run (vsim_analysis/run_metrics.py): agreement with `vsim kc`, exact recovery
 of a known slope, loop width and area from synthetic signals, and the run summary.
 
-Agreement with `vsim kc`: one short run per K&C test (amplitude and rate of vehicle.kc.TESTS, two
+Agreement with `vsim kc`: one short run per K&C test (amplitude and rate of vehicle.simulation.kc.TESTS, two
 cycles, durations × 0.5, so twice kc's rate) against kc_metrics on the same car. The bushings see
 another history (linear settling, a first cycle, the doubled rate), which moves gradients by less
 than 1 % (measured); the test allows 2 % (plus 2e-4 in the metric's unit for values near 0). Loop
@@ -17,14 +17,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from bushings.errors import InputError
-from vehicle import kc
-from vehicle.definition import DEFAULT_VEHICLE, load_vehicle
-from vehicle.io import Run, load_run
-from vehicle.recording import RunMetadata, SignalSpec
-from vehicle.rig import KCRig
-from vehicle.run_cli import summary
-from vehicle.run_metrics import (
+from vsim_core.errors import InputError
+from vehicle.simulation import kc
+from vehicle.model.definition import DEFAULT_VEHICLE, load_vehicle
+from vsim_recordings.run_reader import Run, load_run
+from vsim_recordings.run_writer import RunMetadata, SignalSpec
+from vehicle.simulation.rig import KCRig
+from vsim_cli.run import summary
+from vsim_analysis.run_metrics import (
     BUMP_WINDOW_M,
     case_loop,
     case_metrics,
@@ -32,8 +32,8 @@ from vehicle.run_metrics import (
     contact_base_m,
     run_metrics,
 )
-from vehicle.runner import run_scenario
-from vehicle.scenarios import CORNER_TAGS, load_scenario
+from vehicle.simulation.runner import run_scenario
+from vehicle.scenarios.scenario_file import CORNER_TAGS, load_scenario
 
 SCALE = 0.5        #: duration scale of the short runs
 TOLERANCE = 0.02   #: relative agreement of gradients with `vsim kc`

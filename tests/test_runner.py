@@ -10,13 +10,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from bushings.errors import InputError
-from vehicle import cli
-from vehicle.io import load_run
-from vehicle.recording import PARTIAL_SUFFIX
-from vehicle.run_cli import summary
-from vehicle.runner import DivergenceError, run_scenario
-from vehicle.scenarios import INPUT_CHANNELS, load_scenario
+from vsim_core.errors import InputError
+from vsim_cli import main as cli
+from vsim_recordings.run_reader import load_run
+from vsim_recordings.run_writer import PARTIAL_SUFFIX
+from vsim_cli.run import summary
+from vehicle.simulation.runner import DivergenceError, run_scenario
+from vehicle.scenarios.scenario_file import INPUT_CHANNELS, load_scenario
 
 SCENARIO_DIR = Path(__file__).resolve().parent.parent / "scenarios"
 QUICK = 0.05   #: duration scale of the shortened default scenarios

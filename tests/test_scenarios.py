@@ -10,10 +10,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from bushings.errors import InputError
-from vehicle.builder import CORNERS
-from vehicle.definition import DEFAULT_VEHICLE
-from vehicle.scenarios import CORNER_TAGS, INPUT_CHANNELS, csv_columns, load_scenario
+from vsim_core.errors import InputError
+from vehicle.model.builder import CORNERS
+from vehicle.model.definition import DEFAULT_VEHICLE
+from vehicle.scenarios.scenario_file import CORNER_TAGS, INPUT_CHANNELS, csv_columns, load_scenario
 
 SCENARIO_DIR = Path(__file__).resolve().parent.parent / "scenarios"
 DEFAULT_SET = ("pumping", "roll", "lateral_force", "pumping_speeds", "rack_step", "double_rack_step_same",

@@ -10,10 +10,10 @@ import pytest
 import yaml
 
 from bushings import load_parameter_set
-from bushings.errors import InputError
-from vehicle.builder import mirror_axes
-from vehicle.definition import DEFAULT_VEHICLE, load_vehicle
-from vehicle.statics import axle_loads, resolve_preloads
+from vsim_core.errors import InputError
+from vehicle.model.builder import mirror_axes
+from vehicle.model.definition import DEFAULT_VEHICLE, load_vehicle
+from vehicle.model.statics import axle_loads, resolve_preloads
 
 
 def test_default_car_is_plausible():

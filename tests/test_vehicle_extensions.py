@@ -16,14 +16,14 @@ import pytest
 
 from bushings import BushingBank, load_parameter_set
 from bushings.effects import NO_EFFECTS, ExtendedBank
-from bushings.errors import InputError
+from vsim_core.errors import InputError
 from tests.test_vehicle_definition import _write
-from vehicle.builder import BuildOptions
-from vehicle.definition import VehicleDefinition, load_vehicle, with_extensions
-from vehicle.kc import (TEST, Branches, _design_contact_base, centre_slope, fit_window, loop_width, rig_leg,
+from vehicle.model.builder import BuildOptions
+from vehicle.model.definition import VehicleDefinition, load_vehicle, with_extensions
+from vehicle.simulation.kc import (TEST, Branches, _design_contact_base, centre_slope, fit_window, loop_width, rig_leg,
                         run_triangle, triangle_metrics)
-from vehicle.kinematics import front_corner
-from vehicle.rig import KCRig
+from vehicle.model.kinematics import front_corner
+from vehicle.simulation.rig import KCRig
 
 LINEAR = BuildOptions(bushing_model="linear")
 

@@ -1,6 +1,6 @@
-"""K&C metrics of the default car (vehicle/kc.py) fall in plausible ranges.
+"""K&C metrics of the default car (vehicle/simulation/kc.py) fall in plausible ranges.
 
-Ranges, per axle, as (low, high) in the metric's unit and sign convention (vehicle/kc.py):
+Ranges, per axle, as (low, high) in the metric's unit and sign convention (vehicle/simulation/kc.py):
 
 * from spec vehicle.md §4 (plausible C-segment values): front bump steer −10 … 0 deg/m, rear bump
   steer 0 … +4 deg/m (toe-in), aligning-torque compliance steer 0.5 … 1.5 deg/kN·m (front; the
@@ -20,8 +20,8 @@ from __future__ import annotations
 
 import pytest
 
-from vehicle.definition import load_vehicle
-from vehicle.kc import METRICS, vehicle_kc
+from vehicle.model.definition import load_vehicle
+from vehicle.simulation.kc import METRICS, vehicle_kc
 
 RANGES = {
     "front": {
@@ -73,8 +73,8 @@ def test_metric_in_plausible_range(metrics, axle, key):
 def test_vsim_kc_json_has_the_issue_keys(metrics, monkeypatch, capsys):
     import json
 
-    from vehicle import kc_cli
-    from vehicle.cli import main
+    from vsim_cli import kc as kc_cli
+    from vsim_cli.main import main
 
     monkeypatch.setattr(kc_cli, "vehicle_kc", lambda vehicle, options: metrics)
     assert main(["kc", "--json"]) == 0

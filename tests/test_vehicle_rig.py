@@ -8,11 +8,11 @@ import math
 import numpy as np
 import pytest
 
-from vehicle.builder import CORNERS, BuildOptions
-from vehicle.definition import load_vehicle
-from vehicle.kinematics import front_corner, rear_heave
-from vehicle.rig import KCRig
-from vehicle.statics import axle_loads
+from vehicle.model.builder import CORNERS, BuildOptions
+from vehicle.model.definition import load_vehicle
+from vehicle.model.kinematics import front_corner, rear_heave
+from vehicle.simulation.rig import KCRig
+from vehicle.model.statics import axle_loads
 
 
 @pytest.fixture(scope="module")

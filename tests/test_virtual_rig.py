@@ -8,11 +8,11 @@ import pytest
 import yaml
 
 from bushings.effects import ExtendedBank
-from bushings.errors import InputError
-from vehicle.cli import main as vsim
-from vehicle.diagnosis.bench_campaign import CAMPAIGN
-from vehicle.diagnosis.bench_data import read_bench_dataset
-from vehicle.diagnosis.virtual_rig import OVERSAMPLING, measure_bench, parse_truth, rest_before
+from vsim_core.errors import InputError
+from vsim_cli.main import main as vsim
+from bushings.bench.campaign import CAMPAIGN
+from vsim_recordings.bench_dataset import read_bench_dataset
+from vsim_diagnosis.virtual_bench import OVERSAMPLING, measure_bench, parse_truth, rest_before
 
 SHORT = CAMPAIGN[:3]
 TRUTH = {"level": "bench", "baseline": "fig5_9_progressive", "seed": 7,

@@ -1,0 +1,1 @@
+"""The bushing test bench: programmes, the standard campaign, bench files and runs, records, identification."""

@@ -1,0 +1,105 @@
+"""Benchmark of the full car on the K&C rig in pumping (issue 3): speed and time-step accuracy.
+
+``python tools/benchmarks/vehicle_speed.py [--json] [--timestep H]`` prints one JSON object:
+
+* ``rtf_linear``, ``rtf_stvs_all``: simulated time / wall time of one pumping period (60 mm
+  triangle at 0.1 Hz, inputs ramped inside the compiled loop, no sampling) with every bushing
+  direction linear, and with STVS (N = 15) on all six directions of the six main bushings
+  (``--bushings stvs``: 36 channels, models/vehicles/README.md); best of five periods, the two
+  cars alternating, after a warm-up period each;
+* ``ratio_stvs_to_linear``: ratio of their step times; ``step_us_*``: the step times [µs];
+* ``camber_change_on_half_step_deg``: largest difference between the camber loops computed at H
+  and at H/2 (60 mm, 0.1 Hz pumping, vehicle.simulation.kc.run_triangle, STVS; both branches compared at
+  the same pad heights over ±55 mm, four wheels); ``closure_error_max_m``: largest loop-closure error on that loop at H.
+
+Targets (issue 3): rtf_stvs_all ≥ 10, ratio_stvs_to_linear ≤ 1.5, camber change ≤ 0.005 deg.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import time
+
+import numpy as np
+
+from vehicle.model.builder import CORNERS, BuildOptions
+from vehicle.model.definition import load_vehicle
+from vehicle.simulation.kc import Triangle, branches, run_triangle
+from vehicle.simulation.rig import KCRig
+
+AMPLITUDE = 0.06     #: pumping amplitude [m]
+PERIOD = 10.0        #: [s] (0.1 Hz)
+PUMPING = Triangle("pumping", "pads", (1, 1, 1, 1), AMPLITUDE, 4 * AMPLITUDE / PERIOD)
+
+
+def period(rig: KCRig) -> float:
+    """Wall time [s] of one pumping period (inputs ramped in the compiled loop, no sampling)."""
+    up, down = np.full(4, AMPLITUDE), np.full(4, -AMPLITUDE)
+    t0 = time.perf_counter()
+    rig.ramp(PERIOD / 4, pads=(np.zeros(4), up))
+    rig.ramp(PERIOD / 2, pads=(up, down))
+    rig.ramp(PERIOD / 4, pads=(down, np.zeros(4)))
+    return time.perf_counter() - t0
+
+
+def step_times(rigs: dict[str, KCRig], repeats: int = 5) -> dict[str, float]:
+    """Best wall time per step [s] of each rig, periods alternating between the rigs so that both
+    see the same machine load (after a warm-up period each)."""
+    for rig in rigs.values():
+        rig.reset()
+        period(rig)
+    best = dict.fromkeys(rigs, math.inf)
+    for _ in range(repeats):
+        for name, rig in rigs.items():
+            best[name] = min(best[name], period(rig))
+    return {name: best[name] / round(PERIOD / rig.model.opt.timestep) for name, rig in rigs.items()}
+
+
+def camber_loop(h: float) -> tuple[np.ndarray, float]:
+    """Cambers [deg] on the down and up branches of the STVS pumping loop at step ``h``, at pad
+    heights −55 … +55 mm (wheels × branches × heights), and the largest closure error [m]."""
+    rig = KCRig(load_vehicle(), BuildOptions(bushing_model="stvs", timestep=h))
+    down, up = run_triangle(rig, PUMPING)
+    grid = np.linspace(-0.055, 0.055, 111)
+    loops = [branches(down, up, lambda o, c=c: o.wheels[c].pad_height,
+                      lambda o, c=c: math.degrees(o.wheels[c].camber)).on(grid) for c in CORNERS]
+    return np.array(loops), max(o.closure_error for o in down + up)
+
+
+def bench(h: float) -> dict[str, float]:
+    """The benchmark's JSON object at time step ``h`` [s]."""
+    vehicle = load_vehicle()
+    steps = step_times({model: KCRig(vehicle, BuildOptions(bushing_model=model, timestep=h))
+                        for model in ("linear", "stvs")})
+    coarse, closure = camber_loop(h)
+    fine, _ = camber_loop(h / 2)
+    return {
+        "timestep_s": h,
+        "rtf_linear": h / steps["linear"],
+        "rtf_stvs_all": h / steps["stvs"],
+        "ratio_stvs_to_linear": steps["stvs"] / steps["linear"],
+        "step_us_linear": 1e6 * steps["linear"],
+        "step_us_stvs_all": 1e6 * steps["stvs"],
+        "camber_change_on_half_step_deg": float(np.abs(coarse - fine).max()),
+        "closure_error_max_m": closure,
+    }
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--json", action="store_true", help="print one JSON object (default: aligned text)")
+    parser.add_argument("--timestep", type=float, default=1e-3, help="time step H [s] (default: %(default)s)")
+    args = parser.parse_args()
+    result = bench(args.timestep)
+    if args.json:
+        print(json.dumps(result))
+    else:
+        for key, value in result.items():
+            print(f"{key:<34} {value:.6g}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

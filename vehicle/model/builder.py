@@ -1,0 +1,491 @@
+"""Build the MuJoCo model of a vehicle definition with ``mujoco.MjSpec``.
+
+Topology (per side; the right side mirrors the left):
+
+* front pseudo-McPherson: the lower wishbone hangs from the body on its first bushing (E1 front:
+  six joints, 3 slide + 3 hinge in the bushing's frame); every further bushing of the wishbone
+  (E2 front) is a light sleeve on six joints of its own, welded to the wishbone. The knuckle sits
+  on the wishbone through a ball joint; the strut rod slides in the tube on the knuckle along the
+  strut axis (spring, damper and the rod's Coulomb friction, MuJoCo's ``frictionloss``, on that
+  slide) and is tied to the body at the top mount by a ``connect``. The rack slides laterally in
+  the body; each tie rod is a spatial tendon of fixed length (``equality/tendon``). The wheel
+  turns on a hinge of the knuckle.
+* rear twist beam: each trailing arm hangs from the body on its E1 rear bushing; the left arm
+  carries the beam centre on a hinge about the beam axis (torsional stiffness of the beam),
+  welded to the right arm. Springs and dampers are spatial tendons between arm and body.
+* K&C rig (``rig=True``): under each wheel a pad slides vertically (driven by an
+  ``equality/joint``) and carries a carriage free in x and y, tied to the wheel's contact point
+  by a ``connect``; wheel hinges are locked (brakes on); the rack position is driven.
+
+Linear bushing directions live in the joints' ``stiffness``/``damping`` (implicit under
+``integrator="discrete"``); the others (and any law with effects) get a reference stiffness in the
+joint and the rest of their force from :mod:`vehicle.simulation.coupling`, as do the bushings' cross
+stiffnesses. The right side's laws, effects and cross stiffnesses are the mirror images of the
+left's (:func:`mirror_signs`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+
+import mujoco
+import numpy as np
+
+from bushings.effects import NO_EFFECTS, Effects
+from vehicle.model.definition import DIRECTIONS, BushingDef, Spring, VehicleDefinition
+
+SIDES = (("left", 1.0), ("right", -1.0))
+CORNERS = ("front_left", "front_right", "rear_left", "rear_right")
+#: Stiffness of a "rigid" bushing translation [N/m] (kinematics mode).
+RIGID_TRANSLATION = 1e9
+#: Loop closures and rig drives: time constant at the refsafe floor (2 h) and impedance close to
+#: 1, which keeps the closure error of a 3 kN load in the 10 µm range (measured, see tests).
+CLOSURE_SOLIMP = (0.9999, 0.9999, 0.001, 0.5, 2.0)
+SLEEVE_MASS = 0.4          #: mass of a closed bushing's sleeve [kg], taken from its part's mass
+BEAM_CENTRE_MASS = 1.0    #: share of each arm's mass carried by the beam-centre body [kg]
+PAD_MASS = 1.0             #: rig pad and carriage masses [kg] (gravity compensated)
+_NO_COLLISION = dict(contype=0, conaffinity=0)
+
+
+@dataclass(frozen=True)
+class BuildOptions:
+    """How to build: rig or road, clamped or free body, bushing model override, time step."""
+
+    rig: bool = True                    #: add the K&C rig (pads, rack drive, wheel locks)
+    clamped: bool = True                #: body fixed to the world; otherwise a free joint
+    bushing_model: str | None = None    #: read every named bushing set as this model
+    rigid_bushings: bool = False        #: translations rigid (kinematics); rotations unchanged
+    timestep: float = 1e-3              #: [s]
+
+
+@dataclass
+class Channel:
+    """One bushing direction: a joint of the model and its force law."""
+
+    name: str                            #: e.g. ``e1_front_left.y``
+    joint: str
+    params: object                       #: bushings.ChannelParams (SI)
+    effects: Effects = NO_EFFECTS        #: state extensions of the law (bushings.effects, SI)
+
+    @property
+    def linear(self) -> bool:
+        """True when the whole law fits in the joint's stiffness and damping."""
+        p = self.params
+        return (p.model == "linear" and not math.isfinite(p.S_sup) and not math.isfinite(p.S_inf)
+                and not self.effects.active)
+
+
+@dataclass(frozen=True)
+class CrossTerm:
+    """A cross stiffness between two bushing joints: τ_a += −k·q_b, τ_b += −k·q_a (explicit)."""
+
+    joint_a: str
+    joint_b: str
+    stiffness: float                     #: k [N/m or N·m/rad], this side's sign included
+
+
+@dataclass
+class Element:
+    """A spring or damper acting along a scalar coordinate (a slide joint or a tendon)."""
+
+    name: str
+    kind: str                            #: "joint" or "tendon"
+    target: str                          #: joint or tendon name
+    sign: float                          #: compression = sign × (coordinate − design value)
+    spring: Spring | None = None
+    preload: float = 0.0                 #: [N]
+    damper_curve: object | None = None   #: definition.Curve of compression speed → force
+
+
+@dataclass
+class CarModel:
+    """The compiled model with the names the rig and the coupling need."""
+
+    definition: VehicleDefinition
+    options: BuildOptions
+    spec: mujoco.MjSpec
+    model: mujoco.MjModel
+    channels: list[Channel]
+    elements: list[Element]
+    closures: list[str]                  #: loop-closure equality names
+    corners: dict[str, dict[str, str]] = field(default_factory=dict)
+    cross: list[CrossTerm] = field(default_factory=list)   #: directional couplings of the bushings
+
+    def xml(self) -> str:
+        """The MJCF of the model."""
+        return self.spec.to_xml()
+
+
+def joint_stiffness(channel: Channel) -> float:
+    """Stiffness to put in a bushing joint: the whole law if linear (implicit), else the
+    reference tangent K0 + Kpa (the rest is applied explicitly by :mod:`vehicle.simulation.coupling`)."""
+    p = channel.params
+    return p.K0 if channel.linear else p.K0 + p.Kpa
+
+
+def mirror(p, sign: float) -> np.ndarray:
+    """A left-side point or vector on the side ``sign`` (+1 left, −1 right)."""
+    return np.array([p[0], sign * p[1], p[2]], dtype=float)
+
+
+def _reversed_axis(axes) -> int:
+    """Index of the bushing axis closest to the lateral direction (reversed on the right side)."""
+    return int(np.argmax(np.abs(np.asarray(axes, float)[:, 1])))
+
+
+def mirror_axes(axes, sign: float) -> np.ndarray:
+    """Bushing axes (rows x, y, z) on side ``sign``, kept right-handed.
+
+    A reflection makes the frame left-handed; the axis closest to the lateral direction is then
+    reversed, so the longitudinal and vertical axes keep their world sense on both sides.
+    """
+    rows = np.array([mirror(a, sign) for a in axes])
+    if sign < 0:
+        rows[_reversed_axis(axes)] *= -1.0
+    return rows
+
+
+def mirror_signs(axes, sign: float) -> np.ndarray:
+    """Per direction (x, y, z, rx, ry, rz), +1 or −1: in the mirror image of a left-side motion, a
+    direction's deflection on side ``sign`` is this sign times the left one's.
+
+    On the right the reversed axis (:func:`mirror_axes`) flips its translation, and a reflection
+    flips every rotation (a pseudovector) except the one about the reversed axis.
+    """
+    signs = np.ones(6)
+    if sign < 0:
+        k = _reversed_axis(axes)
+        signs[k] = -1.0
+        signs[3:] = -1.0
+        signs[3 + k] = 1.0
+    return signs
+
+
+def mirrored_law(params, effects: Effects, sign: float):
+    """(law, effects) of a direction whose deflection is the left one's times ``sign`` (see
+    :func:`mirror_signs`): F(e) becomes −F(−e), so the elastic law's sides, the preload and the
+    asymmetry swap; the rest of a law is odd already."""
+    if sign > 0:
+        return params, effects
+    p = params.replace(N_sup=-params.N_inf, N_inf=-params.N_sup, S_sup=-params.S_inf, S_inf=-params.S_sup,
+                       P_sup=params.P_inf, P_inf=params.P_sup)
+    return p, dataclasses.replace(effects, preload=-effects.preload, asymmetry=-effects.asymmetry)
+
+
+def wheel_axis(toe: float, camber: float, sign: float) -> np.ndarray:
+    """Outward unit spin axis of a wheel with toe-in ``toe`` and camber ``camber`` [rad]."""
+    return np.array([math.cos(camber) * math.sin(toe), sign * math.cos(camber) * math.cos(toe),
+                     -math.sin(camber)])
+
+
+def frame_from(primary: np.ndarray, secondary: np.ndarray, order: str = "zx") -> np.ndarray:
+    """Rotation matrix (columns = local axes in world) with ``order[0]`` along ``primary``."""
+    a = primary / np.linalg.norm(primary)
+    b = secondary - a * (a @ secondary)
+    b /= np.linalg.norm(b)
+    cols = {order[0]: a, order[1]: b}
+    if order == "zx":
+        cols["y"] = np.cross(a, b)
+    elif order == "yx":
+        cols["z"] = np.cross(b, a)
+    elif order == "xy":
+        cols["z"] = np.cross(a, b)
+    return np.column_stack([cols["x"], cols["y"], cols["z"]])
+
+
+def _quat(rot: np.ndarray) -> np.ndarray:
+    q = np.zeros(4)
+    mujoco.mju_mat2Quat(q, np.ascontiguousarray(rot).ravel())
+    return q
+
+
+class _Builder:
+    """Creates bodies from world design poses, so every point is written in world coordinates."""
+
+    def __init__(self, vehicle: VehicleDefinition, options: BuildOptions):
+        self.v, self.o = vehicle, options
+        self.spec = mujoco.MjSpec()
+        self.spec.modelname = vehicle.name
+        self.spec.compiler.inertiafromgeom = mujoco.mjtInertiaFromGeom.mjINERTIAFROMGEOM_FALSE
+        self.spec.compiler.autolimits = True
+        opt = self.spec.option
+        opt.timestep = options.timestep
+        opt.integrator = mujoco.mjtIntegrator.mjINT_DISCRETE
+        opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT
+        opt.gravity = [0.0, 0.0, -9.81]
+        self.poses: dict[str, tuple[np.ndarray, np.ndarray]] = {"world": (np.zeros(3), np.eye(3))}
+        self.bodies: dict[str, mujoco.MjsBody] = {"world": self.spec.worldbody}
+        self.channels: list[Channel] = []
+        self.elements: list[Element] = []
+        self.closures: list[str] = []
+        self.corners: dict[str, dict[str, str]] = {}
+        self.cross: list[CrossTerm] = []
+
+    # -- primitives --------------------------------------------------------------------------
+    def local(self, body: str, p) -> np.ndarray:
+        pos, rot = self.poses[body]
+        return rot.T @ (np.asarray(p, float) - pos)
+
+    def body(self, parent: str, name: str, pos, rot, mass: float, com, inertia, gravcomp: float = 0.0):
+        """Add a body at world pose (pos, rot) with mass at world point ``com`` (inertia in the body axes)."""
+        ppos, prot = self.poses[parent]
+        b = self.bodies[parent].add_body(name=name, pos=prot.T @ (np.asarray(pos) - ppos), quat=_quat(prot.T @ rot))
+        b.mass = mass
+        b.ipos = rot.T @ (np.asarray(com, float) - np.asarray(pos))
+        b.inertia = np.asarray(inertia, float)
+        b.explicitinertial = True
+        b.gravcomp = gravcomp
+        self.poses[name] = (np.asarray(pos, float), np.asarray(rot, float))
+        self.bodies[name] = b
+        return b
+
+    def capsule(self, body: str, a, b, radius: float = 0.012, rgba=(0.6, 0.6, 0.65, 1)):
+        self.bodies[body].add_geom(type=mujoco.mjtGeom.mjGEOM_CAPSULE, size=[radius, 0, 0],
+                                   fromto=np.concatenate([self.local(body, a), self.local(body, b)]),
+                                   rgba=rgba, **_NO_COLLISION)
+
+    def site(self, body: str, name: str, p):
+        self.bodies[body].add_site(name=name, pos=self.local(body, p), size=[0.01, 0, 0])
+
+    def closure(self, name: str, kind, b1: str, b2: str, anchor_world=None):
+        """A loop-closing ``connect`` or ``weld`` between two bodies, anchored at a world point
+        (a weld defaults to body1's origin)."""
+        eq = self.spec.add_equality(name=name, type=kind, objtype=mujoco.mjtObj.mjOBJ_BODY, name1=b1, name2=b2)
+        data = np.zeros(12)
+        data[10] = 1.0  # weld torque scale
+        if kind == mujoco.mjtEq.mjEQ_CONNECT:  # anchor in body1; MuJoCo places body2's at design
+            data[0:3] = self.local(b1, anchor_world)
+        else:  # anchor in body2, where the load passes (else the weld's soft rotation rows carry
+            # a moment and the joint turns); zero relative pose = MuJoCo takes the design one
+            data[0:3] = self.local(b2, self.poses[b1][0] if anchor_world is None else anchor_world)
+        eq.data = data
+        self._stiff(eq)
+        self.closures.append(name)
+        return eq
+
+    def _stiff(self, eq):
+        eq.solref = [2.0 * self.o.timestep, 1.0]
+        eq.solimp = list(CLOSURE_SOLIMP)
+
+    def drive(self, name: str, joint: str):
+        """An ``equality/joint`` holding ``joint`` at ``eq_data[0]`` (set at run time)."""
+        eq = self.spec.add_equality(name=name, type=mujoco.mjtEq.mjEQ_JOINT, objtype=mujoco.mjtObj.mjOBJ_JOINT,
+                                    name1=joint)
+        self._stiff(eq)
+
+    def bushing_joints(self, body: str, bushing: BushingDef, side: str, sign: float):
+        """Six joints (slide x, y, z; hinge x, y, z) in the bushing frame = ``body``'s frame, and the
+        bushing's cross stiffnesses; side ``sign`` (+1 left, −1 right) mirrors the left's laws."""
+        b = self.bodies[body]
+        name = f"{bushing.name}_{side}"
+        signs = dict(zip(DIRECTIONS, mirror_signs(bushing.axes, sign)))
+        for i, d in enumerate(DIRECTIONS):
+            direction = bushing.directions[d]
+            params, effects = mirrored_law(direction.channel(self.o.bushing_model), direction.effects_si(), signs[d])
+            if self.o.rigid_bushings and len(d) == 1:
+                params = params.replace(model="linear", K0=RIGID_TRANSLATION, C=0.0, n_cells=0,
+                                        S_sup=math.inf, S_inf=-math.inf)
+                effects = NO_EFFECTS
+            ch = Channel(f"{name}.{d}", f"{name}_{d}", params, effects)
+            axis = np.eye(3)[i % 3]
+            kind = mujoco.mjtJoint.mjJNT_SLIDE if len(d) == 1 else mujoco.mjtJoint.mjJNT_HINGE
+            j = b.add_joint(name=ch.joint, type=kind, axis=axis)
+            j.stiffness = [joint_stiffness(ch), 0.0, 0.0]
+            j.damping = [params.C, 0.0, 0.0]
+            self.channels.append(ch)
+        for term in bushing.coupling:
+            a, c = term.directions
+            self.cross.append(CrossTerm(f"{name}_{a}", f"{name}_{c}", signs[a] * signs[c] * term.stiffness))
+
+    # -- the car -----------------------------------------------------------------------------
+    def build(self) -> CarModel:
+        v = self.v
+        chassis_rot = np.eye(3)
+        chassis = self.body("world", "chassis", np.zeros(3), chassis_rot, v.body.mass, v.body.cg,
+                            v.body.inertia)
+        if not self.o.clamped:
+            chassis.add_freejoint(name="chassis_free")
+        chassis.add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, size=[1.6, 0.6, 0.05],
+                         pos=self.local("chassis", [v.body.cg[0], 0, 0.45]), rgba=[0.3, 0.4, 0.7, 0.3],
+                         **_NO_COLLISION)
+        self.rack()
+        for side, sign in SIDES:
+            self.front_corner(side, sign)
+        for side, sign in SIDES:
+            self.rear_corner(side, sign)
+        self.beam()
+        self.anti_roll_bar()
+        model = self.spec.compile()
+        return CarModel(v, self.o, self.spec, model, self.channels, self.elements, self.closures, self.corners,
+                        self.cross)
+
+    def rack(self):
+        f = self.v.front
+        inner = np.array(f.hardpoints["tie_rod_inner"])
+        centre = np.array([inner[0], 0.0, inner[2]])
+        self.body("chassis", "rack", centre, np.eye(3), f.masses["rack"], centre, [0.05, 1e-3, 0.05])
+        self.bodies["rack"].add_joint(name="rack", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[0, 1, 0])
+        self.capsule("rack", mirror(inner, 1), mirror(inner, -1), 0.015)
+        if self.o.rig:
+            self.drive("rack_drive", "rack")
+
+    def front_corner(self, side: str, sign: float):
+        v, f = self.v, self.v.front
+        hp = {k: mirror(p, sign) for k, p in f.hardpoints.items()}
+        bushings = [b for b in v.bushings if b.child == "front.wishbone"]
+        wishbone = f"wishbone_{side}"
+        com = (hp["wishbone_front_pivot"] + hp["wishbone_rear_pivot"] + hp["lower_ball_joint"]) / 3.0
+        closing = len(bushings) - 1
+        m = f.masses["wishbone"] - SLEEVE_MASS * closing
+        if m <= 0:
+            raise ValueError("wishbone mass smaller than its bushing sleeves")
+        self._hang("chassis", wishbone, bushings, side, sign, m, com, [0.05, 0.05, 0.09])
+        self.capsule(wishbone, hp["wishbone_front_pivot"], hp["lower_ball_joint"])
+        self.capsule(wishbone, hp["wishbone_rear_pivot"], hp["lower_ball_joint"])
+
+        knuckle = f"knuckle_{side}"
+        wc = hp["wheel_centre"]
+        self.body(wishbone, knuckle, hp["lower_ball_joint"], np.eye(3), f.masses["knuckle"],
+                  wc + np.array([0.0, -sign * 0.08, 0.03]), [0.25, 0.2, 0.2])
+        self.bodies[knuckle].add_joint(name=f"ball_joint_{side}", type=mujoco.mjtJoint.mjJNT_BALL)
+        self.capsule(knuckle, hp["lower_ball_joint"], hp["strut_lower"], 0.02)
+        self.capsule(knuckle, hp["strut_lower"], wc, 0.02)
+        self.capsule(knuckle, wc, hp["tie_rod_outer"], 0.012)
+        self.site(knuckle, f"tie_rod_outer_{side}", hp["tie_rod_outer"])
+
+        rod = f"strut_rod_{side}"
+        axis = hp["strut_top"] - hp["strut_lower"]
+        rot = frame_from(axis, np.array([1.0, 0, 0]))
+        self.body(knuckle, rod, hp["strut_lower"], rot, f.masses["strut_rod"],
+                  (hp["strut_lower"] + hp["strut_top"]) / 2, [0.02, 0.02, 1e-3])
+        j = self.bodies[rod].add_joint(name=f"strut_{side}", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[0, 0, 1])
+        j.frictionloss = f.strut_friction[0 if sign > 0 else 1]
+        # friction as stiff as the loop closures: at MuJoCo's default (0.02 s) the regularised friction
+        # let the rod creep through 200 N at 2 mm/s (pad-force loop 7 N wide instead of 2·200 N·MR)
+        j.solref_friction, j.solimp_friction = [2.0 * self.o.timestep, 1.0], list(CLOSURE_SOLIMP)
+        self.capsule(rod, hp["strut_lower"], hp["strut_top"], 0.01, (0.8, 0.8, 0.8, 1))
+        self._spring_damper_joint(j, f"front_{side}", f.spring, f.damper.curve)
+        self.closure(f"top_mount_{side}", mujoco.mjtEq.mjEQ_CONNECT, rod, "chassis", hp["strut_top"])
+
+        tendon = self.spec.add_tendon(name=f"tie_rod_{side}")
+        self.site("rack", f"tie_rod_inner_{side}", hp["tie_rod_inner"])
+        tendon.wrap_site(f"tie_rod_inner_{side}")
+        tendon.wrap_site(f"tie_rod_outer_{side}")
+        eq = self.spec.add_equality(name=f"tie_rod_{side}", type=mujoco.mjtEq.mjEQ_TENDON,
+                                    objtype=mujoco.mjtObj.mjOBJ_TENDON, name1=f"tie_rod_{side}")
+        self._stiff(eq)
+        self.closures.append(f"tie_rod_{side}")
+        self.wheel(knuckle, f"front_{side}", wc, f.static_toe, f.static_camber, sign)
+
+    def rear_corner(self, side: str, sign: float):
+        v, r = self.v, self.v.rear
+        hp = {k: mirror(p, sign) for k, p in r.hardpoints.items()}
+        bushings = [b for b in v.bushings if b.child == "rear.arm"]
+        arm = f"arm_{side}"
+        wc = hp["wheel_centre"]
+        beam_end = np.array([hp["beam_centre"][0], hp["arm_pivot"][1], hp["beam_centre"][2]])
+        closing = len(bushings) - 1
+        com = (hp["arm_pivot"] + wc + beam_end) / 3.0
+        mass = r.masses["arm"] - SLEEVE_MASS * closing - BEAM_CENTRE_MASS
+        self._hang("chassis", arm, bushings, side, sign, mass, com,
+                   [0.15, 0.1, 0.2])
+        self.capsule(arm, hp["arm_pivot"], wc, 0.025)
+        self.capsule(arm, beam_end, hp["beam_centre"], 0.03)
+        hub = f"hub_{side}"
+        self.body(arm, hub, wc, np.eye(3), r.masses["hub"], wc - np.array([0, sign * 0.05, 0]), [0.03, 0.04, 0.03])
+        for kind in ("spring", "damper"):
+            lo, up = f"rear_{kind}_lower_{side}", f"rear_{kind}_upper_{side}"
+            self.site(arm, lo, hp[f"{kind}_lower"])
+            self.site("chassis", up, hp[f"{kind}_upper"])
+            t = self.spec.add_tendon(name=f"rear_{kind}_{side}")
+            t.wrap_site(lo)
+            t.wrap_site(up)
+            length0 = float(np.linalg.norm(hp[f"{kind}_upper"] - hp[f"{kind}_lower"]))
+            el = Element(f"rear_{kind}_{side}", "tendon", t.name, -1.0)
+            if kind == "spring":
+                el.spring, el.preload = r.spring, r.spring.preload or 0.0
+                t.stiffness = [r.spring.rate, 0.0, 0.0]
+                t.springlength = [length0 + el.preload / r.spring.rate] * 2
+            else:
+                el.damper_curve = r.damper.curve
+            self.elements.append(el)
+        self.wheel(hub, f"rear_{side}", wc, r.static_toe, r.static_camber, sign)
+
+    def beam(self):
+        """The cross beam's torsion: a hinge about the beam axis between the two arms."""
+        r = self.v.rear
+        centre = np.array(r.hardpoints["beam_centre"])
+        # the middle of the beam, taken from the arms' masses: its inertia stiffens the weld in rotation
+        self.body("arm_left", "beam_centre", centre, np.eye(3), 2 * BEAM_CENTRE_MASS, centre, [0.25, 0.01, 0.25])
+        j = self.bodies["beam_centre"].add_joint(name="beam_torsion", type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 1, 0])
+        j.stiffness = [r.beam_torsion, 0.0, 0.0]
+        self.closure("beam_weld", mujoco.mjtEq.mjEQ_WELD, "beam_centre", "arm_right")
+
+    def anti_roll_bar(self):
+        """Front anti-roll bar: a fixed tendon of (left − right) strut length with a stiffness."""
+        t = self.spec.add_tendon(name="front_anti_roll_bar")
+        t.wrap_joint("strut_left", 1.0)
+        t.wrap_joint("strut_right", -1.0)
+        t.stiffness = [self.v.front.anti_roll_rate, 0.0, 0.0]
+        t.springlength = [0.0, 0.0]
+
+    def _hang(self, parent, part, bushings, side, sign, mass, com, inertia):
+        """The part on its first bushing's joints; further bushings as sleeves welded to it."""
+        first, *others = bushings
+        axes = mirror_axes(first.axes, sign)
+        self.body(parent, part, mirror(first.location, sign), axes.T, mass, com, inertia)
+        self.bushing_joints(part, first, side, sign)
+        for b in others:
+            sleeve = f"{b.name}_{side}_sleeve"
+            loc = mirror(b.location, sign)
+            self.body(parent, sleeve, loc, mirror_axes(b.axes, sign).T, SLEEVE_MASS, loc, [1e-3] * 3)
+            self.bushing_joints(sleeve, b, side, sign)
+            self.closure(f"{b.name}_{side}_weld", mujoco.mjtEq.mjEQ_WELD, sleeve, part)
+
+    def _spring_damper_joint(self, joint, name: str, spring: Spring, damper_curve):
+        """Spring and damper on a strut slide (positive = extension, so compression = −q)."""
+        preload = spring.preload or 0.0
+        joint.stiffness = [spring.rate, 0.0, 0.0]
+        joint.springref = preload / spring.rate
+        self.elements.append(Element(f"{name}_spring", "joint", joint.name, -1.0, spring, preload))
+        self.elements.append(Element(f"{name}_damper", "joint", joint.name, -1.0, damper_curve=damper_curve))
+
+    def wheel(self, parent: str, corner: str, centre, toe: float, camber: float, sign: float):
+        """Wheel on a spin hinge; on the rig, a pad under its contact point."""
+        t = self.v.tyre
+        spin_left = sign * wheel_axis(toe, camber, sign)  # spin axis pointing to the vehicle's left
+        rot = frame_from(spin_left, np.array([1.0, 0, 0]), order="yx")
+        name = f"wheel_{corner}"
+        i_spin, i_diam = t.wheel_inertia
+        self.body(parent, name, centre, rot, t.wheel_mass, centre, [i_diam, i_spin, i_diam])
+        hinge = self.bodies[name].add_joint(name=f"spin_{corner}", type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 1, 0])
+        self.bodies[name].add_geom(type=mujoco.mjtGeom.mjGEOM_CYLINDER, size=[t.radius, 0.095, 0],
+                                   quat=_quat(frame_from(np.array([0, 1.0, 0]), np.array([1.0, 0, 0]))),
+                                   rgba=[0.1, 0.1, 0.1, 0.6], **_NO_COLLISION)
+        up = np.array([0, 0, 1.0]) - spin_left * spin_left[2]
+        contact = np.asarray(centre) - t.radius * up / np.linalg.norm(up)
+        self.site(name, f"contact_{corner}", contact)
+        self.site(name, f"centre_{corner}", centre)
+        names = {"wheel": name, "contact_site": f"contact_{corner}", "centre_site": f"centre_{corner}"}
+        if self.o.rig:
+            self.drive(f"brake_{corner}", hinge.name)
+            pad = f"pad_{corner}"
+            self.body("world", pad, contact, np.eye(3), PAD_MASS, contact, [0.01] * 3, gravcomp=1.0)
+            self.bodies[pad].add_joint(name=f"pad_z_{corner}", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[0, 0, 1])
+            self.bodies[pad].add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, size=[0.2, 0.15, 0.01],
+                                      pos=[0, 0, -0.012], rgba=[0.7, 0.5, 0.2, 1], **_NO_COLLISION)
+            carriage = f"carriage_{corner}"
+            self.body(pad, carriage, contact, np.eye(3), PAD_MASS, contact, [0.01] * 3, gravcomp=1.0)
+            self.bodies[carriage].add_joint(name=f"pad_x_{corner}", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[1, 0, 0])
+            self.bodies[carriage].add_joint(name=f"pad_y_{corner}", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[0, 1, 0])
+            self.drive(f"pad_drive_{corner}", f"pad_z_{corner}")
+            self.closure(f"contact_{corner}", mujoco.mjtEq.mjEQ_CONNECT, name, carriage, contact)
+            names |= {"pad_drive": f"pad_drive_{corner}", "pad_z": f"pad_z_{corner}", "contact_eq": f"contact_{corner}"}
+        self.corners[corner] = names
+
+
+def build(vehicle: VehicleDefinition, options: BuildOptions = BuildOptions()) -> CarModel:
+    """Compile the MuJoCo model of ``vehicle`` (spring preloads must be resolved, see ``vehicle.model.statics``)."""
+    return _Builder(vehicle, options).build()

@@ -1,0 +1,120 @@
+"""Kinematics of the suspensions with rigid bushings, solved from the hardpoints alone (no MuJoCo).
+
+Used as the independent reference of the kinematics test and for the static spring preloads. The
+bushings are ball joints (rigid in translation, free in rotation): the wishbone turns about the
+line through its two pivots, the twist beam about the line through the arm pivots (heave).
+Wheels are braked (fixed to knuckle or arm); the rig moves the wheel's design contact point
+vertically. Left side; the right side is its mirror image.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import brentq, fsolve
+from scipy.spatial.transform import Rotation
+
+from vehicle.model.builder import wheel_axis
+from vehicle.model.definition import VehicleDefinition
+
+
+@dataclass(frozen=True)
+class Motion:
+    """A rigid displacement from design: ``p -> rot @ p + shift`` (world coordinates)."""
+
+    rot: np.ndarray
+    shift: np.ndarray
+
+    def __call__(self, p) -> np.ndarray:
+        return self.rot @ np.asarray(p, float) + self.shift
+
+
+def about(point, axis, angle: float) -> Motion:
+    """Rotation by ``angle`` [rad] about the line through ``point`` along ``axis``."""
+    rot = Rotation.from_rotvec(np.asarray(axis) / np.linalg.norm(axis) * angle).as_matrix()
+    point = np.asarray(point, float)
+    return Motion(rot, point - rot @ point)
+
+
+def contact_point(centre, spin_axis, radius: float) -> np.ndarray:
+    """The lowest point of the wheel's mid-plane circle at design (fixed on the wheel after that)."""
+    up = np.array([0.0, 0, 1]) - spin_axis * spin_axis[2]
+    return np.asarray(centre) - radius * up / np.linalg.norm(up)
+
+
+def wheel_angles(spin_out: np.ndarray, sign: float = 1.0) -> tuple[float, float]:
+    """(toe-in, camber) [rad] of a wheel from its outward spin axis (ISO 8855 signs)."""
+    toe = math.atan2(spin_out[0], sign * spin_out[1])
+    camber = -math.asin(float(np.clip(spin_out[2], -1.0, 1.0)))
+    return toe, camber
+
+
+@dataclass(frozen=True)
+class CornerState:
+    """Pose of a corner's parts for one wheel travel."""
+
+    travel: float                     #: contact-point height change [m], bump positive
+    parts: dict[str, Motion]          #: motion of each part from design
+    strut_extension: float            #: front strut slide [m] (extension positive); rear: 0
+    toe: float                        #: [rad]
+    camber: float                     #: [rad]
+    wheel_centre: np.ndarray          #: [m]
+
+
+def front_corner(v: VehicleDefinition, travel: float, rack: float = 0.0,
+                 guess: np.ndarray | None = None) -> tuple[CornerState, np.ndarray]:
+    """Left front corner at contact-point travel ``travel`` [m] and rack shift ``rack`` [m, +y].
+
+    Unknowns: wishbone angle about its pivot line, knuckle rotation vector about the ball joint,
+    strut extension. Equations: rod top at the top mount (3), tie-rod length (1), contact height (1).
+    Returns the state and the solution vector (a guess for the next call).
+    """
+    hp = {k: np.array(p) for k, p in v.front.hardpoints.items()}
+    e1, e2, lbj = hp["wishbone_front_pivot"], hp["wishbone_rear_pivot"], hp["lower_ball_joint"]
+    s0, top = hp["strut_lower"], hp["strut_top"]
+    strut_len = np.linalg.norm(top - s0)
+    e0 = (top - s0) / strut_len
+    inner = hp["tie_rod_inner"] + np.array([0.0, rack, 0.0])
+    tie_len = np.linalg.norm(hp["tie_rod_outer"] - hp["tie_rod_inner"])
+    spin = wheel_axis(v.front.static_toe, v.front.static_camber, 1.0)
+    contact = contact_point(hp["wheel_centre"], spin, v.tyre.radius)
+
+    def parts(x):
+        wishbone = about(e1, e1 - e2, x[0])
+        rot = Rotation.from_rotvec(x[1:4]).as_matrix()
+        knuckle = Motion(rot, wishbone(lbj) - rot @ lbj)
+        rod = Motion(rot, knuckle.shift + rot @ e0 * x[4])
+        return {"wishbone": wishbone, "knuckle": knuckle, "rod": rod}
+
+    def residual(x):
+        p = parts(x)
+        k = p["knuckle"]
+        return np.concatenate([
+            k(s0) + k.rot @ e0 * (strut_len + x[4]) - top,
+            [np.linalg.norm(k(hp["tie_rod_outer"]) - inner) - tie_len,
+             k(contact)[2] - contact[2] - travel]])
+
+    x0 = np.zeros(5) if guess is None else guess
+    x, _, _, msg = fsolve(residual, x0, full_output=True, xtol=1e-13)
+    # judged by the residual, not by fsolve's flag: near round-off the flag depends on the CPU's
+    # rounding ("not making good progress" on a solution whose residual is below 1e-15)
+    if not np.abs(residual(x)).max() <= 1e-10:
+        raise RuntimeError(f"front kinematics did not converge at travel {travel}: {msg}")
+    p = parts(x)
+    toe, camber = wheel_angles(p["knuckle"].rot @ spin)
+    return CornerState(travel, p, float(x[4]), toe, camber, p["knuckle"](hp["wheel_centre"])), x
+
+
+def rear_heave(v: VehicleDefinition, travel: float) -> CornerState:
+    """Left rear corner in heave (both arms turning together about the pivot line)."""
+    hp = {k: np.array(p) for k, p in v.rear.hardpoints.items()}
+    pivot = hp["arm_pivot"]
+    spin = wheel_axis(v.rear.static_toe, v.rear.static_camber, 1.0)
+    contact = contact_point(hp["wheel_centre"], spin, v.tyre.radius)
+    arm = lambda angle: about(pivot, [0.0, 1.0, 0.0], angle)
+    angle = brentq(lambda a: arm(a)(contact)[2] - contact[2] - travel, -0.5, 0.5, xtol=1e-15)
+    m = arm(angle)
+    toe, camber = wheel_angles(m.rot @ spin)
+    return CornerState(travel, {"arm": m}, 0.0, toe, camber, m(hp["wheel_centre"]))

@@ -1,0 +1,231 @@
+"""Per-step forces computed outside MuJoCo: bushing laws, spring and damper characteristics.
+
+Scheme (stable at any step, see the engineering notes): MuJoCo's ``discrete`` integrator treats
+joint stiffness and damping implicitly, forces written to ``qfrc_applied`` explicitly. So
+
+* a linear bushing direction lives entirely in its joint (stiffness K0, damping C);
+* any other direction keeps a reference stiffness K_ref = K0 + Kpa (its tangent at small
+  amplitude, the largest tangent of the ladder family) and its damping C in the joint; before each
+  step ONE compiled call of the bushing bank (:func:`bushings.effects.step_extended`: the law with
+  its state extensions, if any) gives F(e) at the current deflections and only F(e) − K_ref·e is
+  applied explicitly. That remainder's stiffness lies in [−Kpa, 0] ⊂ (−K_ref, 0], so the explicit
+  part can never destabilise the implicit one (laws that may stiffen beyond K_ref, the nonlinear
+  elastic saturation and any law with effects, get K_ref raised to their current tangent each step);
+* a bushing's directional coupling (cross stiffness k between two of its directions) is applied
+  explicitly; k² < K0_a·K0_b (checked on loading) keeps the coupled tangent positive definite,
+  which is also what keeps that explicit term below the implicit diagonal;
+* springs: rate and preload in the joint or tendon; a curve's departure from its rate explicit;
+* dampers: the slope of the active curve segment set as the joint/tendon damping each step
+  (implicit), the segment's intercept applied explicitly.
+
+:meth:`ForceCoupling.apply` does all of it in one compiled call (:mod:`vehicle.simulation.stepping`, which
+also runs whole stretches of steps with ``mj_step`` inside the compiled loop).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Sequence
+
+import mujoco
+import numpy as np
+
+from vehicle.model.builder import CarModel, CrossTerm
+
+
+def _pad_curves(curves) -> tuple[np.ndarray, np.ndarray]:
+    """Curves as (E, P) arrays, padded by extending each last segment (for a batched lookup)."""
+    n = max(len(c.x) for c in curves)
+    xs, ys = np.zeros((len(curves), n)), np.zeros((len(curves), n))
+    for i, c in enumerate(curves):
+        x, y = list(c.x), list(c.y)
+        slope = (y[-1] - y[-2]) / (x[-1] - x[-2])
+        while len(x) < n:
+            x.append(x[-1] + 1e3)
+            y.append(y[-1] + 1e3 * slope)
+        xs[i], ys[i] = x, y
+    return xs, ys
+
+
+def _segments(xq: np.ndarray, xs: np.ndarray, ys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Slope and intercept of each curve's segment at ``xq`` (linear extrapolation at the ends)."""
+    rows = np.arange(len(xq))
+    i = np.clip((xs <= xq[:, None]).sum(axis=1) - 1, 0, xs.shape[1] - 2)
+    slope = (ys[rows, i + 1] - ys[rows, i]) / (xs[rows, i + 1] - xs[rows, i])
+    return slope, ys[rows, i] - slope * xs[rows, i]
+
+
+class BushingForces:
+    """The bushing directions of a model: one bank call per step, remainder into ``qfrc_applied``.
+
+    Each channel's joint must carry its reference stiffness (K0 for linear laws, K0 + Kpa
+    otherwise, see :func:`vehicle.model.builder.joint_stiffness`). The parallel damping C is taken where
+    the model put it: in the joint if the joint has damping (implicit), else in the bank (explicit).
+    The bank is an :class:`bushings.effects.ExtendedBank`: a channel with a preload is mounted at
+    the design position (deflection 0) on every reset, with zero force there. ``cross`` are the
+    bushings' cross stiffnesses between channels (:class:`vehicle.model.builder.CrossTerm`).
+    """
+
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, channels, cross: Sequence[CrossTerm] = ()):
+        self.model, self.data = model, data
+        from bushings.effects import ExtendedBank
+
+        ids = np.array([mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, c.joint) for c in channels], dtype=np.int64)
+        self.jnt = ids
+        self.qpos = model.jnt_qposadr[ids]
+        self.dof = model.jnt_dofadr[ids]
+        self.K = model.jnt_stiffness[ids].copy()
+        self.C = model.dof_damping[self.dof].copy()
+        self.bank_idx = np.flatnonzero([not c.linear for c in channels])
+        params = [channels[i].params for i in self.bank_idx]
+        params = [p.replace(C=0.0) if self.C[i] > 0 else p for p, i in zip(params, self.bank_idx)]
+        effects = [channels[i].effects for i in self.bank_idx]
+        #: possibly empty (all laws linear, in the joints); None = laws off, joints only (KCRig.bushing_laws_off)
+        self.bank: ExtendedBank | None = ExtendedBank(params, effects)
+        self.bank_force = np.zeros(self.bank_idx.size)
+        self.bank_jnt, self.bank_qpos = ids[self.bank_idx], self.qpos[self.bank_idx]
+        self.bank_dof = self.dof[self.bank_idx]
+        self.K_ref = self.K[self.bank_idx].copy()
+        self.saturating = np.array([math.isfinite(p.S_sup) or math.isfinite(p.S_inf) or fx.active
+                                    for p, fx in zip(params, effects)], dtype=np.bool_)
+        index = {c.joint: i for i, c in enumerate(channels)}
+        #: (P, 2) channel indices of each cross term's two directions, and its stiffness k (P,)
+        self.cross_channels = np.array([[index[t.joint_a], index[t.joint_b]] for t in cross],
+                                       dtype=np.int64).reshape(-1, 2)
+        self.cross_k = np.array([t.stiffness for t in cross], dtype=float)
+
+    def apply(self, dt: float) -> None:
+        """Step the bank to the current deflections and add F(e) − K_ref·e, and the cross
+        stiffnesses' forces, to ``qfrc_applied``."""
+        d = self.data
+        if self.bank is not None and self.bank.size:
+            e = d.qpos[self.bank_qpos]
+            force, tangent = self.bank.step(e, dt)
+            self.bank_force = force
+            if self.saturating.any():
+                self.K_ref[:] = np.where(self.saturating, np.maximum(self.K[self.bank_idx], tangent), self.K_ref)
+                self.model.jnt_stiffness[self.bank_jnt] = self.K_ref
+            d.qfrc_applied[self.bank_dof] += self.K_ref * e - force
+        if self.cross_k.size:
+            d.qfrc_applied[self.dof] -= self.cross_forces()
+
+    def deflections(self) -> np.ndarray:
+        """Deflection of every direction [m or rad], in the bushing's frame."""
+        return self.data.qpos[self.qpos].copy()
+
+    def cross_forces(self) -> np.ndarray:
+        """Force of the cross stiffnesses on every direction [N or N·m], resisting deflection."""
+        q = self.data.qpos[self.qpos]
+        a, b = self.cross_channels.T
+        force = np.zeros(self.qpos.size)
+        np.add.at(force, a, self.cross_k * q[b])
+        np.add.at(force, b, self.cross_k * q[a])
+        return force
+
+    def forces(self) -> np.ndarray:
+        """Force of every direction [N or N·m], resisting its deflection (joint damping included)."""
+        d = self.data
+        force = self.K * d.qpos[self.qpos] + self.C * d.qvel[self.dof]
+        if self.bank is not None:
+            force[self.bank_idx] = self.bank_force + self.C[self.bank_idx] * d.qvel[self.bank_dof]
+        return force + self.cross_forces()
+
+    def reset(self) -> None:
+        """Forget the bushings' history (virgin state)."""
+        if self.bank is not None:
+            self.bank.reset()
+        self.bank_force = np.zeros(self.bank_idx.size)
+
+
+class ForceCoupling:
+    """Writes the non-implicit forces of a :class:`CarModel` into ``MjData`` before every step.
+
+    It owns ``qfrc_applied`` (rewritten every step); inputs from outside go to ``xfrc_applied``.
+    """
+
+    def __init__(self, car: CarModel, data: mujoco.MjData):
+        self.model, self.car, self.data = car.model, car, data
+        self.bushings = BushingForces(car.model, data, car.channels, car.cross)
+        self._init_elements()
+        self._kernel_bank: object = False  # the bank the compiled-kernel arrays were built for
+        self._kernel: tuple = ()
+
+    def _init_elements(self) -> None:
+        m = self.model
+        springs = [e for e in self.car.elements if e.spring is not None]
+        dampers = [e for e in self.car.elements if e.damper_curve is not None]
+        jid = lambda n: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, n)
+        tid = lambda n: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_TENDON, n)
+        d0 = mujoco.MjData(m)
+        mujoco.mj_forward(m, d0)
+
+        def coords(elements):
+            joint = np.array([e.kind == "joint" for e in elements])
+            index = np.array([m.jnt_dofadr[jid(e.target)] if e.kind == "joint" else tid(e.target)
+                              for e in elements])
+            qadr = np.array([m.jnt_qposadr[jid(e.target)] if e.kind == "joint" else -1 for e in elements])
+            design = np.array([0.0 if e.kind == "joint" else d0.ten_length[tid(e.target)] for e in elements])
+            return joint, index, qadr, design, np.array([e.sign for e in elements])
+
+        self.springs = springs
+        self.sp_joint, self.sp_index, self.sp_qadr, self.sp_design, self.sp_sign = coords(springs)
+        self.sp_xs, self.sp_ys = _pad_curves([e.spring.curve for e in springs])
+        self.sp_rate = np.array([e.spring.rate for e in springs])
+        self.sp_preload = np.array([e.preload for e in springs])
+        self.sp_y0 = np.array([e.spring.curve(0.0) for e in springs])
+        self.sp_nonlinear = any(len(e.spring.curve.x) > 2 for e in springs)
+        self.dampers = dampers
+        self.dp_joint, self.dp_index, self.dp_qadr, _, self.dp_sign = coords(dampers)
+        self.dp_xs, self.dp_ys = _pad_curves([e.damper_curve for e in dampers])
+        self.dp_offset = np.zeros(len(dampers))
+
+    # -- every step --------------------------------------------------------------------------
+    def kernel_arrays(self) -> tuple:
+        """Arguments of :func:`vehicle.simulation.stepping.coupling_step` after ``h`` (views of the model and
+        data, and this coupling's tables), rebuilt when the bank is swapped (see BushingForces.bank)."""
+        from vehicle.simulation import stepping
+
+        b = self.bushings
+        if self._kernel_bank is not b.bank:
+            self._kernel_bank = b.bank
+            m, d = self.model, self.data
+            self._kernel = (d.qpos, d.qvel, d.qfrc_applied, d.ten_length, d.ten_velocity, d.ten_J, m.ten_J_rowadr,
+                            m.ten_J_rownnz, m.ten_J_colind, m.jnt_stiffness, m.dof_damping,
+                            m.tendon_damping) + stepping.coupling_arrays(self)
+        return self._kernel
+
+    def apply(self, dt: float) -> None:
+        """Compute and write the forces for the next step of length ``dt`` [s] (one compiled call)."""
+        from vehicle.simulation import stepping
+
+        stepping.coupling_step(dt, *self.kernel_arrays())
+        b = self.bushings
+        if b.bank is not None:
+            b.bank_force = b.bank.force
+
+    # -- outputs -----------------------------------------------------------------------------
+    def spring_compression(self) -> np.ndarray:
+        """Compression of every spring from design [m], bump positive."""
+        d = self.data
+        coord = np.where(self.sp_joint, d.qpos[np.where(self.sp_joint, self.sp_qadr, 0)],
+                         d.ten_length[np.where(self.sp_joint, 0, self.sp_index)])
+        return self.sp_sign * (coord - self.sp_design)
+
+    def spring_forces(self) -> np.ndarray:
+        """Force of every spring [N], pushing apart."""
+        x = self.spring_compression()
+        slope, offset = _segments(x, self.sp_xs, self.sp_ys)
+        return self.sp_preload + slope * x + offset - self.sp_y0
+
+    def damper_forces(self) -> np.ndarray:
+        """Force of every damper [N], pushing apart (positive in compression)."""
+        d = self.data
+        velocity = np.where(self.dp_joint, d.qvel[np.where(self.dp_joint, self.dp_index, 0)],
+                            d.ten_velocity[np.where(self.dp_joint, 0, self.dp_index)])
+        speed = self.dp_sign * velocity
+        slope, offset = _segments(speed, self.dp_xs, self.dp_ys)
+        return slope * speed + offset
+
+    def reset(self) -> None:
+        """Forget the bushings' history (virgin state)."""
+        self.bushings.reset()

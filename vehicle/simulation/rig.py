@@ -1,0 +1,237 @@
+"""The virtual K&C rig: body clamped, each wheel on a pad, rack displacement input.
+
+Pads impose the vertical displacement of each wheel's contact point (bump positive) and apply
+longitudinal and lateral forces at it and an aligning torque about the vertical; the wheels are
+braked. Outputs follow ISO 8855: toe-in positive, camber positive when the wheel top leans
+outward, steer angle positive to the left, half-track = |y| of the wheel centre.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from contextlib import contextmanager
+from dataclasses import dataclass
+from typing import Iterator
+
+import mujoco
+import numpy as np
+
+from vehicle.simulation import stepping
+from vehicle.model.builder import CORNERS, BuildOptions, CarModel, build
+from vehicle.simulation.coupling import ForceCoupling
+from vehicle.model.definition import VehicleDefinition
+from vehicle.model.kinematics import wheel_angles
+from vehicle.model.statics import resolve_preloads
+
+_NO_INPUTS = np.zeros((0, 17))
+_INACTIVE = np.zeros(5, dtype=bool)
+_ALL_ACTIVE = np.ones(5, dtype=bool)
+# a plain int: comparing an array with the pybind enum goes element by element through Python (100 µs)
+_EQUALITY_ROW = int(mujoco.mjtConstraint.mjCNSTR_EQUALITY)
+_SIGN = {"front_left": 1.0, "front_right": -1.0, "rear_left": 1.0, "rear_right": -1.0}
+
+
+@dataclass(frozen=True)
+class WheelOutputs:
+    """What the rig measures at one wheel."""
+
+    camber: float               #: [rad], top outward positive
+    toe: float                  #: [rad], toe-in positive
+    steer: float                #: yaw of the wheel heading [rad], to the left positive
+    half_track: float           #: |y| of the wheel centre [m]
+    wheel_centre: np.ndarray    #: [m], world (= body, clamped) frame
+    pad_force: np.ndarray       #: force of the pad on the wheel (Fx, Fy, Fz) [N]
+    pad_height: float           #: measured pad (contact-point) displacement [m], bump positive
+    pad_torque: float = 0.0     #: aligning torque applied about the vertical [N·m]
+
+
+@dataclass(frozen=True)
+class RigOutputs:
+    """One sample of the rig."""
+
+    time: float                              #: [s]
+    wheels: dict[str, WheelOutputs]
+    bushing_names: tuple[str, ...]           #: ``bushing_side.direction``
+    bushing_deflection: np.ndarray           #: [m or rad] in each bushing's frame
+    bushing_force: np.ndarray                #: [N or N·m], resisting the deflection
+    spring_force: dict[str, float]           #: [N], pushing apart
+    damper_force: dict[str, float]           #: [N], pushing apart
+    closure_error: float                     #: largest loop-closure position error [m]
+
+
+class KCRig:
+    """A vehicle on the K&C rig, stepped with its bushing coupling."""
+
+    def __init__(self, vehicle: VehicleDefinition, options: BuildOptions = BuildOptions()):
+        options = dataclasses.replace(options, rig=True)
+        self.vehicle = resolve_preloads(vehicle)
+        self.car: CarModel = build(self.vehicle, options)
+        m = self.model = self.car.model
+        self.data = mujoco.MjData(m)
+        self.coupling = ForceCoupling(self.car, self.data)
+        eq = lambda n: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_EQUALITY, n)
+        body = lambda n: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, n)
+        self.pad_eq = np.array([eq(self.car.corners[c]["pad_drive"]) for c in CORNERS])
+        self.rack_eq = eq("rack_drive")
+        self.wheel_body = np.array([body(self.car.corners[c]["wheel"]) for c in CORNERS])
+        self.pad_qpos = m.jnt_qposadr[[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, self.car.corners[c]["pad_z"])
+                                       for c in CORNERS]]
+        self.carriage_body = np.array([body(f"carriage_{c}") for c in CORNERS])
+        self.centre_site = np.array([mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, self.car.corners[c]["centre_site"])
+                                     for c in CORNERS])
+        self.closure_eq = np.array([eq(n) for n in self.car.closures])
+        self.closure_rows = np.array([3 if m.eq_type[i] != mujoco.mjtEq.mjEQ_TENDON else 1 for i in self.closure_eq])
+
+    # -- inputs ------------------------------------------------------------------------------
+    def set_pads(self, heights) -> None:
+        """Contact-point displacements [m] of the four pads (order of ``CORNERS``), bump positive."""
+        self.model.eq_data[self.pad_eq, 0] = np.asarray(heights, float)
+
+    def set_rack(self, displacement: float) -> None:
+        """Rack displacement [m], positive to the left (+y)."""
+        self.model.eq_data[self.rack_eq, 0] = displacement
+
+    def set_pad_loads(self, fx=(0, 0, 0, 0), fy=(0, 0, 0, 0), mz=(0, 0, 0, 0)) -> None:
+        """Longitudinal and lateral forces [N] at the contact points and aligning torques [N·m]."""
+        d = self.data
+        d.xfrc_applied[self.carriage_body, 0] = fx
+        d.xfrc_applied[self.carriage_body, 1] = fy
+        d.xfrc_applied[self.wheel_body, 5] = mz
+
+    def set_inputs(self, u: np.ndarray) -> None:
+        """Set every rig input at once from ``u`` (SI, in the order of ``vehicle.scenarios.scenario_file.INPUT_CHANNELS``,
+        as :meth:`play` reads its rows)."""
+        self.set_pads(u[0:4])
+        self.set_pad_loads(fx=u[4:8], fy=u[8:12], mz=u[12:16])
+        self.set_rack(u[16])
+
+    def reset(self) -> None:
+        """Back to the design pose at rest: virgin bushings, pads and rack at zero, no loads."""
+        mujoco.mj_resetData(self.model, self.data)
+        self.coupling.reset()
+        self.set_pads([0.0] * 4)
+        self.set_rack(0.0)
+
+    @contextmanager
+    def bushing_laws_off(self) -> Iterator[None]:
+        """Within the block every bushing direction is linear, with the stiffness and damping held
+        in its joint (the reference tangent); on leaving, the laws are back, from their virgin state
+        (the thesis settles the car this way before switching the bushing models on)."""
+        # The coupling skips a bank it does not have and then reports the joint forces of every channel.
+        forces = self.coupling.bushings
+        laws, forces.bank = forces.bank, None
+        try:
+            yield
+        finally:
+            forces.bank = laws
+            self.coupling.reset()
+
+    # -- running -----------------------------------------------------------------------------
+    def step(self, n: int = 1) -> None:
+        """Advance ``n`` time steps with the inputs held (compiled loop, the coupling called before each step)."""
+        self._run(n, _NO_INPUTS, _INACTIVE)
+
+    def play(self, inputs: np.ndarray) -> None:
+        """Advance one time step per row of ``inputs`` (rig inputs in the order of
+        ``vehicle.scenarios.scenario_file.INPUT_CHANNELS``, SI), each row set before its step."""
+        inputs = np.ascontiguousarray(inputs, dtype=float)
+        if inputs.ndim != 2 or inputs.shape[1] != _NO_INPUTS.shape[1]:  # the compiled loop does not check
+            raise ValueError(f"expected rig inputs of shape (steps, {_NO_INPUTS.shape[1]}), got {inputs.shape}")
+        self._run(len(inputs), inputs, _ALL_ACTIVE)
+
+    def _run(self, n: int, inputs: np.ndarray, active: np.ndarray) -> None:
+        """``n`` compiled steps (vehicle.simulation.stepping.run) with ``inputs`` and ``active`` as it documents."""
+        m, d = self.model, self.data
+        stepping.run(n, inputs, active, m.eq_data, self.pad_eq, self.rack_eq, d.xfrc_applied, self.carriage_body,
+                     self.wheel_body, m._address, d._address, m.opt.timestep, *self.coupling.kernel_arrays())
+        b = self.coupling.bushings
+        if b.bank is not None:
+            b.bank_force = b.bank.force
+
+    def settle(self, duration: float = 1.0) -> None:
+        """Run ``duration`` [s] with the inputs held."""
+        self.step(int(round(duration / self.model.opt.timestep)))
+
+    def pad_ramp(self, start, end, duration: float, samples: int = 0) -> list[RigOutputs]:
+        """Move the pads linearly from ``start`` to ``end`` [m] in ``duration`` [s], sampling."""
+        return self.ramp(duration, samples, pads=(start, end))
+
+    def ramp(self, duration: float, samples: int = 0, pads=None, fx=None, fy=None, mz=None) -> list[RigOutputs]:
+        """Move inputs linearly over ``duration`` [s], measuring every ⌊steps/samples⌋ steps.
+
+        Each input given is a (start, end) pair of four values (order of ``CORNERS``): ``pads``
+        contact-point displacements [m], ``fx``/``fy`` contact-point forces [N], ``mz`` aligning
+        torques [N·m]; inputs not given are held.
+        """
+        h = self.model.opt.timestep
+        n = max(1, int(round(duration / h)))
+        every = max(1, n // samples) if samples else n + 1
+        groups = (pads, fx, fy, mz)
+        active = np.array([g is not None for g in groups] + [False])  # the rack is held
+        start = np.concatenate([np.zeros(4) if g is None else np.asarray(g[0], float) for g in groups] + [[0.0]])
+        end = np.concatenate([np.zeros(4) if g is None else np.asarray(g[1], float) for g in groups] + [[0.0]])
+        out = []
+        done = 0
+        while done < n:
+            k = min(every - done % every, n - done)
+            f = (done + np.arange(1, k + 1)) / n
+            self._run(k, start + (end - start) * f[:, None], active)
+            done += k
+            if done % every == 0:
+                out.append(self.measure())
+        return out
+
+    # -- outputs -----------------------------------------------------------------------------
+    def _eq_first_rows(self) -> np.ndarray:
+        """Index in ``efc_*`` of the first row of every equality, -1 where inactive (an equality's
+        rows are consecutive)."""
+        d = self.data
+        rows = np.flatnonzero(d.efc_type[: d.nefc] == _EQUALITY_ROW)
+        first = np.full(self.model.neq, -1)
+        eq, at = np.unique(d.efc_id[rows], return_index=True)
+        first[eq] = rows[at]
+        return first
+
+    def ride_height(self) -> float:
+        """Height of the body's ride-height point above the ground (pads at zero) [m]."""
+        m, d = self.model, self.data
+        mujoco.mj_kinematics(m, d)
+        body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "chassis")
+        point = d.xpos[body] + d.xmat[body].reshape(3, 3) @ np.asarray(self.vehicle.body.ride_height_point)
+        return float(point[2])
+
+    def _closure_error(self, first_rows: np.ndarray) -> float:
+        """Largest position error of the loop closures [m] (connect, weld position, tie-rod length),
+        from the equalities' first rows (:meth:`_eq_first_rows`)."""
+        d = self.data
+        rows = first_rows[self.closure_eq][:, None] + np.arange(3)
+        used = np.arange(3) < self.closure_rows[:, None]  # 3 position rows, 1 for a tendon length
+        pos = np.where(used, d.efc_pos[np.minimum(rows, d.nefc - 1)], 0.0)
+        return float(np.sqrt((pos * pos).sum(axis=1)).max())
+
+    def measure(self) -> RigOutputs:
+        """The rig's outputs at the current state."""
+        m, d = self.model, self.data
+        mujoco.mj_forward(m, d)
+        first_rows = self._eq_first_rows()
+        fz = d.efc_force[first_rows[self.pad_eq]]
+        wheels = {}
+        for k, corner in enumerate(CORNERS):
+            sign = _SIGN[corner]
+            rot = d.xmat[self.wheel_body[k]].reshape(3, 3)
+            spin_left = rot[:, 1]
+            toe, camber = wheel_angles(sign * spin_left, sign)
+            heading = (spin_left[1], -spin_left[0])  # spin_left × z, in plan
+            centre = d.site_xpos[self.centre_site[k]].copy()
+            force = np.array([d.xfrc_applied[self.carriage_body[k], 0], d.xfrc_applied[self.carriage_body[k], 1], fz[k]])
+            wheels[corner] = WheelOutputs(camber, toe, math.atan2(heading[1], heading[0]), abs(centre[1]), centre,
+                                          force, float(d.qpos[self.pad_qpos[k]]),
+                                          float(d.xfrc_applied[self.wheel_body[k], 5]))
+        c = self.coupling
+        return RigOutputs(
+            time=float(d.time), wheels=wheels, bushing_names=tuple(ch.name for ch in self.car.channels),
+            bushing_deflection=c.bushings.deflections(), bushing_force=c.bushings.forces(),
+            spring_force=dict(zip((e.name for e in c.springs), c.spring_forces().tolist())),
+            damper_force=dict(zip((e.name for e in c.dampers), c.damper_forces().tolist())),
+            closure_error=self._closure_error(first_rows))

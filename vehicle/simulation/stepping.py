@@ -1,0 +1,156 @@
+"""Compiled stepping: the coupling of :mod:`vehicle.simulation.coupling` and ``mj_step`` in one numba loop.
+
+A numpy coupling called from a Python loop cost ~150–250 µs per step on the rig, more than
+``mj_step``; here the rig inputs, the bushing bank step (the laws with their state extensions,
+:func:`bushings.effects.step_extended`), the bushings' cross stiffnesses, the damper and spring
+laws and ``mj_step`` (called through ctypes on the model's and data's addresses) all run in
+compiled code, so a step costs ``mj_step`` plus the bank kernel. :func:`run` gives bit-identical
+results to calling ``ForceCoupling.apply`` and ``mujoco.mj_step`` from Python (tests/test_vehicle_rig.py).
+
+Arrays of ``MjModel``/``MjData`` are numpy views of MuJoCo's memory, so the loop reads and writes
+them in place.
+"""
+
+from __future__ import annotations
+
+import ctypes
+from pathlib import Path
+
+import mujoco
+import numba as nb
+import numpy as np
+from numba.core import caching
+
+from bushings import effects as _fx
+
+# coupling_step compiles the bushing kernels into itself: its cache must follow their files too
+caching.CacheImpl._locator_classes.insert(0, _fx.kernel_stamped_locator(__file__))
+
+_LIB = ctypes.CDLL(str(next(Path(mujoco.__file__).parent.glob("libmujoco.so*"))))
+_mj_step = _LIB.mj_step
+_mj_step.argtypes = (ctypes.c_size_t, ctypes.c_size_t)  # mjModel*, mjData* as addresses
+_mj_step.restype = None
+
+
+@nb.njit(cache=True)
+def _segment(x, xs, ys):
+    """Slope and intercept of the padded curve (xs, ys) at x (linear extrapolation at the ends)."""
+    n = xs.shape[0]
+    i = 0
+    while i < n - 2 and xs[i + 1] <= x:
+        i += 1
+    slope = (ys[i + 1] - ys[i]) / (xs[i + 1] - xs[i])
+    return slope, ys[i] - slope * xs[i]
+
+
+@nb.njit(cache=True)
+def _push(qfrc, ten_J, ten_J_rowadr, ten_J_rownnz, ten_J_colind, joint, index, gen):
+    """Add generalised forces ``gen`` along joint dofs or tendons (through their sparse Jacobian rows)."""
+    for k in range(gen.shape[0]):
+        if joint[k]:
+            qfrc[index[k]] += gen[k]
+        elif gen[k] != 0.0:
+            a = ten_J_rowadr[index[k]]
+            for p in range(a, a + ten_J_rownnz[index[k]]):
+                qfrc[ten_J_colind[p]] += ten_J[p] * gen[k]
+
+
+@nb.njit(cache=True)
+def coupling_step(h, qpos, qvel, qfrc, ten_length, ten_velocity, ten_J, ten_J_rowadr, ten_J_rownnz, ten_J_colind,
+                  jnt_stiffness, dof_damping, tendon_damping, bush, bank, cross, damp, spring):
+    """Write the non-implicit forces for the next step of ``h`` [s] (see vehicle.simulation.coupling).
+
+    ``bush`` = (qpos adr, dof adr, joint ids, base stiffness, K_ref, saturating, e work) of the
+    bank channels, ``bank`` = :meth:`bushings.effects.ExtendedBank.kernel_args`, ``cross`` = (qpos adr
+    (P, 2), dof adr (P, 2), stiffness (P,)) of the cross stiffnesses, ``damp`` = (is joint, dof or
+    tendon index, sign, xs, ys, intercept out [N], work), ``spring`` = (is joint, index, qpos adr,
+    design, sign, xs, ys, rate, y0, nonlinear?, remainder work).
+    """
+    qfrc[:] = 0.0
+    bq, bd, bj, kbase, kref, sat, e = bush
+    if bq.shape[0]:
+        for c in range(bq.shape[0]):
+            e[c] = qpos[bq[c]]
+        _fx.step_extended(e, h, *bank)
+        force, tangent = bank[3], bank[4]
+        for c in range(bq.shape[0]):
+            if sat[c]:
+                kref[c] = max(kbase[c], tangent[c])
+                jnt_stiffness[bj[c]] = kref[c]
+            qfrc[bd[c]] += kref[c] * e[c] - force[c]
+    xq, xd, xk = cross
+    for p in range(xk.shape[0]):
+        qfrc[xd[p, 0]] -= xk[p] * qpos[xq[p, 1]]
+        qfrc[xd[p, 1]] -= xk[p] * qpos[xq[p, 0]]
+    joint, index, sign, xs, ys, offset, gen = damp
+    for k in range(joint.shape[0]):
+        v = qvel[index[k]] if joint[k] else ten_velocity[index[k]]
+        slope, offset[k] = _segment(sign[k] * v, xs[k], ys[k])
+        if joint[k]:
+            dof_damping[index[k]] = slope
+        else:
+            tendon_damping[index[k]] = slope
+        gen[k] = -sign[k] * offset[k]  # compression = sign·Δq: a force pushing apart acts along −sign
+    _push(qfrc, ten_J, ten_J_rowadr, ten_J_rownnz, ten_J_colind, joint, index, gen)
+    sjoint, sindex, sqadr, design, ssign, sxs, sys_, rate, y0, nonlinear, rem = spring
+    if nonlinear:
+        for k in range(sjoint.shape[0]):
+            coord = qpos[sqadr[k]] if sjoint[k] else ten_length[sindex[k]]
+            x = ssign[k] * (coord - design[k])
+            slope, icpt = _segment(x, sxs[k], sys_[k])
+            rem[k] = -ssign[k] * (slope * x + icpt - y0[k] - rate[k] * x)
+        _push(qfrc, ten_J, ten_J_rowadr, ten_J_rownnz, ten_J_colind, sjoint, sindex, rem)
+
+
+@nb.njit(cache=True)
+def _run(mj_step, n, inputs, active, eq_data, pad_eq, rack_eq, xfrc, carriage, wheel, m_addr, d_addr, h,
+        qpos, qvel, qfrc, ten_length, ten_velocity, ten_J, ten_J_rowadr, ten_J_rownnz, ten_J_colind, jnt_stiffness,
+        dof_damping, tendon_damping, bush, bank, cross, damp, spring):
+    """Advance ``n`` steps, row i of ``inputs`` set before step i (none if ``inputs`` has no rows).
+
+    A row holds the rig inputs in the order of ``vehicle.scenarios.scenario_file.INPUT_CHANNELS`` (17 values):
+    pad heights [m], Fx, Fy [N] at the carriages, Mz [N·m] at the wheels, four corners each, then
+    the rack [m]; ``active[g]`` says whether group g (pads, Fx, Fy, Mz, rack) is driven (else left
+    as is). ``mj_step`` is MuJoCo's, passed as a ctypes function so that the compiled code can be
+    cached.
+    """
+    for i in range(n):
+        if inputs.shape[0]:
+            u = inputs[i]
+            for c in range(4):
+                if active[0]:
+                    eq_data[pad_eq[c], 0] = u[c]
+                if active[1]:
+                    xfrc[carriage[c], 0] = u[4 + c]
+                if active[2]:
+                    xfrc[carriage[c], 1] = u[8 + c]
+                if active[3]:
+                    xfrc[wheel[c], 5] = u[12 + c]
+            if active[4]:
+                eq_data[rack_eq, 0] = u[16]
+        coupling_step(h, qpos, qvel, qfrc, ten_length, ten_velocity, ten_J, ten_J_rowadr, ten_J_rownnz, ten_J_colind,
+                      jnt_stiffness, dof_damping, tendon_damping, bush, bank, cross, damp, spring)
+        mj_step(m_addr, d_addr)
+
+
+def run(*args) -> None:
+    """:func:`_run` with MuJoCo's ``mj_step``; ``args`` are the rest of its arguments, from ``n``."""
+    _run(_mj_step, *args)
+
+
+def coupling_arrays(coupling) -> tuple:
+    """The (bush, bank, cross, damp, spring) tuples of :func:`coupling_step` for a ForceCoupling."""
+    b = coupling.bushings
+    on = b.bank is not None  # None: laws off, every direction linear in its joint
+    idx = b.bank_idx if on else np.zeros(0, np.int64)
+    bush = (b.qpos[idx].astype(np.int64), b.dof[idx].astype(np.int64), b.jnt[idx].astype(np.int64), b.K[idx].copy(),
+            b.K_ref if on else np.zeros(0), b.saturating if on else np.zeros(0, np.bool_), np.zeros(idx.size))
+    bank = (b.bank if on else _fx.ExtendedBank([])).kernel_args()
+    # the cross stiffnesses are linear and stay on when the laws are off
+    cross = (b.qpos[b.cross_channels].astype(np.int64), b.dof[b.cross_channels].astype(np.int64), b.cross_k)
+    c = coupling
+    damp = (c.dp_joint, c.dp_index.astype(np.int64), c.dp_sign.astype(float), c.dp_xs, c.dp_ys, c.dp_offset,
+            np.zeros(len(c.dp_offset)))
+    spring = (c.sp_joint, c.sp_index.astype(np.int64), c.sp_qadr.astype(np.int64), c.sp_design, c.sp_sign.astype(float),
+              c.sp_xs, c.sp_ys, c.sp_rate, c.sp_y0, bool(c.sp_nonlinear), np.zeros(len(c.sp_rate)))
+    return bush, bank, cross, damp, spring

@@ -1,0 +1,35 @@
+"""`vsim model export VEHICLE.yaml -o car.xml`: write the MJCF of a vehicle for inspection."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from vehicle.model.builder import BuildOptions, build
+from vehicle.model.definition import load_vehicle
+from vehicle.model.statics import resolve_preloads
+
+BUSHING_MODELS = ("linear", "sts", "rt", "stvs")
+
+
+def _export(args: argparse.Namespace) -> int:
+    vehicle = resolve_preloads(load_vehicle(args.vehicle))
+    car = build(vehicle, BuildOptions(rig=not args.road, clamped=not args.free, bushing_model=args.bushings))
+    Path(args.output).write_text(car.xml())
+    print(f"wrote {args.output}: {car.model.nbody - 1} bodies, {car.model.nv} DOF, "
+          f"{len(car.channels)} bushing directions, {car.model.neq} equality constraints")
+    return 0
+
+
+def register(subparsers) -> None:
+    """Add ``model export``."""
+    model = subparsers.add_parser("model", help="vehicle models")
+    sub = model.add_subparsers(dest="model_command", required=True)
+    export = sub.add_parser("export", help="write the MJCF of a vehicle definition")
+    export.add_argument("vehicle", help="vehicle YAML file (models/vehicles/)")
+    export.add_argument("-o", "--output", required=True, help="MJCF file to write")
+    export.add_argument("--bushings", choices=BUSHING_MODELS, default=None,
+                        help="read every bushing parameter set as this model")
+    export.add_argument("--road", action="store_true", help="without the K&C rig")
+    export.add_argument("--free", action="store_true", help="free body instead of clamped")
+    export.set_defaults(func=_export)

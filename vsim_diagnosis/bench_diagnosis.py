@@ -1,0 +1,304 @@
+"""Diagnosis of a bushing-bench dataset (spec measured-data §2): replay the measured deflections
+through the baseline law, quantify the mismatch, fit every applicable cause of the catalogue on
+half of the tests, score it on the other half, and name the cause that explains the mismatch, or
+say that nothing significant is missing, or that the mismatch is real but unexplained.
+
+The measured deflection drives the simulation (as a bench drives the part), record after record
+with the rests between them, so that the part's state carries over as on the rig. A constant
+load-cell zero error is a nuisance fitted in closed form for every model alike.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import Callable, Sequence
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from bushings.effects import ExtendedBank
+from bushings.parameters import ParameterSet
+from vsim_recordings.bench_dataset import BenchDataset
+from vsim_diagnosis.causes import Cause, applicable
+
+#: Relative held-out error reduction below which a cause explains nothing significant.
+MIN_GAIN = 0.10
+#: A cause is named when the mismatch beyond noise it leaves on held-out tests is at most this
+#: fraction of the baseline's (i.e. it explains at least 1 − 0.35² ≈ 88 % of the excess variance).
+MAX_EXCESS_LEFT = 0.35
+#: A baseline whose held-out error is within this factor of the noise floor fits the data.
+NOISE_FACTOR = 1.5
+#: Penalty per fitted parameter on the held-out error used for ranking.
+PARAMETER_PENALTY = 0.02
+#: Longest step used to simulate a rest between tests [s].
+REST_STEP_S = 0.05
+#: Ladder solver tolerance of the replays [m]: force errors below 0.3 N, under a load cell's noise.
+REPLAY_TOLERANCE_M = 1e-8
+
+
+@dataclass(frozen=True)
+class Replay:
+    """The dataset as one deflection history: every record, with the rests between them."""
+
+    e: np.ndarray           #: deflection [m] at each step (T,)
+    dts: np.ndarray         #: step [s] (T,)
+    record: np.ndarray      #: index of the record a step samples, −1 during rests (T,)
+    measured: np.ndarray    #: measured force at the steps of records [N] (T,), 0 during rests
+    names: list[str]
+    scale: np.ndarray       #: per record: half the peak-to-peak measured force [N]
+
+    @classmethod
+    def of(cls, data: BenchDataset) -> "Replay":
+        """Lay out a dataset's records in the order played."""
+        e, dts, rec, meas = [], [], [], []
+        for k, r in enumerate(data.records):
+            x = r.record
+            n = math.ceil(r.rest_before_s / REST_STEP_S - 1e-9)
+            if n:  # at rest at the rig's zero, read as the record's first deflection
+                e.append(np.full(n, x.e[0]))
+                dts.append(np.full(n, r.rest_before_s / n))
+                rec.append(np.full(n, -1))
+                meas.append(np.zeros(n))
+            steps = np.diff(x.t, prepend=x.t[0] - (x.t[1] - x.t[0]))
+            e.append(x.e)
+            dts.append(steps)
+            rec.append(np.full(len(x.t), k))
+            meas.append(x.F)
+        scale = np.array([max(np.ptp(r.record.F) / 2.0, 1e-9) for r in data.records])
+        return cls(np.concatenate(e), np.concatenate(dts), np.concatenate(rec), np.concatenate(meas),
+                   [r.name for r in data.records], scale)
+
+    def simulate(self, models: Sequence[ParameterSet]) -> np.ndarray:
+        """Forces (K, T) of K candidate models along the history, each from a virgin part."""
+        bank = ExtendedBank([m.channel() for m in models], [m.effects_si() for m in models], REPLAY_TOLERANCE_M)
+        return bank.run(np.repeat(self.e[:, None], len(models), axis=1), self.dts).T
+
+    @cached_property
+    def weights(self) -> np.ndarray:
+        """Per-step residual weights: each record counts equally, relative to its force level."""
+        w = np.zeros(len(self.e))
+        for k in range(len(self.names)):
+            on = self.record == k
+            w[on] = 1.0 / (self.scale[k] * math.sqrt(on.sum()))
+        return w
+
+    def residuals(self, forces: np.ndarray, records: np.ndarray) -> np.ndarray:
+        """Measured − simulated forces [N] (K, T), with the load-cell zero error fitted on ``records``
+        (a boolean mask over records) removed; 0 during rests."""
+        w2 = self.weights ** 2 * np.isin(self.record, np.flatnonzero(records))
+        raw = self.measured - np.atleast_2d(forces)
+        offset = (raw * w2).sum(axis=1, keepdims=True) / w2.sum()
+        return np.where(self.record >= 0, raw - offset, 0.0)
+
+    def record_errors(self, residual: np.ndarray) -> np.ndarray:
+        """Relative RMS error of each record (RMS residual / half its peak-to-peak force) for one model."""
+        out = np.empty(len(self.names))
+        for k in range(len(self.names)):
+            on = self.record == k
+            out[k] = math.sqrt(np.mean(residual[on] ** 2)) / self.scale[k]
+        return out
+
+    def noise_floor(self, residual: np.ndarray) -> np.ndarray:
+        """Per record, the relative RMS of the white measurement noise in a residual, estimated from
+        its sample-to-sample differences (robust: median absolute deviation), which a smooth model
+        error hardly affects."""
+        out = np.empty(len(self.names))
+        for k in range(len(self.names)):
+            d = np.diff(residual[self.record == k])
+            out[k] = 1.4826 * np.median(np.abs(d - np.median(d))) / math.sqrt(2.0) / self.scale[k]
+        return out
+
+
+def aggregate(errors: np.ndarray, records: np.ndarray) -> float:
+    """Root mean square of per-record relative errors over the selected records."""
+    return float(math.sqrt(np.mean(errors[records] ** 2)))
+
+
+@dataclass
+class Candidate:
+    """A cause fitted on the training tests and scored on the held-out ones."""
+
+    cause: Cause
+    values: dict[str, float]           #: fitted on the training tests (parameter-set units)
+    heldout_error: float               #: relative RMS error on held-out tests
+    record_errors: np.ndarray          #: per record, with the training-fit values
+    score: float = 0.0                 #: held-out error with the parameter penalty (lower is better)
+    final: dict[str, float] = field(default_factory=dict)   #: refitted on every test
+    #: uncertainty of ``final``: the larger of the linearised standard error and the shift from ``values``
+    std: dict[str, float] = field(default_factory=dict)
+    model: ParameterSet | None = None                       #: the extended baseline with ``final``
+
+
+@dataclass
+class BenchDiagnosis:
+    """The outcome: a cause (or none, or unexplained) with its evidence."""
+
+    verdict: str                        #: a catalogue id, "none" or "unexplained"
+    baseline: ParameterSet
+    replay: Replay
+    heldout: np.ndarray                 #: boolean mask of held-out records
+    baseline_errors: np.ndarray         #: per-record relative error of the baseline
+    noise: np.ndarray                   #: per-record relative noise floor
+    ranking: list[Candidate]
+    best: Candidate | None
+    part: str
+    wall_s: float = 0.0
+
+    @property
+    def named(self) -> bool:
+        """True when a catalogue cause is named (then ``best`` is it, refitted on every test)."""
+        return self.verdict not in ("none", "unexplained")
+
+    @property
+    def heldout_error_before(self) -> float:
+        return aggregate(self.baseline_errors, self.heldout)
+
+    @property
+    def heldout_error_after(self) -> float:
+        return self.best.heldout_error if self.best is not None and self.verdict != "none" else self.heldout_error_before
+
+
+class _Objective:
+    """Weighted residuals of a cause with values from a parameter vector in fit coordinates, and
+    their Jacobian by finite differences computed as extra channels of one bank run."""
+
+    def __init__(self, replay: Replay, base: ParameterSet, cause: Cause, train: np.ndarray):
+        self.replay, self.base, self.cause, self.train = replay, base, cause, train
+        on = np.isin(replay.record, np.flatnonzero(train))
+        self.w = replay.weights * on
+        self.cache: dict[bytes, np.ndarray] = {}
+
+    def values(self, z: np.ndarray) -> dict[str, float]:
+        return {p.name: float(math.exp(v) if p.log else v) for p, v in zip(self.cause.parameters, z)}
+
+    def residuals(self, Z: np.ndarray) -> np.ndarray:
+        """Weighted residuals (K, T) for K parameter vectors, in one simulation."""
+        forces = self.replay.simulate([self.cause.apply(self.base, self.values(z)) for z in Z])
+        return self.replay.residuals(forces, self.train) * self.w
+
+    def fun(self, z: np.ndarray) -> np.ndarray:
+        key = z.tobytes()
+        if key not in self.cache:
+            self.cache = {key: self.residuals(z[None])[0]}
+        return self.cache[key]
+
+    def jac(self, z: np.ndarray) -> np.ndarray:
+        r0 = self.fun(z)
+        h = 1e-3 * np.maximum(1.0, np.abs(z))
+        r = self.residuals(z + np.diag(h))
+        return ((r - r0) / h[:, None]).T
+
+
+def _coordinates(cause: Cause) -> tuple[np.ndarray, np.ndarray]:
+    lo = np.array([math.log(p.bounds[0]) if p.log else p.bounds[0] for p in cause.parameters])
+    hi = np.array([math.log(p.bounds[1]) if p.log else p.bounds[1] for p in cause.parameters])
+    return lo, hi
+
+
+def _grid(cause: Cause) -> np.ndarray:
+    """Starting points: the corners of the realistic range (both signs for signed parameters)."""
+    axes = []
+    for p in cause.parameters:
+        pts = np.log(p.draw) if p.log else np.array(p.draw, dtype=float)
+        if len(cause.parameters) == 1:
+            pts = np.array([pts.mean()])
+        axes.append(np.r_[-pts[::-1], pts] if p.signed else pts)
+    return np.array(np.meshgrid(*axes, indexing="ij")).reshape(len(axes), -1).T
+
+
+def _to_fit(cause: Cause, values: dict[str, float]) -> np.ndarray:
+    return np.array([math.log(values[p.name]) if p.log else values[p.name] for p in cause.parameters])
+
+
+def fit_cause(replay: Replay, base: ParameterSet, cause: Cause, train: np.ndarray,
+              start: dict[str, float] | None = None, max_nfev: int = 15) -> tuple[dict[str, float], dict[str, float]]:
+    """Least-squares fit of a cause's parameters on the training records, from ``start`` or the
+    best of a few starting points; returns the values and their standard uncertainties
+    (linearised, from the Jacobian and the residual variance)."""
+    obj = _Objective(replay, base, cause, train)
+    if start is None:
+        grid = _grid(cause)
+        z0 = grid[int(np.argmin((obj.residuals(grid) ** 2).sum(axis=1)))] if len(grid) > 1 else grid[0]
+    else:
+        z0 = _to_fit(cause, start)
+    lo, hi = _coordinates(cause)
+    sol = least_squares(obj.fun, np.clip(z0, lo + 1e-9, hi - 1e-9), jac=obj.jac, bounds=(lo, hi),
+                        x_scale=1.0, max_nfev=max_nfev, method="trf", ftol=1e-6, xtol=1e-6)
+    J = sol.jac
+    dof = max(int((obj.w > 0).sum()) - len(sol.x), 1)
+    # Residual variance, inflated for the residuals' correlation from sample to sample (a smooth
+    # model error is not white noise): n independent samples are worth n(1 − ρ)/(1 + ρ).
+    r = sol.fun[obj.w > 0]
+    rho = float(np.clip(np.dot(r[1:], r[:-1]) / max(np.dot(r, r), 1e-300), 0.0, 0.999))
+    s2 = 2.0 * sol.cost / dof * (1.0 + rho) / (1.0 - rho)
+    try:
+        cov = np.linalg.inv(J.T @ J) * s2
+        std_z = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    except np.linalg.LinAlgError:
+        std_z = np.full(len(sol.x), np.inf)
+    values = obj.values(sol.x)
+    std = {p.name: float(values[p.name] * s if p.log else s) for p, s in zip(cause.parameters, std_z)}
+    return values, std
+
+
+def split(n_records: int) -> np.ndarray:
+    """Held-out records: every other one, starting with the second (the first is the virgin part's)."""
+    return np.arange(n_records) % 2 == 1
+
+
+def diagnose_bench(data: BenchDataset, baseline: ParameterSet,
+                   progress: Callable[[str], None] | None = None) -> BenchDiagnosis:
+    """Diagnose a bench dataset against a baseline parameter set (see the module docstring)."""
+    started = time.perf_counter()
+    say = progress or (lambda _: None)
+    replay = Replay.of(data)
+    heldout = split(len(replay.names))
+    train = ~heldout
+    everything = np.ones(len(replay.names), dtype=bool)
+    say(f"baseline {baseline.name} ({baseline.model}) on {len(replay.names)} tests")
+    base_res = replay.residuals(replay.simulate([baseline]), train)[0]
+    base_errors = replay.record_errors(base_res)
+    noise = replay.noise_floor(base_res)
+
+    def score(cause: Cause) -> Candidate:
+        values, _ = fit_cause(replay, baseline, cause, train)
+        res = replay.residuals(replay.simulate([cause.apply(baseline, values)]), train)[0]
+        errors = replay.record_errors(res)
+        err = aggregate(errors, heldout)
+        say(f"{cause.id}: held-out error {err:.4f} (baseline {aggregate(base_errors, heldout):.4f})")
+        return Candidate(cause, values, err, errors, err * (1.0 + PARAMETER_PENALTY * len(cause.parameters)))
+
+    causes = applicable(baseline)
+    say(f"fitting {len(causes)} causes on {int(train.sum())} tests, scoring each on the {int(heldout.sum())} held out")
+    # The replays release the GIL: one fit per core.
+    with ThreadPoolExecutor(max_workers=min(len(causes), os.cpu_count() or 1) or 1) as pool:
+        ranking = sorted(pool.map(score, causes), key=lambda c: c.score)
+    before = aggregate(base_errors, heldout)
+    floor = aggregate(noise, heldout)
+    best = ranking[0] if ranking else None
+    verdict = decide(before, best.heldout_error if best else before, floor)
+    if verdict == "named":
+        say(f"refitting {best.cause.id} on every test")
+        best.final, linearised = fit_cause(replay, baseline, best.cause, everything, start=best.values, max_nfev=6)
+        # The linearised error ignores model error; the shift from the half-data fit shows it.
+        best.std = {k: max(s, abs(best.final[k] - best.values[k])) for k, s in linearised.items()}
+        best.model = best.cause.apply(baseline, best.final,
+                                      source=f"{baseline.name} extended by {best.cause.id}, fitted by vsim diagnose "
+                                             f"on {data.path.name} ({len(replay.names)} bench tests)")
+    return BenchDiagnosis(best.cause.id if verdict == "named" else verdict, baseline, replay, heldout,
+                          base_errors, noise, ranking, best, data.part, time.perf_counter() - started)
+
+
+def decide(before: float, after: float, floor: float) -> str:
+    """``named``, ``none`` or ``unexplained`` from held-out errors before and after the best cause
+    and the noise floor (all relative RMS)."""
+    excess_before = math.sqrt(max(before ** 2 - floor ** 2, 0.0))
+    excess_after = math.sqrt(max(after ** 2 - floor ** 2, 0.0))
+    if after <= before * (1.0 - MIN_GAIN) and excess_after <= MAX_EXCESS_LEFT * excess_before:
+        return "named"
+    return "none" if before <= NOISE_FACTOR * floor else "unexplained"

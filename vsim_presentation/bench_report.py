@@ -1,0 +1,185 @@
+"""What a bench diagnosis tells an engineer: the JSON verdict, the extended parameter set, and a
+one-page markdown report with loop overlays before/after, residuals against speed, amplitude and
+static load, the ranking with its evidence and the error per held-out test."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from bushings.bench.bench_file import atomic_output
+from bushings.parameters import save_parameter_set
+from vsim_presentation.bench_plots import save_figure
+from vsim_diagnosis.bench_diagnosis import BenchDiagnosis, aggregate
+
+#: Held-out records overlaid in the report (the largest baseline errors first).
+OVERLAYS = 4
+
+
+def record_features(d: BenchDiagnosis) -> list[dict[str, float]]:
+    """Per record, from the measured deflection: amplitude [mm], static level [mm], and median
+    speed while moving [mm/s]."""
+    out = []
+    for k in range(len(d.replay.names)):
+        on = d.replay.record == k
+        e = d.replay.e[on] * 1e3
+        v = np.abs(np.diff(e) / d.replay.dts[on][1:])
+        moving = v > 0.05 * v.max() if v.size else v.astype(bool)
+        out.append({"amplitude_mm": float(np.ptp(e) / 2.0), "static_mm": float(np.median(e)),
+                    "speed_mm_s": float(np.median(v[moving])) if moving.any() else 0.0})
+    return out
+
+
+def _parameters(d: BenchDiagnosis) -> dict[str, Any]:
+    if not d.named:
+        return {}
+    return {p.name: {"value": d.best.final[p.name], "std": d.best.std.get(p.name, math.nan), "unit": p.unit}
+            for p in d.best.cause.parameters}
+
+
+def summary(d: BenchDiagnosis) -> dict[str, Any]:
+    """The machine-readable verdict (``vsim diagnose --json``)."""
+    return {
+        "cause": d.verdict,
+        "location": {"level": "bench", "part": d.part} if d.named else None,
+        "parameters": _parameters(d),
+        "heldout_error_before": d.heldout_error_before,
+        "heldout_error_after": d.heldout_error_after,
+        "noise_floor": aggregate(d.noise, d.heldout),
+        "ranking": [{"cause": c.cause.id, "heldout_error": c.heldout_error, "score": c.score,
+                     "n_parameters": len(c.cause.parameters), "parameters": c.values} for c in d.ranking],
+        "tests": [{"name": n, "heldout": bool(h), "error_before": float(b),
+                   "error_after": float(d.best.record_errors[k]) if d.named else float(b)}
+                  for k, (n, h, b) in enumerate(zip(d.replay.names, d.heldout, d.baseline_errors))],
+        "baseline": {"name": d.baseline.name, "model": d.baseline.model},
+        "wall_s": d.wall_s,
+    }
+
+
+def verdict_sentence(d: BenchDiagnosis) -> str:
+    """One sentence for people."""
+    before, after = d.heldout_error_before, d.heldout_error_after
+    if d.verdict == "none":
+        return (f"Nothing significant is missing: the baseline's held-out error ({before:.2%} of the force range) "
+                f"is at the noise floor or no cause reduces it by {10:.0f} %.")
+    if d.verdict == "unexplained":
+        best = d.ranking[0] if d.ranking else None
+        partial = f"; the best catalogue cause, {best.cause.id}, only brings it to {best.heldout_error:.2%}" if best else ""
+        return f"The mismatch is real ({before:.2%} held-out error) but no catalogue cause explains it{partial}."
+    values = ", ".join(f"{k} = {v['value']:.4g} ± {v['std']:.2g} {v['unit']}" for k, v in _parameters(d).items())
+    return (f"Cause: **{d.verdict}** ({values}); held-out error {before:.2%} → {after:.2%} "
+            f"of the force range.")
+
+
+def write_extended_model(d: BenchDiagnosis, path: Path) -> Path | None:
+    """The baseline parameter set extended by the named cause, as a parameter-set YAML file."""
+    return save_parameter_set(d.best.model, path) if d.named else None
+
+
+def _overlays(d: BenchDiagnosis, after: np.ndarray | None, out: Path) -> Path:
+    held = [k for k in np.argsort(-d.baseline_errors) if d.heldout[k]][:OVERLAYS]
+    fig = Figure(figsize=(4.2 * len(held), 3.8))
+    base = d.replay.simulate([d.baseline])[0]
+    for i, k in enumerate(held):
+        ax = fig.add_subplot(1, len(held), i + 1)
+        on = d.replay.record == k
+        e = d.replay.e[on] * 1e3
+        step = "step" in d.replay.names[k]
+        t = np.cumsum(d.replay.dts[on])
+        x = t if step else e
+        ax.plot(x, d.replay.measured[on], "k.", ms=1.5, label="measured")
+        offset = np.median(d.replay.measured[on] - base[on])
+        ax.plot(x, base[on] + offset, "C3-", lw=0.8, label="baseline")
+        if after is not None:
+            offset = np.median(d.replay.measured[on] - after[on])
+            ax.plot(x, after[on] + offset, "C0-", lw=0.8, label=f"+ {d.verdict}")
+        if step:
+            ax.set_xscale("log")
+        ax.set_xlabel("time [s]" if step else "deflection [mm]")
+        ax.set_ylabel("force [N]")
+        ax.set_title(f"{d.replay.names[k]} (held out)", fontsize=8)
+        ax.legend(fontsize=7)
+    return save_figure(fig, out)
+
+
+def _residuals(d: BenchDiagnosis, features: list[dict[str, float]], out: Path) -> Path:
+    fig = Figure(figsize=(12, 3.6))
+    for i, (key, label) in enumerate((("speed_mm_s", "median speed [mm/s]"), ("amplitude_mm", "amplitude [mm]"),
+                                      ("static_mm", "static level [mm]"))):
+        ax = fig.add_subplot(1, 3, i + 1)
+        x = np.array([f[key] for f in features])
+        ax.scatter(x, 100 * d.baseline_errors, c="C3", label="baseline", s=14)
+        if d.named:
+            ax.scatter(x, 100 * d.best.record_errors, c="C0", marker="s", label=f"+ {d.verdict}", s=14)
+        if key == "speed_mm_s" and (x > 0).all():
+            ax.set_xscale("log")
+        ax.set_xlabel(label)
+        ax.set_ylabel("RMS error [% of force range]")
+        ax.set_yscale("log")
+        ax.legend(fontsize=7)
+    return save_figure(fig, out)
+
+
+def _ranking(d: BenchDiagnosis, out: Path) -> Path:
+    fig = Figure(figsize=(7, 0.5 + 0.4 * (len(d.ranking) + 1)))
+    ax = fig.add_subplot(1, 1, 1)
+    names = ["baseline"] + [c.cause.id for c in d.ranking]
+    values = [d.heldout_error_before] + [c.heldout_error for c in d.ranking]
+    ax.barh(names[::-1], [100 * v for v in values[::-1]], color=["C0"] * len(d.ranking) + ["C3"])
+    ax.axvline(100 * aggregate(d.noise, d.heldout), color="k", ls="--", lw=0.8, label="noise floor")
+    ax.set_xscale("log")
+    ax.set_xlabel("held-out RMS error [% of force range]")
+    ax.legend(fontsize=7)
+    return save_figure(fig, out)
+
+
+def write_report(d: BenchDiagnosis, out_dir: Path) -> list[Path]:
+    """Write report.md, its PNGs, diagnosis.json and (for a named cause) extended_model.yaml."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    after = d.replay.simulate([d.best.model])[0] if d.named else None
+    features = record_features(d)
+    written = [_overlays(d, after, out_dir / "overlays.png"), _residuals(d, features, out_dir / "residuals.png"),
+               _ranking(d, out_dir / "ranking.png")]
+    model_path = write_extended_model(d, out_dir / "extended_model.yaml")
+    result = summary(d)
+    lines = [f"# Diagnosis: {d.part}", "", verdict_sentence(d), "",
+             f"Baseline: `{d.baseline.name}` ({d.baseline.model}); {len(d.replay.names)} tests, "
+             f"{int(d.heldout.sum())} held out from every fit (every other test). Errors are RMS of measured − "
+             f"simulated force relative to half the test's peak-to-peak force; noise floor "
+             f"{result['noise_floor']:.2%}.", ""]
+    if model_path is not None:
+        lines += [f"Extended model: [`{model_path.name}`]({model_path.name}) (a parameter set: "
+                  f"`vsim bushing run` benches and vehicles can use it).", ""]
+    lines += ["## Ranking (fitted on the training tests, scored on the held-out ones)", "",
+              "| cause | parameters | held-out error | score (with parameter penalty) | fitted values |",
+              "|---|---|---|---|---|",
+              f"| baseline | 0 | {d.heldout_error_before:.3%} | | |"]
+    for c in d.ranking:
+        vals = ", ".join(f"{p.name} = {c.values[p.name]:.4g} {p.unit}" for p in c.cause.parameters)
+        lines.append(f"| {c.cause.id} | {len(c.cause.parameters)} | {c.heldout_error:.3%} | {c.score:.3%} | {vals} |")
+    lines += ["", "![ranking](ranking.png)", "", "## Tests", "",
+              "| test | held out | amplitude [mm] | static [mm] | speed [mm/s] | error before | error after |",
+              "|---|---|---|---|---|---|---|"]
+    for t, f in zip(result["tests"], features):
+        lines.append(f"| {t['name']} | {'yes' if t['heldout'] else ''} | {f['amplitude_mm']:.3g} | {f['static_mm']:.3g} | "
+                     f"{f['speed_mm_s']:.3g} | {t['error_before']:.3%} | {t['error_after']:.3%} |")
+    lines += ["", "## Loops and relaxations (held-out tests with the largest baseline error)", "",
+              "![overlays](overlays.png)", "", "## Residual against speed, amplitude and static load", "",
+              "![residuals](residuals.png)", ""]
+    return written + write_report_text(out_dir, lines, result) + ([model_path] if model_path else [])
+
+
+def write_report_text(out_dir: Path, lines: list[str], result: dict[str, Any]) -> list[Path]:
+    """``report.md`` (the markdown ``lines``) and ``diagnosis.json`` (``result``), each written atomically."""
+    import json
+
+    written = []
+    for name, text in (("report.md", "\n".join(lines)), ("diagnosis.json", json.dumps(result, indent=2))):
+        with atomic_output(out_dir / name) as tmp:
+            tmp.write_text(text)
+        written.append(out_dir / name)
+    return written

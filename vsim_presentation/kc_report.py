@@ -1,0 +1,177 @@
+"""What a K&C diagnosis tells an engineer: the JSON verdict, the extended vehicle file, and a
+one-page markdown report with overlays before/after, the error per test against its amplitude and
+static load, and the ranking with its evidence."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from bushings.bench.bench_file import atomic_output
+from vsim_presentation.bench_plots import save_figure
+from vehicle.model.definition import VehicleDefinition
+from vsim_presentation.bench_report import write_report_text
+from vsim_diagnosis.kc_causes import parameters
+from vsim_diagnosis.kc_diagnosis import KCDiagnosis
+
+#: Channels overlaid in the report (the largest baseline mismatch on held-out tests first).
+OVERLAYS = 4
+
+
+def _parameters(d: KCDiagnosis) -> dict[str, Any]:
+    """The named cause's parameters, each with its uncertainty if it was fitted: the screening fits
+    only the first, with a second held at mid-range (``"fitted": false``, no uncertainty); the refit
+    fits both."""
+    if not d.named:
+        return {}
+    return {p.name: {"value": d.best.hypothesis.values[p.name], "std": d.best.std.get(p.name), "unit": p.unit,
+                     "fitted": p.name in d.best.std} for p in parameters(d.best.hypothesis.cause)}
+
+
+def summary(d: KCDiagnosis) -> dict[str, Any]:
+    """The machine-readable verdict (``vsim diagnose --json``)."""
+    after = d.best.test_errors if d.named else d.baseline_errors
+    return {
+        "cause": d.verdict,
+        "location": d.best.hypothesis.location_json() if d.named else None,
+        "parameters": _parameters(d),
+        "heldout_error_before": d.heldout_error_before,
+        "heldout_error_after": d.heldout_error_after,
+        "noise_floor": 1.0,
+        "ranking": [{"cause": c.hypothesis.cause, "location": c.hypothesis.location_json(),
+                     "heldout_error": c.heldout_error if c.verified else None, "training_error": c.screened_error,
+                     "score": c.score, "n_parameters": len(parameters(c.hypothesis.cause)),
+                     "parameters": dict(c.hypothesis.values)} for c in d.ranking],
+        "tests": [{"name": n, "heldout": bool(h), "error_before": float(b), "error_after": float(a)}
+                  for n, h, b, a in zip(d.test_names, d.heldout, d.baseline_errors, after)],
+        "noise": {c: float(s) for c, s in zip(d.layout.channels, d.noise)},
+        "wall_s": d.wall_s,
+    }
+
+
+def _where(d: KCDiagnosis) -> str:
+    loc = d.best.hypothesis.location_json() or {}
+    return ", ".join(f"{k} {'/'.join(v) if isinstance(v, list) else v}" for k, v in loc.items())
+
+
+def verdict_sentence(d: KCDiagnosis) -> str:
+    """One sentence for people."""
+    before, after = d.heldout_error_before, d.heldout_error_after
+    if d.verdict == "none":
+        return (f"Nothing significant is missing: the baseline's held-out error ({before:.2f} × the measurement "
+                f"noise) is at the noise or no cause of the catalogue reduces it.")
+    best = d.ranking[0]
+    if d.verdict == "unexplained":
+        return (f"The mismatch is real ({before:.2f} × the noise on held-out tests) but no catalogue cause explains "
+                f"it; the best, {best.hypothesis.label}, only brings it to {best.heldout_error:.2f}.")
+    values = ", ".join(f"{k} = {v['value']:.4g} ± {v['std']:.2g} {v['unit']}" if v["fitted"] else
+                       f"{k} = {v['value']:.4g} {v['unit']} (held at mid-range)" for k, v in _parameters(d).items())
+    return (f"Cause: **{d.verdict}** at {_where(d)} ({values}); held-out error {before:.2f} → {after:.2f} "
+            f"× the measurement noise.")
+
+
+def _test_features(d: KCDiagnosis, measured: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per test: peak-to-peak wheel travel [mm] (largest wheel) and mean static pad load [N]."""
+    cols = d.layout.channels
+    travel = [i for i, c in enumerate(cols) if c.startswith("wheel_travel_")]
+    load = [i for i, c in enumerate(cols) if c.startswith("pad_fz_")]
+    amp = np.array([np.ptp(measured[t.rows][:, travel], axis=0).max() for t in d.layout.tests])
+    static = np.array([measured[t.rows][:, load].mean() for t in d.layout.tests])
+    return amp, static
+
+
+def _overlays(d: KCDiagnosis, out: Path) -> Path:
+    held = d.heldout[d.layout.test]
+    mismatch = np.std((d.layout.measured - d.baseline)[held], axis=0) / d.noise   # a zero error does not count
+    worst = [int(i) for i in np.argsort(-mismatch)[:OVERLAYS]]
+    k = max((i for i in range(len(d.layout.tests)) if d.heldout[i]), key=lambda i: d.baseline_errors[i])
+    rows = d.layout.tests[k].rows
+    fig = Figure(figsize=(4.2 * len(worst), 3.6))
+    for j, c in enumerate(worst):
+        ax = fig.add_subplot(1, len(worst), j + 1)
+        m = d.layout.measured[rows, c]
+        x = np.arange(len(rows))
+        ax.plot(x, m, "k.", ms=1.5, label="measured")
+        for sim, style, label in ((d.baseline, "C3-", "baseline"),
+                                  (d.best.simulated if d.named else None, "C0-", f"+ {d.verdict}")):
+            if sim is not None:
+                ax.plot(x, sim[rows, c] + np.median(m - sim[rows, c]), style, lw=0.8, label=label)
+        ax.set_xlabel("sample of the input phase")
+        ax.set_ylabel(d.layout.channels[c])
+        ax.set_title(f"{d.layout.tests[k].name} (held out)", fontsize=8)
+        ax.legend(fontsize=7)
+    return save_figure(fig, out)
+
+
+def _residuals(d: KCDiagnosis, out: Path) -> Path:
+    amp, static = _test_features(d, d.layout.measured)
+    fig = Figure(figsize=(8.5, 3.6))
+    for i, (x, label) in enumerate(((amp, "peak-to-peak wheel travel [mm]"), (static, "mean pad load [N]"))):
+        ax = fig.add_subplot(1, 2, i + 1)
+        ax.scatter(x, d.baseline_errors, c="C3", s=14, label="baseline")
+        if d.named:
+            ax.scatter(x, d.best.test_errors, c="C0", marker="s", s=14, label=f"+ {d.verdict}")
+        ax.axhline(1.0, color="k", ls="--", lw=0.8, label="noise")
+        ax.set_xlabel(label)
+        ax.set_ylabel("RMS error [× noise]")
+        ax.legend(fontsize=7)
+    return save_figure(fig, out)
+
+
+def _ranking(d: KCDiagnosis, out: Path) -> Path:
+    shown = [c for c in d.ranking if c.verified]
+    fig = Figure(figsize=(7, 0.5 + 0.4 * (len(shown) + 1)))
+    ax = fig.add_subplot(1, 1, 1)
+    names = ["baseline"] + [c.hypothesis.label for c in shown]
+    values = [d.heldout_error_before] + [c.heldout_error for c in shown]
+    ax.barh(names[::-1], values[::-1], color=["C0"] * len(shown) + ["C3"])
+    ax.axvline(1.0, color="k", ls="--", lw=0.8, label="noise")
+    ax.set_xlabel("held-out RMS error [× noise]")
+    ax.legend(fontsize=7)
+    return save_figure(fig, out)
+
+
+def write_report(d: KCDiagnosis, baseline: VehicleDefinition, out_dir: Path, dataset: str) -> list[Path]:
+    """Write report.md, its PNGs, diagnosis.json and (for a named cause) extended_vehicle.yaml."""
+    from vsim_diagnosis.kc_causes import extended_vehicle_yaml
+
+    out_dir.mkdir(parents=True, exist_ok=True)
+    written = [_overlays(d, out_dir / "overlays.png"), _residuals(d, out_dir / "residuals.png"),
+               _ranking(d, out_dir / "ranking.png")]
+    result = summary(d)
+    lines = [f"# K&C diagnosis of {dataset}", "", verdict_sentence(d), "",
+             f"Baseline: `{baseline.path}`; {len(d.test_names)} tests (recorded cases), {int(d.heldout.sum())} held "
+             f"out from every fit (every other one). Errors are RMS of measured − simulated over every measured "
+             f"channel but the rig inputs, each in units of its own measurement noise (estimated from the data), "
+             f"each channel's zero in each recording removed: 1 is a perfect model.", ""]
+    if d.named:
+        model = out_dir / "extended_vehicle.yaml"
+        note = (f"{baseline.path} extended by {d.best.hypothesis.label} {dict(d.best.hypothesis.values)}, fitted by "
+                f"vsim diagnose on {dataset}.")
+        with atomic_output(model) as tmp:
+            tmp.write_text(extended_vehicle_yaml(baseline, [d.best.hypothesis], note))
+        written.append(model)
+        lines += [f"Extended model: [`{model.name}`]({model.name}) (a vehicle file: `vsim run` uses it "
+                  f"through a scenario's `vehicle:` key).", ""]
+    lines += ["## Ranking", "",
+              "Every cause at every place it can sit was run once on the training tests and its magnitude fitted; "
+              "the best were run on every test and scored on the held-out ones.", "",
+              "| hypothesis | parameters | held-out error | training error | fitted values |", "|---|---|---|---|---|",
+              f"| baseline | 0 | {d.heldout_error_before:.3f} | | |"]
+    for c in d.ranking[:12]:
+        vals = ", ".join(f"{k} = {v:.4g}" for k, v in c.hypothesis.values.items())
+        held = f"{c.heldout_error:.3f}" if c.verified else "(not run)"
+        lines.append(f"| {c.hypothesis.label} | {len(parameters(c.hypothesis.cause))} | {held} | "
+                     f"{c.screened_error:.3f} | {vals} |")
+    lines += ["", "![ranking](ranking.png)", "", "## Tests", "", "| test | held out | error before | error after |",
+              "|---|---|---|---|"]
+    for t in result["tests"]:
+        lines.append(f"| {t['name']} | {'yes' if t['heldout'] else ''} | {t['error_before']:.3f} | "
+                     f"{t['error_after']:.3f} |")
+    lines += ["", "## Channels with the largest mismatch (held-out test with the largest baseline error)", "",
+              "![overlays](overlays.png)", "", "## Error against amplitude and static load", "",
+              "![residuals](residuals.png)", ""]
+    return written + write_report_text(out_dir, lines, result)

@@ -1,0 +1,152 @@
+"""A bushing-bench dataset on disk: ``rig.yaml`` plus one ``t_s,e_mm,F_N`` CSV per test.
+
+``rig.yaml`` (documented in data/README.md)::
+
+    level: bench
+    part: "front lower arm, E1 front bushing, radial x"   # free text
+    quantity: translation                                  # e in mm, F in N
+    rig: {name: ..., notes: ...}                           # free text about the rig
+    records:                                               # in the order played on the part
+      - file: 01_triangle_2mm_slow.csv
+        programme: {type: triangle, amplitude_mm: 2.0, speed_mm_s: 0.333, cycles: 2}
+        rest_before_s: 0.0                                 # part at rest (e = 0) before the test
+
+The order matters: the part's state (hysteresis memory, Mullins damage, heat) carries over.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import shutil
+import tempfile
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Iterator, Sequence
+
+import numpy as np
+import yaml
+
+from vsim_core.errors import InputError, read_yaml
+from bushings.bench.records import BenchRecord, read_bench_csv
+
+RIG_FILE = "rig.yaml"
+_KEYS = {"level", "part", "quantity", "rig", "records"}
+_RECORD_KEYS = {"file", "programme", "rest_before_s"}
+
+
+@dataclass(frozen=True)
+class BenchTestRecord:
+    """One measured test in a dataset."""
+
+    name: str
+    programme: dict[str, Any]
+    rest_before_s: float
+    record: BenchRecord
+
+
+@dataclass(frozen=True)
+class BenchDataset:
+    """A measured bench campaign on one part."""
+
+    path: Path
+    part: str
+    quantity: str
+    records: list[BenchTestRecord]
+    rig: dict[str, Any] = field(default_factory=dict)
+
+
+def dataset_level(directory: str | os.PathLike[str]) -> str:
+    """``bench`` or ``kc``: the level a measured directory declares in its rig.yaml."""
+    data = _read_yaml(Path(directory) / RIG_FILE)
+    level = data.get("level")
+    if level not in ("bench", "kc"):
+        raise InputError(f"expected level bench or kc, got {level!r}", source=str(Path(directory) / RIG_FILE),
+                         key="level")
+    return level
+
+
+def _read_yaml(path: Path) -> dict[str, Any]:
+    data = read_yaml(path, f"no {RIG_FILE} here: a measured directory describes its tests in {RIG_FILE}")
+    if not isinstance(data, dict):
+        raise InputError("expected a mapping", source=str(path))
+    return data
+
+
+def read_bench_dataset(directory: str | os.PathLike[str]) -> BenchDataset:
+    """Read and validate a bench dataset; errors name the file and key (or CSV line and column)."""
+    root = Path(directory)
+    path = root / RIG_FILE
+    data = _read_yaml(path)
+    source = str(path)
+    unknown = sorted(set(data) - _KEYS)
+    if unknown:
+        raise InputError(f"unknown key {unknown[0]!r}; expected {', '.join(sorted(_KEYS))}", source=source, key=unknown[0])
+    if data.get("level") != "bench":
+        raise InputError(f"expected level: bench, got {data.get('level')!r}", source=source, key="level")
+    quantity = data.get("quantity", "translation")
+    if quantity != "translation":
+        raise InputError(f"the bench works in mm and N; got quantity {quantity!r}", source=source, key="quantity")
+    entries = data.get("records")
+    if not isinstance(entries, list) or not entries:
+        raise InputError("expected a non-empty list of records", source=source, key="records")
+    records = []
+    for i, entry in enumerate(entries):
+        key = f"records[{i}]"
+        if not isinstance(entry, dict) or "file" not in entry:
+            raise InputError("expected a mapping with at least a file key", source=source, key=key)
+        bad = sorted(set(entry) - _RECORD_KEYS)
+        if bad:
+            raise InputError(f"unknown key {bad[0]!r}; expected {', '.join(sorted(_RECORD_KEYS))}", source=source,
+                             key=f"{key}.{bad[0]}")
+        rest = entry.get("rest_before_s", 0.0)
+        if isinstance(rest, bool) or not isinstance(rest, (int, float)) or not 0.0 <= rest < math.inf:
+            raise InputError(f"expected a rest duration >= 0 s, got {rest!r}", source=source, key=f"{key}.rest_before_s")
+        csv_path = root / str(entry["file"])
+        if not csv_path.is_file():
+            raise InputError(f"no such record file {str(entry['file'])!r}", source=source, key=f"{key}.file")
+        records.append(BenchTestRecord(Path(str(entry["file"])).stem, dict(entry.get("programme") or {}),
+                                       float(rest), read_bench_csv(csv_path)))
+    return BenchDataset(root, str(data.get("part", "")), quantity, records, dict(data.get("rig") or {}))
+
+
+def write_bench_dataset(directory: str | os.PathLike[str], part: str, records: Sequence[BenchTestRecord],
+                        rig: dict[str, Any], *, overwrite: bool = False) -> Path:
+    """Write a dataset as a whole: into a temporary folder renamed at the end, so that a reader
+    never sees a partial one. Forces are written to 0.001 N, deflections to 0.1 nm."""
+    root = Path(directory)
+    with whole_directory(root, overwrite=overwrite) as tmp:
+        entries = []
+        width = len(str(len(records)))
+        for i, r in enumerate(records, start=1):
+            name = f"{i:0{width}d}_{r.name}.csv"
+            rec = r.record
+            np.savetxt(tmp / name, np.column_stack([rec.t, rec.e * 1e3, rec.F]), delimiter=",",
+                       fmt=("%.6f", "%.7f", "%.3f"), header="t_s,e_mm,F_N", comments="")
+            entries.append({"file": name, "programme": r.programme, "rest_before_s": r.rest_before_s})
+        manifest = {"level": "bench", "part": part, "quantity": "translation", "rig": rig, "records": entries}
+        (tmp / RIG_FILE).write_text(yaml.safe_dump(manifest, sort_keys=False))
+    return root
+
+
+@contextmanager
+def whole_directory(root: Path, *, overwrite: bool = False) -> Iterator[Path]:
+    """A temporary folder next to ``root`` to write a dataset into, renamed to ``root`` when the block
+    ends without error (replacing it only if ``overwrite``) and removed otherwise: a reader never
+    sees a partial dataset. The folder has the usual permissions (umask), not mkdtemp's 0700."""
+    if root.exists() and not overwrite:
+        raise InputError("exists; pass --overwrite to replace it", source=str(root))
+    root.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{root.name}.", dir=root.parent))
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(tmp, 0o777 & ~umask)
+    try:
+        yield tmp
+        if root.exists():
+            shutil.rmtree(root)
+        os.replace(tmp, root)
+    finally:
+        if tmp.exists():
+            shutil.rmtree(tmp)
