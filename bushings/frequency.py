@@ -19,8 +19,8 @@ import numpy as np
 from scipy.special import gamma
 
 from bushings.bank import BushingBank
-from vsim_core.errors import InputError
 from bushings.parameters import ChannelParams
+from vsim_core.errors import InputError
 
 
 @dataclass(frozen=True)

@@ -1,42 +1,33 @@
-"""Bushing channel parameters: the model catalogue, named parameter sets, and unit conversion.
+"""Bushing channel parameters: the model catalogue and the conversion from the thesis's units to SI.
 
-Parameter sets are written in the thesis's units (N, mm, s for translations; N·m, deg, s for
+Parameter values are written in the thesis's units (N, mm, s for translations; N·m, deg, s for
 rotations) and converted to SI exactly once, here, when a :class:`ChannelParams` is built.
 Everything downstream (kernels, bank, vehicle) is SI: N, m, s or N·m, rad, s.
 """
 
 from __future__ import annotations
 
-import copy
-import functools
 import math
 from dataclasses import dataclass, field, replace
-from pathlib import Path
-from typing import TYPE_CHECKING, Any, Mapping
+from typing import Any, Mapping
 
-import yaml
-
-
-from vsim_core.errors import InputError, parse_yaml
-from vsim_core.shipped import PARAMETER_SET_DIR
-
-if TYPE_CHECKING:
-    from bushings.effects import Effects
-
-#: The folder holding the named parameter sets shipped with the project.
+from vsim_core import units
+from vsim_core.errors import InputError
 
 #: Number of ladder cells when a set does not say (the thesis's choice for 0.05–2 mm).
 DEFAULT_CELLS = 15
 #: Most ladder cells a channel may have (the kernel's ladder rows are sized for it).
 MAX_CELLS = 200
 
-# Each parameter's dimension as (power of length) so that value_SI = value_user * L**power, where
-# L is the length unit in SI (1e-3 m per mm, pi/180 rad per deg). Force units need no conversion
-# (N, or N·m for rotations). Co has dimension force/(length/s)**pw, handled in to_si().
-_LENGTH_POWER = {
-    "K0": -1, "C": -1, "Kpa": -1, "Kr": -1, "Ff": 0, "Co": None, "pw": 0, "N": 0,
-    "N_sup": 1, "N_inf": 1, "S_sup": 1, "S_inf": 1, "P_sup": 0, "P_inf": 0,
-    "Ct": -1, "n": 0, "maxwell_k": -1, "maxwell_c": -1,
+#: Each parameter's dimension: the power of the length unit L in value_SI = value_user · L**power, and
+#: its unit with F the force unit (N, or N·m for rotations) and L the length unit (mm, or deg). Co has
+#: dimension F/(L/s)**pw, handled in to_si().
+_PARAMETERS: dict[str, tuple[int | None, str]] = {
+    "K0": (-1, "{F}/{L}"), "C": (-1, "{F}·s/{L}"), "Kpa": (-1, "{F}/{L}"), "Kr": (-1, "{F}/{L}"), "Ff": (0, "{F}"),
+    "Co": (None, "{F}/({L}/s)^pw"), "pw": (0, ""), "N": (0, ""),
+    "N_sup": (1, "{L}"), "N_inf": (1, "{L}"), "S_sup": (1, "{L}"), "S_inf": (1, "{L}"), "P_sup": (0, "{F}"),
+    "P_inf": (0, "{F}"), "Ct": (-1, "{F}^n/{L}"), "n": (0, ""), "maxwell_k": (-1, "{F}/{L}"),
+    "maxwell_c": (-1, "{F}·s/{L}"),
 }
 
 _ELASTIC_KEYS = ("N_sup", "N_inf", "S_sup", "S_inf", "P_sup", "P_inf")
@@ -56,8 +47,14 @@ MODELS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
 }
 
 #: Length unit of user-facing parameter values, per quantity, in SI.
-LENGTH_UNIT_SI = {"translation": 1e-3, "rotation": math.pi / 180.0}
+LENGTH_UNIT_SI = {"translation": units.si("mm"), "rotation": units.si("deg")}
 UNIT_LABELS = {"translation": ("N", "mm"), "rotation": ("N·m", "deg")}
+
+
+def parameter_unit(key: str, quantity: str = "translation") -> str:
+    """The unit a parameter is written in (``N/mm`` for K0 of a translation, ``N·m/deg`` of a rotation)."""
+    force, length = UNIT_LABELS[quantity]
+    return _PARAMETERS[key][1].format(F=force, L=length)
 
 
 @dataclass(frozen=True)
@@ -156,7 +153,7 @@ def to_si(model: str, values: Mapping[str, Any], quantity: str = "translation",
             raise InputError(f"expected a non-negative value, got {raw!r}", source=source, key=key)
         if key in ("Kpa", "Kr", "Ct") and value == 0:
             raise InputError(f"expected a positive value, got {raw!r}", source=source, key=key)
-        si[key] = value if key == "Co" else value * length ** _LENGTH_POWER[key]
+        si[key] = value if key == "Co" else value * length ** _PARAMETERS[key][0]
     if "Co" in si:  # force/(length/s)^pw: dividing by length**pw
         si["Co"] = si["Co"] / length ** si.get("pw", 1.0)
     if "n" in si:
@@ -179,110 +176,3 @@ def _check_elastic(si: dict[str, Any], source: str) -> None:
                          source=source, key=missing[0])
     if present and not (si["S_inf"] < si["N_inf"] <= 0.0 <= si["N_sup"] < si["S_sup"]):
         raise InputError("expected S_inf < N_inf <= 0 <= N_sup < S_sup", source=source, key="N_sup")
-
-
-@dataclass(frozen=True)
-class ParameterSet:
-    """A named, cited parameter set for one bushing direction, as written in its YAML file."""
-
-    name: str
-    model: str
-    quantity: str
-    values: Mapping[str, Any]  #: user-facing values in the thesis's units
-    source: str                #: provenance (publication, figure, measurement, assumption)
-    path: Path | None = None
-    effects: Mapping[str, Any] = field(default_factory=dict)  #: law extensions, see :mod:`bushings.effects`
-
-    def effects_si(self) -> "Effects":
-        """The set's state extensions (preload, asymmetry, Mullins, self-heating, backlash) in SI."""
-        from bushings.effects import effects_to_si  # effects builds on this module
-
-        return effects_to_si(self.effects, self.quantity, str(self.path or self.name))
-
-    def channel(self, model: str | None = None) -> ChannelParams:
-        """SI parameters of this set, optionally read as another model.
-
-        Reading as another model keeps the parameters that model uses (e.g. an STVS set read as
-        ``sts`` drops Co and pw; read as ``sts_continuous`` it takes Ct = 2·Ff·Kr, Coveney's
-        limit of the discrete ladder); a parameter the other model needs and the set lacks is an
-        error naming this set.
-        """
-        target = model or self.model
-        values = dict(self.values)
-        if target != self.model:
-            if target in ("sts_continuous", "stsn") and "Ct" not in values and {"Ff", "Kr"} <= set(values):
-                values["Ct"] = 2.0 * values["Ff"] * values["Kr"]
-            if target not in MODELS:
-                raise InputError(f"unknown model {target!r}; expected one of {', '.join(MODELS)}",
-                                 source=str(self.path or self.name), key="model")
-            required, optional = MODELS[target]
-            values = {k: v for k, v in values.items() if k in required + optional}
-        return to_si(target, values, self.quantity, str(self.path or self.name))
-
-
-def parse_parameter_set(data: Any, source: str, name: str | None = None) -> ParameterSet:
-    """Validate the mapping of a parameter-set file (keys: model, quantity, source, params)."""
-    if not isinstance(data, Mapping):
-        raise InputError("expected a mapping with keys model, params, source", source=source)
-    allowed = {"name", "model", "quantity", "source", "description", "params", "effects"}
-    unknown = sorted(set(data) - allowed)
-    if unknown:
-        raise InputError(f"unknown key {unknown[0]!r}; expected {', '.join(sorted(allowed))}",
-                         source=source, key=unknown[0])
-    for key in ("model", "params"):
-        if key not in data:
-            raise InputError("missing key", source=source, key=key)
-    for key in ("params", "effects"):
-        if not isinstance(data.get(key, {}), Mapping):
-            raise InputError(f"expected a mapping, got {data[key]!r}", source=source, key=key)
-    pset = ParameterSet(name=str(data.get("name", name or source)), model=str(data["model"]),
-                        quantity=str(data.get("quantity", "translation")), values=dict(data["params"]),
-                        source=str(data.get("source", "unspecified")),
-                        path=Path(source) if source.endswith((".yaml", ".yml")) else None,
-                        effects=dict(data.get("effects") or {}))
-    pset.channel()  # validate now, so errors name this file
-    pset.effects_si()
-    return pset
-
-
-def load_parameter_set(name_or_path: str | Path) -> ParameterSet:
-    """Load a parameter set by name (a file in ``models/bushings/``) or by path."""
-    path = Path(name_or_path)
-    if path.suffix not in (".yaml", ".yml"):
-        path = PARAMETER_SET_DIR / f"{name_or_path}.yaml"
-    if not path.is_file():
-        known = ", ".join(sorted(p.stem for p in PARAMETER_SET_DIR.glob("*.yaml")))
-        raise InputError(f"no parameter set {str(name_or_path)!r}; known sets: {known}", source=str(path))
-    # a vehicle build reads the same few files once per bushing direction: parsed once per content;
-    # a copy keeps the cached set intact
-    return copy.deepcopy(_parsed(str(path), path.read_text()))
-
-
-@functools.lru_cache(maxsize=128)
-def _parsed(path: str, text: str) -> ParameterSet:
-    return parse_parameter_set(parse_yaml(text, path), path, name=Path(path).stem)
-
-
-def save_parameter_set(pset: ParameterSet, path: str | Path) -> Path:
-    """Write a parameter set in the format of ``models/bushings/*.yaml`` (read back by
-    :func:`load_parameter_set`), atomically."""
-    from bushings.bench.bench_file import atomic_output  # bench builds on this module
-
-    def plain(v: Any) -> Any:
-        if isinstance(v, (list, tuple)):
-            return [float(x) for x in v]
-        return int(v) if isinstance(v, int) else float(v)
-
-    data: dict[str, Any] = {"model": pset.model, "quantity": pset.quantity, "source": pset.source,
-                            "params": {k: plain(v) for k, v in pset.values.items()}}
-    if pset.effects:
-        data["effects"] = {k: float(v) for k, v in pset.effects.items()}
-    with atomic_output(Path(path)) as tmp:
-        tmp.write_text(yaml.safe_dump(data, sort_keys=False, default_flow_style=None, width=10_000,
-                                      allow_unicode=True))
-    return Path(path)
-
-
-def available_parameter_sets() -> list[str]:
-    """Names of the parameter sets shipped in ``models/bushings/``."""
-    return sorted(p.stem for p in PARAMETER_SET_DIR.glob("*.yaml"))

@@ -14,7 +14,7 @@ from typing import Callable
 
 import numpy as np
 
-from vsim_diagnosis.causes import CAUSES, draw
+from vsim_diagnosis.catalogue import CAUSES, draw
 from vsim_diagnosis.virtual_bench import OUTSIDE, measure_bench, parse_truth
 
 
@@ -69,7 +69,7 @@ def measure(tmp: Path, cause: str, seed: int) -> tuple[str, list[dict], Path]:
 
 def diagnose_fresh(directory: Path, baseline: str, report: Path | None = None) -> dict:
     """``vsim diagnose DIR --bushing-model BASELINE --json`` in a fresh Python process."""
-    cmd = [sys.executable, "-m", "vsim_cli.main", "diagnose", str(directory), "--bushing-model", baseline, "--json"]
+    cmd = [sys.executable, "-m", "vsim_cli", "diagnose", str(directory), "--bushing-model", baseline, "--json"]
     if report is not None:
         cmd += ["-o", str(report)]
     done = subprocess.run(cmd, capture_output=True, text=True, timeout=600, cwd=directory.parent)

@@ -2,20 +2,18 @@
 
 from __future__ import annotations
 
-import argparse
 import csv
-import sys
-import types
 from pathlib import Path
 
 import numpy as np
 import pytest
 import yaml
 
-from bushings import InputError
-from bushings.bench.bench_file import atomic_output, load_bench, parse_bench, run_bench
+from bushings.bench.bench_file import load_bench, parse_bench, run_bench
 from bushings.bench.programmes import firtree, multisine, parse_programme, read_csv_record, sine, step, triangle
 from vsim_cli.main import build_parser, main
+from vsim_core.errors import InputError
+from vsim_core.files import atomic_output
 
 MM = 1e-3
 BENCH_DIR = Path(__file__).resolve().parent.parent / "models" / "bushings" / "benches"
@@ -70,6 +68,23 @@ def test_programme_defaults_are_the_thesis_firtree():
     prog = parse_programme({"type": "firtree"}, 0.01, "b.yaml")
     assert prog.t_s[-1] == pytest.approx(12 * 0.1 + 11 * 60.0)
     assert np.max(prog.e_m) == pytest.approx(3 * MM)
+
+
+def test_a_sine_about_a_static_offset_ramps_there_rests_and_comes_back():
+    """``static_mm``: a 1 mm/s ramp to the offset, 1 s at rest, the sine about the offset, a ramp back."""
+    dt = 0.002
+    prog = parse_programme({"type": "sine", "amplitude_mm": 0.5, "frequency_hz": 1.0, "cycles": 3, "static_mm": -2.0},
+                           dt, "b.yaml")
+    t, e = prog.t_s, prog.e_m
+    assert np.all(np.diff(t) == pytest.approx(dt))
+    ramp = t <= 2.0
+    np.testing.assert_allclose(e[ramp], -1e-3 * t[ramp], atol=1e-15)                       # 1 mm/s to -2 mm
+    rest = (t > 2.0 + dt / 2) & (t < 3.0 - dt / 2)
+    np.testing.assert_allclose(e[rest], -2 * MM, atol=1e-15)
+    sine_part = (t > 3.0 + dt / 2) & (t < 6.0 + dt / 2)
+    assert e[sine_part].max() == pytest.approx(-1.5 * MM, abs=1e-9) and e[sine_part].min() == pytest.approx(-2.5 * MM, abs=1e-9)
+    assert e[sine_part].mean() == pytest.approx(-2 * MM, abs=1e-6)
+    assert e[-1] == 0.0 and t[-1] == pytest.approx(2.0 + 1.0 + dt + 3.0 + dt + 2.0)
 
 
 def test_csv_record_is_resampled(tmp_path):
@@ -214,17 +229,11 @@ def test_atomic_output_keeps_the_old_file_on_failure(tmp_path):
     assert target.read_text() == "old" and list(tmp_path.iterdir()) == [target]
 
 
-def test_bushing_group_has_run_and_takes_fit_from_identification_cli(monkeypatch):
+def test_bushing_group_has_run_and_fit():
     args = build_parser().parse_args(["bushing", "run", "b.yaml", "-o", "o.csv"])
     assert args.bench == Path("b.yaml") and args.plot is None
-
-    def add_fit_command(subparsers: argparse._SubParsersAction) -> None:
-        subparsers.add_parser("fit").set_defaults(func=lambda a: 0)
-
-    fake = types.ModuleType("vsim_cli.bushing_fit")
-    fake.add_fit_command = add_fit_command
-    monkeypatch.setitem(sys.modules, "vsim_cli.bushing_fit", fake)
-    assert build_parser().parse_args(["bushing", "fit"]).bushing_command == "fit"
+    args = build_parser().parse_args(["bushing", "fit", "r.csv", "--model", "sts"])
+    assert args.bushing_command == "fit" and args.records == [Path("r.csv")] and args.model == "sts"
 
 
 def test_load_bench_reads_a_file(tmp_path):

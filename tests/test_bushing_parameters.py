@@ -6,7 +6,8 @@ import math
 
 import pytest
 
-from bushings import InputError, available_parameter_sets, load_parameter_set, to_si
+from bushings import available_parameter_sets, load_parameter_set, to_si
+from vsim_core.errors import InputError
 
 
 def test_shipped_sets_load_with_their_source():

@@ -13,15 +13,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from vsim_core.errors import InputError
-from vsim_cli import main as cli
-from vsim_analysis.compare import compare_runs, format_table
-from vehicle.model.definition import DEFAULT_VEHICLE
-from vsim_recordings.run_reader import Run, load_run
-from vsim_recordings.run_writer import RunWriter
-from vsim_analysis.run_metrics import dynamic_stiffness, loop_area, relaxation_amplitude, rms_error
-from vehicle.simulation.runner import run_scenario
 from vehicle.scenarios.scenario_file import load_scenario
+from vsim_analysis.compare import compare_runs
+from vsim_analysis.loops import dynamic_stiffness, loop_area, relaxation_amplitude, rms_error
+from vsim_cli import main as cli
+from vsim_core.errors import InputError
+from vsim_core.shipped import DEFAULT_VEHICLE
+from vsim_presentation.comparison_report import format_table
+from vsim_recordings.recorder import run_scenario
+from vsim_recordings.run_format import Run
+from vsim_recordings.run_reader import load_run
+from vsim_recordings.run_writer import RunWriter
 
 #: Two pumping cases at 2 Hz, a triangle and a sine (which has a dynamic stiffness).
 PUMPING = """\

@@ -12,10 +12,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from bushings.effects import ExtendedBank, broad_relaxation_branches
-from bushings.parameters import load_parameter_set
+from bushings.effects import broad_relaxation_branches
+from bushings.extended_bank import ExtendedBank
+from bushings.parameter_sets import load_parameter_set
 from tests.diagnosis_helpers import SLOW_SEEDS, assert_success_rate, diagnose_fresh, measure
-from vsim_diagnosis.causes import CAUSES
+from vsim_diagnosis.catalogue import CAUSES
 
 BENCH_CAUSES = sorted(CAUSES)
 #: Seeds per cause in the default suite (one, for time: each diagnosis takes 15-60 s); the slow

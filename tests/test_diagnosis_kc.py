@@ -20,18 +20,19 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from vsim_core.errors import InputError
-from bushings.parameters import load_parameter_set
+from bushings.parameter_sets import load_parameter_set
 from tests.diagnosis_helpers import SLOW_SEEDS, assert_success_rate
-from vehicle.model.definition import load_vehicle, with_extensions
-from vsim_diagnosis.kc_causes import (OBSERVABLE, Hypothesis, draw, extended_vehicle, extended_vehicle_yaml,
-                                            locations, parameters)
-from vsim_diagnosis.kc_diagnosis import Candidate, Layout, Test, _nominal, _Scorer, fit, split
-from vsim_presentation.kc_report import _parameters
-from vsim_diagnosis.virtual_kc_rig import DEFAULT_SCENARIOS, measure_kc, parse_kc_truth
-from vsim_recordings.run_reader import load_run
-from vehicle.simulation.runner import run_scenario, simulate
+from vehicle.model.vehicle_file import load_vehicle, with_extensions
 from vehicle.scenarios.scenario_file import load_scenario
+from vsim_core.errors import InputError
+from vsim_diagnosis.kc_catalogue import (OBSERVABLE, Hypothesis, draw, extended_vehicle, extended_vehicle_yaml,
+                                         locations, parameters)
+from vsim_diagnosis.kc_diagnosis import Candidate, Layout, Test, _nominal, _Scorer, fit
+from vsim_diagnosis.verdict import split
+from vsim_diagnosis.virtual_kc_rig import DEFAULT_SCENARIOS, measure_kc, parse_kc_truth
+from vsim_presentation.kc_report import _parameters
+from vsim_recordings.recorder import run_scenario, simulate
+from vsim_recordings.run_reader import load_run
 
 KC_CAUSES = sorted(c for c in OBSERVABLE if c != "backlash")
 #: The default suite diagnoses one draw (about 2 min); the slow suite SLOW_SEEDS per cause.
@@ -179,7 +180,7 @@ def test_simulate_gives_the_recorded_run(tmp_path):
 
 def test_diagnose_refuses_a_bushing_model_for_a_kc_dataset(tmp_path):
     (tmp_path / "rig.yaml").write_text("level: kc\nvehicle: car\nrecordings: []\n")
-    done = subprocess.run([sys.executable, "-m", "vsim_cli.main", "diagnose", str(tmp_path), "--bushing-model",
+    done = subprocess.run([sys.executable, "-m", "vsim_cli", "diagnose", str(tmp_path), "--bushing-model",
                            "fig5_9"], capture_output=True, text=True)
     assert done.returncode != 0
     assert "--vehicle" in done.stderr and "rig.yaml" in done.stderr
@@ -218,7 +219,7 @@ def measure_truth(tmp: Path, h: Hypothesis | None, seed: int, *, duration_scale:
 
 def diagnose_fresh(directory: Path, *options: str) -> dict:
     """``vsim diagnose DIR --json [options]`` (the default car as baseline) in a fresh Python process."""
-    done = subprocess.run([sys.executable, "-m", "vsim_cli.main", "diagnose", str(directory), "--json", *options],
+    done = subprocess.run([sys.executable, "-m", "vsim_cli", "diagnose", str(directory), "--json", *options],
                           capture_output=True, text=True, timeout=1800, cwd=directory.parent)
     assert done.returncode == 0, done.stderr
     return json.loads(done.stdout)

@@ -7,8 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from bushings import BushingBank, InputError, load_parameter_set, to_si
+from bushings import BushingBank, load_parameter_set, to_si
 from bushings.frequency import equivalent_damping, first_harmonic, harmonic_ratio, rate_scaled
+from vsim_core.errors import InputError
 
 MM = 1e-3
 STVS = load_parameter_set("fig5_9").channel()

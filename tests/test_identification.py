@@ -8,11 +8,12 @@ import math
 import numpy as np
 import pytest
 
-from bushings import InputError, load_parameter_set
+from bushings import load_parameter_set
 from bushings.bench.identification import (CycleMeasures, fit, identify_sts, measure_cycle, sts_cycle_measures,
-                                     sts_from_measures, stvs_initial)
-from vsim_cli.bushing_fit import add_fit_command
+                                           sts_from_measures, stvs_initial)
 from bushings.bench.records import BenchRecord, read_bench_csv, simulate_record
+from vsim_cli import bushing_fit
+from vsim_core.errors import InputError
 
 MM = 1e-3
 
@@ -169,7 +170,7 @@ def test_fit_cli_writes_a_loadable_parameter_set(tmp_path, capsys):
         write_csv(paths[-1], record(name, pset.channel(), programme))
     out = tmp_path / "fitted.yaml"
     parser = argparse.ArgumentParser(prog="vsim bushing")
-    add_fit_command(parser.add_subparsers(dest="command", required=True))
+    bushing_fit.register(parser.add_subparsers(dest="command", required=True))
     args = parser.parse_args(["fit", *map(str, paths), "--model", "sts", "-o", str(out)])
     assert args.func(args) == 0
     printed = capsys.readouterr().out

@@ -17,18 +17,14 @@ import rerun.chunk
 from foxglove.messages import FrameTransform, FrameTransforms, Quaternion, Timestamp, Vector3
 from mcap.reader import make_reader
 
-from vsim_core.errors import InputError
+from vsim_cli import plot as plot_cli
 from vsim_cli import view as view_cli
+from vsim_core.errors import InputError
+from vsim_recordings.message_layouts import FrameTransformsLayout, timestamp_field
+from vsim_recordings.recorder import geometry_from_model
+from vsim_recordings.run_format import RunMetadata, SignalSpec, rotation_matrix, signal_label
 from vsim_recordings.run_reader import load_run
-from vsim_recordings.run_writer import (
-    FrameTransformsLayout,
-    RunMetadata,
-    RunWriter,
-    SignalSpec,
-    geometry_from_model,
-    signal_label,
-    timestamp_field,
-)
+from vsim_recordings.run_writer import RunWriter
 
 BODIES = ["chassis", "arm", "wheel"]
 SIGNALS = [
@@ -153,6 +149,18 @@ def test_geometry_from_model_in_body_frames() -> None:
     assert geometry[2].size_m[:2] == pytest.approx((0.03, 0.2)) and geometry[2].pos_m == pytest.approx((0, 0.2, 0))
     with pytest.raises(ValueError, match="nose"):
         geometry_from_model(toy_model(), ["nose"])
+
+
+def test_rotation_matrix_is_mujocos_without_mujoco() -> None:
+    """Reading and drawing runs needs no MuJoCo: the numpy rotation agrees with mju_quat2Mat within
+    round-off, and is a rotation."""
+    rng = np.random.default_rng(3)
+    for q in [np.array([1.0, 0, 0, 0]), *(q / np.linalg.norm(q) for q in rng.normal(size=(200, 4)))]:
+        expected = np.empty(9)
+        mujoco.mju_quat2Mat(expected, q)
+        r = rotation_matrix(q)
+        np.testing.assert_allclose(r, expected.reshape(3, 3), rtol=0, atol=4e-16)
+        np.testing.assert_allclose(r @ r.T, np.eye(3), atol=1e-15)
 
 
 def test_frame_transforms_encoding_matches_foxglove_sdk() -> None:
@@ -298,7 +306,9 @@ def test_rerun_mcap_convert_holds_transforms_and_signals(run_file: Path, traject
 
 def _cli(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(prog="vsim")
-    view_cli.register(parser.add_subparsers(dest="command", required=True))
+    commands = parser.add_subparsers(dest="command", required=True)
+    for command in (view_cli, plot_cli):
+        command.register(commands)
     args = parser.parse_args(argv)
     return args.func(args)
 

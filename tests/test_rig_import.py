@@ -12,14 +12,16 @@ import pytest
 import yaml
 from mcap.reader import make_reader
 
-from vsim_core.errors import InputError
-from vsim_cli import main as cli
-from vsim_recordings.run_reader import Run, load_run
-from vsim_recordings.run_writer import RUN_RECORD, TF_TOPIC, RunMetadata, RunWriter, SignalSpec
-from vsim_cli.rig import UNITS, import_csv
-from vsim_recordings.rig_recordings import measured_channels, write_rig_recording
-from vehicle.simulation.runner import run_scenario
 from vehicle.scenarios.scenario_file import load_scenario
+from vsim_cli import main as cli
+from vsim_core import units
+from vsim_core.errors import InputError
+from vsim_recordings.csv_import import import_csv
+from vsim_recordings.recorder import run_scenario
+from vsim_recordings.rig_recordings import measured_channels, write_rig_recording
+from vsim_recordings.run_format import RUN_RECORD, TF_TOPIC, Run, RunMetadata, SignalSpec
+from vsim_recordings.run_reader import load_run
+from vsim_recordings.run_writer import RunWriter
 
 ROOT = Path(__file__).resolve().parent.parent
 PUMPING = ROOT / "scenarios/pumping.yaml"
@@ -33,9 +35,10 @@ def write_csv(run: Run, meta: Path, path: Path) -> None:
     column = channel / (sign × unit factor) − offset, 9 significant digits."""
     declared = yaml.safe_load(meta.read_text())
     time = declared["time"]
-    columns = {time["column"]: run.t_s / UNITS[time["unit"]][1] - time.get("offset", 0.0)}
+    columns = {time["column"]: run.t_s / units.factor(time["unit"], "s") - time.get("offset", 0.0)}
     for name, c in declared["columns"].items():
-        columns[name] = run.signals[c["channel"]] / (c.get("sign", 1) * UNITS[c["unit"]][1]) - c.get("offset", 0.0)
+        factor = units.factor(c["unit"], run.units[c["channel"]])
+        columns[name] = run.signals[c["channel"]] / (c.get("sign", 1) * factor) - c.get("offset", 0.0)
     np.savetxt(path, np.column_stack(list(columns.values())), delimiter=",", fmt="%.9g", header=",".join(columns),
                comments="")
 

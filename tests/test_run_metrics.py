@@ -1,7 +1,7 @@
 """K&C metrics of a recorded run (vsim_analysis/run_metrics.py): agreement with `vsim kc`, exact recovery
 of a known slope, loop width and area from synthetic signals, and the run summary.
 
-Agreement with `vsim kc`: one short run per K&C test (amplitude and rate of vehicle.simulation.kc.TESTS, two
+Agreement with `vsim kc`: one short run per K&C test (amplitude and rate of vehicle.scenarios.kc_tests.TESTS, two
 cycles, durations × 0.5, so twice kc's rate) against kc_metrics on the same car. The bushings see
 another history (linear settling, a first cycle, the doubled rate), which moves gradients by less
 than 1 % (measured); the test allows 2 % (plus 2e-4 in the metric's unit for values near 0). Loop
@@ -17,23 +17,20 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from vsim_core.errors import InputError
-from vehicle.simulation import kc
-from vehicle.model.definition import DEFAULT_VEHICLE, load_vehicle
-from vsim_recordings.run_reader import Run, load_run
-from vsim_recordings.run_writer import RunMetadata, SignalSpec
+from vehicle.model.vehicle_file import load_vehicle
+from vehicle.scenarios.channels import CORNER_TAGS
+from vehicle.scenarios.scenario_file import load_scenario
+from vehicle.simulation.kc_triangles import design_contact_base
 from vehicle.simulation.rig import KCRig
-from vsim_cli.run import summary
-from vsim_analysis.run_metrics import (
-    BUMP_WINDOW_M,
-    case_loop,
-    case_metrics,
-    cases,
-    contact_base_m,
-    run_metrics,
-)
-from vehicle.simulation.runner import run_scenario
-from vehicle.scenarios.scenario_file import CORNER_TAGS, load_scenario
+from vsim_analysis.kc_metrics import BUMP_WINDOW_M
+from vsim_analysis.kc_test import kc_metrics
+from vsim_analysis.run_metrics import case_loop, case_metrics, cases, contact_base_m, run_metrics
+from vsim_core.errors import InputError
+from vsim_core.shipped import DEFAULT_VEHICLE
+from vsim_presentation.run_summary import summary
+from vsim_recordings.recorder import run_scenario
+from vsim_recordings.run_format import Run, RunMetadata, SignalSpec
+from vsim_recordings.run_reader import load_run
 
 SCALE = 0.5        #: duration scale of the short runs
 TOLERANCE = 0.02   #: relative agreement of gradients with `vsim kc`
@@ -54,7 +51,7 @@ def kc_rig() -> KCRig:
 
 @pytest.fixture(scope="module")
 def kc_values(kc_rig: KCRig) -> dict[str, dict[str, float]]:
-    return kc.kc_metrics(kc_rig)
+    return kc_metrics(kc_rig)
 
 
 @pytest.fixture(scope="module")
@@ -91,7 +88,7 @@ def test_recorded_run_gives_the_kc_metrics_of_vsim_kc(runs, kc_values, kind: str
 
 def test_contact_base_from_the_recording_is_the_one_of_vsim_kc(runs, kc_rig) -> None:
     base = contact_base_m(runs["roll"])
-    for axle, expected in kc._design_contact_base(kc_rig).items():
+    for axle, expected in design_contact_base(kc_rig).items():
         assert base[axle] == pytest.approx(expected, abs=1e-9)
 
 

@@ -10,13 +10,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from vsim_core.errors import InputError
+from vehicle.scenarios.channels import INPUT_CHANNELS
+from vehicle.scenarios.scenario_file import load_scenario
+from vehicle.simulation.runner import DivergenceError
 from vsim_cli import main as cli
+from vsim_core.errors import InputError
+from vsim_presentation.run_summary import summary
+from vsim_recordings.recorder import run_scenario
+from vsim_recordings.run_format import PARTIAL_SUFFIX
 from vsim_recordings.run_reader import load_run
-from vsim_recordings.run_writer import PARTIAL_SUFFIX
-from vsim_cli.run import summary
-from vehicle.simulation.runner import DivergenceError, run_scenario
-from vehicle.scenarios.scenario_file import INPUT_CHANNELS, load_scenario
 
 SCENARIO_DIR = Path(__file__).resolve().parent.parent / "scenarios"
 QUICK = 0.05   #: duration scale of the shortened default scenarios

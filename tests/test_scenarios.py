@@ -10,10 +10,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from vehicle.model.definition import CORNERS
+from vehicle.scenarios.channels import CORNER_TAGS, INPUT_CHANNELS, csv_columns
+from vehicle.scenarios.scenario_file import load_scenario, parse_scenario
 from vsim_core.errors import InputError
-from vehicle.model.builder import CORNERS
-from vehicle.model.definition import DEFAULT_VEHICLE
-from vehicle.scenarios.scenario_file import CORNER_TAGS, INPUT_CHANNELS, csv_columns, load_scenario
+from vsim_core.shipped import DEFAULT_VEHICLE
 
 SCENARIO_DIR = Path(__file__).resolve().parent.parent / "scenarios"
 DEFAULT_SET = ("pumping", "roll", "lateral_force", "pumping_speeds", "rack_step", "double_rack_step_same",
@@ -39,6 +40,20 @@ def test_every_default_scenario_validates(name: str) -> None:
         u = case.inputs(np.linspace(0.0, case.duration_s, 50))
         assert u.shape == (50, len(INPUT_CHANNELS)) and np.all(np.isfinite(u))
         np.testing.assert_array_equal(u[0], 0.0)  # every input starts from rest
+
+
+def test_a_scenario_parses_from_text_as_if_read_from_its_path(tmp_path: Path) -> None:
+    """parse_scenario needs no file: text held in memory (a recording's, an inline one) reads as the
+    file it stands for, its relative paths from that file's folder."""
+    path = SCENARIO_DIR / "pumping.yaml"
+    from_file, from_text = load_scenario(path), parse_scenario(path.read_text(), path)
+    assert from_text == from_file
+    text = "type: rack_step\nvehicle: car.yaml\ncases: [{rack_mm: 5, hold_s: 2}]\n"
+    (tmp_path / "car.yaml").write_text(DEFAULT_VEHICLE.read_text())
+    s = parse_scenario(text, tmp_path / "step.yaml", source="inline")
+    assert (s.name, s.vehicle, s.path) == ("step", tmp_path / "car.yaml", tmp_path / "step.yaml")
+    with pytest.raises(InputError, match=r"^inline:3: cases\[0\]\.rack_mm: expected a non-zero number, got 0$"):
+        parse_scenario(text.replace("rack_mm: 5", "rack_mm: 0"), tmp_path / "step.yaml", source="inline")
 
 
 def test_default_set_matches_the_thesis_programme() -> None:

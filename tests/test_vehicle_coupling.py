@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 from bushings import to_si
-from vehicle.model.builder import Channel, joint_stiffness
+from vehicle.model.elements import Channel, joint_stiffness
 from vehicle.simulation.coupling import BushingForces
 
 M_NS, K, TAN_D, R_UNB, M_UNB = 45.0, 4.93e6, 0.15, 0.2, 0.01
@@ -84,8 +84,9 @@ def test_tendon_damper_intercept_acts_through_the_tendon_jacobian():
     qfrc_applied through MuJoCo's sparse tendon Jacobian."""
     import dataclasses
 
-    from vehicle.model.builder import BuildOptions
-    from vehicle.model.definition import Curve, Damper, load_vehicle
+    from vehicle.model.definition import Curve, Damper
+    from vehicle.model.elements import BuildOptions
+    from vehicle.model.vehicle_file import load_vehicle
     from vehicle.simulation.rig import KCRig
 
     v = load_vehicle()

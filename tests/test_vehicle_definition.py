@@ -10,10 +10,11 @@ import pytest
 import yaml
 
 from bushings import load_parameter_set
-from vsim_core.errors import InputError
-from vehicle.model.builder import mirror_axes
-from vehicle.model.definition import DEFAULT_VEHICLE, load_vehicle
+from vehicle.model.geometry import mirror_axes
 from vehicle.model.statics import axle_loads, resolve_preloads
+from vehicle.model.vehicle_file import load_vehicle
+from vsim_core.errors import InputError
+from vsim_core.shipped import DEFAULT_VEHICLE
 
 
 def test_default_car_is_plausible():

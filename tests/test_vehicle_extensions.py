@@ -15,15 +15,20 @@ import numpy as np
 import pytest
 
 from bushings import BushingBank, load_parameter_set
-from bushings.effects import NO_EFFECTS, ExtendedBank
-from vsim_core.errors import InputError
+from bushings.effects import NO_EFFECTS
+from bushings.extended_bank import ExtendedBank
 from tests.test_vehicle_definition import _write
-from vehicle.model.builder import BuildOptions
-from vehicle.model.definition import VehicleDefinition, load_vehicle, with_extensions
-from vehicle.simulation.kc import (TEST, Branches, _design_contact_base, centre_slope, fit_window, loop_width, rig_leg,
-                        run_triangle, triangle_metrics)
+from vehicle.model.definition import VehicleDefinition
+from vehicle.model.elements import BuildOptions
 from vehicle.model.kinematics import front_corner
+from vehicle.model.vehicle_file import load_vehicle, with_extensions
+from vehicle.scenarios.kc_tests import TEST
+from vehicle.simulation.kc_triangles import design_contact_base, run_triangle
 from vehicle.simulation.rig import KCRig
+from vsim_analysis.kc_metrics import fit_window, triangle_metrics
+from vsim_analysis.kc_test import rig_leg
+from vsim_analysis.loops import Branches, centre_slope, loop_width
+from vsim_core.errors import InputError
 
 LINEAR = BuildOptions(bushing_model="linear")
 
@@ -165,7 +170,7 @@ def test_strut_friction_widens_the_pad_force_loop_by_twice_the_mapped_friction(v
 def _rear_roll(v: VehicleDefinition) -> tuple[float, float, float]:
     """(roll stiffness [N·m/deg] of the rear axle at the pads, roll steer, roll camber [deg/deg])."""
     rig = KCRig(v, LINEAR)
-    base = _design_contact_base(rig)["rear"]
+    base = design_contact_base(rig)["rear"]
     samples = run_triangle(rig, TEST["roll"])
     down, up = (rig_leg(s) for s in samples)
     window = fit_window("roll", TEST["roll"].amplitude, base)

@@ -1,6 +1,6 @@
 """STVS camber loops in pumping (issue 3): non-zero width that changes with speed; none when linear.
 
-Pumping triangle 0 → +60 → −60 → +60 mm (vehicle.simulation.kc.run_triangle) at 1.5 and 15 mm/s and at
+Pumping triangle 0 → +60 → −60 → +60 mm (vehicle.simulation.kc_triangles.run_triangle) at 1.5 and 15 mm/s and at
 0.1 Hz (24 mm/s), the loop width taken at design height. The strut dampers are removed: their
 viscous loop (1.3e-3 deg measured at 15 mm/s) is wider than the change the bushings' rate
 dependence makes (4e-4 deg at the front) and would hide it. h = 5 ms: quasi-static, and the
@@ -14,10 +14,14 @@ import math
 
 import pytest
 
-from vehicle.model.builder import BuildOptions
-from vehicle.model.definition import Curve, Damper, load_vehicle
-from vehicle.simulation.kc import Triangle, branches, loop_width, run_triangle
+from vehicle.model.definition import Curve, Damper
+from vehicle.model.elements import BuildOptions
+from vehicle.model.vehicle_file import load_vehicle
+from vehicle.scenarios.kc_tests import Triangle
+from vehicle.simulation.kc_triangles import run_triangle
 from vehicle.simulation.rig import KCRig
+from vsim_analysis.kc_test import branches
+from vsim_analysis.loops import loop_width
 
 H = 5e-3
 AMPLITUDE = 0.06

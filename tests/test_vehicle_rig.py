@@ -8,11 +8,12 @@ import math
 import numpy as np
 import pytest
 
-from vehicle.model.builder import CORNERS, BuildOptions
-from vehicle.model.definition import load_vehicle
+from vehicle.model.definition import CORNERS
+from vehicle.model.elements import BuildOptions
 from vehicle.model.kinematics import front_corner, rear_heave
-from vehicle.simulation.rig import KCRig
 from vehicle.model.statics import axle_loads
+from vehicle.model.vehicle_file import load_vehicle
+from vehicle.simulation.rig import KCRig
 
 
 @pytest.fixture(scope="module")

@@ -5,7 +5,7 @@ Prints the model error it makes in excess of the noise: the RMS over every compa
 sample of the change, each channel's mean per recording removed (the diagnosis takes it for a zero
 error), in units of the channel's noise (the virtual rig's defaults). A baseline held-out error of
 √(1 + excess²) is what the diagnosis must explain; it names nothing below 1.11 (excess 0.48).
-``vsim_diagnosis.kc_causes.OBSERVABLE`` lists the places whose excess is at least
+``vsim_diagnosis.kc_catalogue.OBSERVABLE`` lists the places whose excess is at least
 ``kc_catalogue.MIN_EXCESS`` at the test campaign's speed (``--duration-scale 0.25``).
 
     python tools/kc_observability.py [--vehicle V.yaml] [--duration-scale S] [--json]
@@ -25,13 +25,15 @@ from pathlib import Path
 
 import numpy as np
 
-from vehicle.model.definition import DEFAULT_VEHICLE, VehicleDefinition, load_vehicle
-from vsim_diagnosis.kc_causes import (BUSHING_CAUSES, MIN_EXCESS, VEHICLE_CAUSES, Hypothesis, extended_vehicle,
-                                            locations, parameters)
+from vehicle.model.definition import VehicleDefinition
+from vehicle.model.vehicle_file import load_vehicle
+from vehicle.scenarios.scenario_file import load_scenario
+from vsim_core.shipped import DEFAULT_VEHICLE
+from vsim_diagnosis.kc_catalogue import (BUSHING_CAUSES, MIN_EXCESS, VEHICLE_CAUSES, Hypothesis, extended_vehicle,
+                                         locations, parameters)
 from vsim_diagnosis.kc_diagnosis import COMPARED, _nominal
 from vsim_diagnosis.virtual_kc_rig import DEFAULT_SCENARIOS, MEASUREMENT_DEFAULTS, sensor
-from vehicle.simulation.runner import simulate
-from vehicle.scenarios.scenario_file import load_scenario
+from vsim_recordings.recorder import simulate
 
 
 def weak(cause: str) -> list[dict[str, float]]:

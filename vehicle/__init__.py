@@ -1,1 +1,1 @@
-"""The MuJoCo car, its K&C rig, scenarios, recordings, comparison with measured data and diagnosis."""
+"""The MuJoCo car and how it is mounted: its model, what it is made to do, and its simulation."""

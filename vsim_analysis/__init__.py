@@ -1,1 +1,1 @@
-"""Metrics of recorded runs (K&C gradients, loops, relaxation, dynamic stiffness) and their comparison."""
+"""Metrics of runs and rig samples (K&C gradients, loops, relaxation, dynamic stiffness), comparison, `vsim kc`."""

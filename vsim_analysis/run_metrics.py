@@ -1,18 +1,18 @@
-"""Metrics of a recorded run (:class:`vsim_recordings.run_reader.Run`, simulated or measured), shared by the run
-summary (`vsim run`), `vsim compare` and the diagnosis.
+"""Metrics of a recorded run (:class:`vsim_recordings.run_format.Run`, simulated or measured), shared
+by the run summary (`vsim run`), `vsim compare` and the diagnosis.
 
 Signals stay in their recorded units (mm, deg, N, N·m; time in s) unless a name says SI. Loops are
 read on a case's last cycle, split into an unloading (down) and a loading (up) branch at the
-extremes of the input driving them, with :mod:`vehicle.simulation.kc`'s definitions: the centre line is the
-mean of the branches, the gradient its least-squares slope around design (zero input), the loop
-width the difference between the branches at design and its largest value over the fit window.
-The functions of arrays (:func:`gradient`, :func:`loop_width`, :func:`loop_area`, :func:`rms_error`,
-:func:`relaxation_amplitude`, :func:`dynamic_stiffness`) know nothing of runs.
+extremes of the input driving them, with the definitions of :mod:`vsim_analysis.loops`: the centre
+line is the mean of the branches, the gradient its least-squares slope around design (zero input),
+the loop width the difference between the branches at design and its largest value over the fit
+window.
 
-The named K&C metrics (:data:`vehicle.simulation.kc.METRICS`) of a case come from :func:`vehicle.simulation.kc.triangle_metrics`
-fed with the recorded signals, so a run and `vsim kc` share one definition; they differ only in
-the history the run gives the bushings (settling, earlier cycles) and in the fit window, which
-here follows the case's amplitude (±80 %, and at most ±20 mm in bump).
+The named K&C metrics (:data:`vsim_analysis.kc_metrics.METRICS`) of a case come from
+:func:`vsim_analysis.kc_metrics.triangle_metrics` fed with the recorded signals, so a run and
+`vsim kc` share one definition; they differ only in the history the run gives the bushings
+(settling, earlier cycles) and in the fit window, which here follows the case's amplitude (±80 %,
+and at most ±20 mm in bump).
 """
 
 from __future__ import annotations
@@ -22,29 +22,17 @@ from dataclasses import dataclass
 from typing import Any, Mapping
 
 import numpy as np
-import yaml
 
+from vehicle.scenarios.channels import CORNER_TAGS
+from vehicle.scenarios.scenario import SIGNAL_TYPES
+from vsim_analysis.kc_metrics import BUMP_WINDOW_M, FIT_FRACTION, Leg, bump_loop_widths, fit_window, triangle_metrics
+from vsim_analysis.loops import (Branches, centre_slope, common_range, dynamic_stiffness, loop_area, loop_width,
+                                 relaxation_amplitude)
+from vsim_core import units
+from vsim_core.documents import Document
 from vsim_core.errors import InputError
-from bushings.frequency import harmonic_ratio
-from vsim_recordings.run_reader import Run
-from vehicle.simulation.kc import (
-    FIT_FRACTION,
-    TEST,
-    Branches,
-    Leg,
-    bump_loop_widths,
-    centre_slope,
-    fit_window,
-    loop_width,
-    triangle_metrics,
-)
-from vehicle.scenarios.scenario_file import CORNER_TAGS, SIGNAL_TYPES
+from vsim_recordings.run_format import Run
 
-#: Recorded unit → SI factor.
-SI_PER_UNIT = {"mm": 1e-3, "deg": math.pi / 180.0, "N": 1.0, "N·m": 1.0}
-#: Gradients against wheel travel or pad height over at most ±20 mm around design (spec §4), the
-#: window of `vsim kc`'s bump test [m].
-BUMP_WINDOW_M = fit_window("bump", TEST["bump"].amplitude, math.nan)
 #: The `vsim kc` test that each scenario type (or bi-sine input) plays.
 KC_TESTS = {"pumping": "bump", "roll": "roll", "lateral_force": "lateral", "longitudinal_force": "longitudinal",
             "aligning_torque": "aligning"}
@@ -55,54 +43,6 @@ STIFFNESS_PAIRS = {"pad_z": ("pad_fz", "pad_height"), "pad_fy": ("pad_fy", "whee
 #: A thousand of each x unit, for gradients: per m of travel, per kN, per kN·m.
 _THOUSAND = {"mm": "m", "N": "kN", "N·m": "kN·m"}
 _EPS_S = 1e-9   #: times closer than this are the same instant (the recording's 1 ns stamps)
-
-#: Centre-line slope of :class:`Branches` over ±window (:func:`vehicle.simulation.kc.centre_slope`) [y unit / x unit].
-gradient = centre_slope
-
-
-# -- metrics of arrays -------------------------------------------------------------------------------
-def loop_area(x: np.ndarray, y: np.ndarray) -> float:
-    """∮ y dx over the closed polygon of the samples (last joined to first) [y unit · x unit].
-
-    Positive for a loop run clockwise in the (x, y) plane, where y leads x: for a force against
-    its displacement, the energy dissipated per cycle.
-    """
-    xc, yc = np.append(x, x[:1]), np.append(y, y[:1])
-    return float(np.sum(0.5 * (yc[1:] + yc[:-1]) * np.diff(xc)))
-
-
-def rms_error(a: np.ndarray, b: np.ndarray) -> float:
-    """Root-mean-square of ``a − b`` over samples on the same time base [their unit]."""
-    return float(np.sqrt(np.mean((np.asarray(a) - np.asarray(b)) ** 2)))
-
-
-def relaxation_amplitude(t_s: np.ndarray, y: np.ndarray, hold_from_s: float) -> float:
-    """y(last sample) − y(first sample at or after ``hold_from_s`` [s]) [y unit]: how far y moves
-    while its input is held, e.g. the toe drift after a rack step as the bushings relax."""
-    held = y[t_s >= hold_from_s - _EPS_S]
-    return float(held[-1] - held[0])
-
-
-def dynamic_stiffness(t_s: np.ndarray, force: np.ndarray, displacement: np.ndarray, frequency_hz: float) -> complex:
-    """First-harmonic ratio K* = F1/X1 over the last period (ending at the last sample) of a
-    sine at ``frequency_hz`` [force unit / displacement unit, complex; |K*| the dynamic stiffness,
-    Im/Re the loss factor tan δ]. The signals are resampled linearly onto a uniform grid of that
-    period (the same filter on both, so their ratio keeps); ValueError if they span less than one.
-    """
-    period = 1.0 / frequency_hz
-    step = float(np.median(np.diff(t_s)))
-    start = t_s[-1] - period
-    if start < t_s[0] - 0.5 * step:
-        raise ValueError(f"{t_s[-1] - t_s[0]:.6g} s of samples; a first harmonic at {frequency_hz:g} Hz needs "
-                         f"one period, {period:.6g} s")
-    n = max(16, int(round(period / step)))
-    grid = start + period * np.arange(n) / n
-    return complex(harmonic_ratio(np.interp(grid, t_s, displacement), np.interp(grid, t_s, force), n))
-
-
-def common_range(b: Branches) -> float:
-    """Half-width of the x range that both branches cover on each side of 0 [x unit]."""
-    return float(min(b.x_down.max(), b.x_up.max(), -b.x_down.min(), -b.x_up.min()))
 
 
 def gradient_unit(y_unit: str, x_unit: str) -> tuple[float, str]:
@@ -188,9 +128,9 @@ def case_loop(run: Run, case: Mapping[str, Any], x: str, y: str, driver: str) ->
     if not reach > 0:
         return None
     window = FIT_FRACTION * reach
-    cap = BUMP_WINDOW_M / SI_PER_UNIT[run.units[x]] if x.startswith("wheel_travel") else math.inf
+    cap = BUMP_WINDOW_M / units.si(run.units[x]) if x.startswith("wheel_travel") else math.inf
     last = case_mask(run, case, last_cycle=True)
-    return Loop(gradient(b, min(window, cap)), *loop_width(b, window),
+    return Loop(centre_slope(b, min(window, cap)), *loop_width(b, window),
                 loop_area(run.signals[x][last], run.signals[y][last]), min(window, cap))
 
 
@@ -229,31 +169,31 @@ def contact_base_m(run: Run) -> dict[str, float]:
     the design pose first) and the tyre radius of the run's vehicle: contact = centre − r × the
     wheel plane's up direction. InputError for a run without a vehicle (a rig recording)."""
     try:
-        radius = float(yaml.safe_load(run.metadata.vehicle_yaml)["tyre"]["radius"])
-    except (yaml.YAMLError, TypeError, KeyError, ValueError) as exc:
+        radius = float(Document(run.metadata.vehicle_yaml, str(run.path)).data["tyre"]["radius"])
+    except (TypeError, KeyError, ValueError) as exc:  # an InputError (not YAML) is a ValueError
         raise InputError("roll metrics need the design contact-point base, from the tyre radius of the run's "
                          "vehicle, and this run has none (pass contact_base)", source=str(run.path)) from exc
     out = {}
     for axle in ("front", "rear"):
         left, right = (CORNER_TAGS[f"{axle}_{side}"] for side in ("left", "right"))
-        offset = [radius * math.cos(run.signals[f"toe_{t}"][0] * SI_PER_UNIT["deg"])
-                  * math.sin(run.signals[f"camber_{t}"][0] * SI_PER_UNIT["deg"]) for t in (left, right)]
-        centres = [run.signals[f"wheel_centre_y_{t}"][0] * SI_PER_UNIT["mm"] for t in (left, right)]
+        offset = [radius * math.cos(run.signals[f"toe_{t}"][0] * units.DEG)
+                  * math.sin(run.signals[f"camber_{t}"][0] * units.DEG) for t in (left, right)]
+        centres = [run.signals[f"wheel_centre_y_{t}"][0] * units.MM for t in (left, right)]
         out[axle] = centres[0] - centres[1] - offset[0] - offset[1]
     return out
 
 
 def _leg(run: Run, mask: np.ndarray) -> Leg:
-    """The :data:`vehicle.simulation.kc.Leg` of the recorded samples ``mask``, in SI."""
+    """The :data:`vsim_analysis.kc_metrics.Leg` of the recorded samples ``mask``, in SI."""
     def signal(quantity: str, corner: str) -> np.ndarray:
         name = f"{quantity}_{CORNER_TAGS[corner]}"
-        return run.signals[name][mask] * SI_PER_UNIT[run.units[name]]
+        return run.signals[name][mask] * units.si(run.units[name])
     return signal
 
 
 def case_metrics(run: Run, case: Mapping[str, Any],
                  contact_base: Mapping[str, float] | None = None) -> dict[str, dict[str, float]]:
-    """The named K&C metrics (keys, units and signs of :data:`vehicle.simulation.kc.METRICS`) that ``case``
+    """The named K&C metrics (keys, units and signs of :data:`vsim_analysis.kc_metrics.METRICS`) that ``case``
     gives per axle of the run: pumping → bump steer and camber and the toe and camber loop
     widths; roll → roll steer and camber per degree of body roll; lateral force → its three
     compliances; longitudinal force, aligning torque → their compliance steer. Empty for inputs
@@ -275,7 +215,7 @@ def case_metrics(run: Run, case: Mapping[str, Any],
             contact_base = contact_base_m(run)
         down, up = (_leg(run, m) for m in legs)
         base = contact_base[axle] if test == "roll" else math.nan
-        amplitude = float(np.abs(run.signals[driver][legs[0] | legs[1]]).max()) * SI_PER_UNIT[run.units[driver]]
+        amplitude = float(np.abs(run.signals[driver][legs[0] | legs[1]]).max()) * units.si(run.units[driver])
         window = fit_window(test, amplitude, base)
         if test == "bump":
             window = min(window, BUMP_WINDOW_M)

@@ -7,7 +7,8 @@ from pathlib import Path
 
 
 def _compare(args: argparse.Namespace) -> int:
-    from vsim_analysis.compare import compare_runs, format_table, write_outputs
+    from vsim_analysis.compare import compare_runs
+    from vsim_presentation.comparison_report import format_table, write_outputs
     from vsim_recordings.run_reader import load_run
 
     sim, rig = load_run(args.sim), load_run(args.rig)

@@ -11,7 +11,7 @@ from vsim_core.errors import InputError
 
 
 def _diagnose(args: argparse.Namespace) -> int:
-    from vsim_recordings.bench_dataset import dataset_level
+    from vsim_recordings.datasets import dataset_level
 
     level = dataset_level(args.rigdir)
     quiet = args.json
@@ -36,10 +36,10 @@ def _diagnose(args: argparse.Namespace) -> int:
 
 
 def _bench(args: argparse.Namespace, progress):
-    from bushings.parameters import load_parameter_set
-    from vsim_recordings.bench_dataset import read_bench_dataset
+    from bushings.parameter_sets import load_parameter_set
     from vsim_diagnosis.bench_diagnosis import diagnose_bench
     from vsim_presentation.bench_report import summary, verdict_sentence, write_report
+    from vsim_recordings.bench_dataset import read_bench_dataset
 
     result = diagnose_bench(read_bench_dataset(args.rigdir), load_parameter_set(args.bushing_model), progress=progress)
     written = write_report(result, args.output) if args.output is not None else []
@@ -47,10 +47,11 @@ def _bench(args: argparse.Namespace, progress):
 
 
 def _kc(args: argparse.Namespace, progress):
-    from vehicle.model.definition import DEFAULT_VEHICLE, load_vehicle
-    from vsim_recordings.kc_dataset import read_kc_dataset
+    from vehicle.model.vehicle_file import load_vehicle
+    from vsim_core.shipped import DEFAULT_VEHICLE
     from vsim_diagnosis.kc_diagnosis import diagnose_kc
     from vsim_presentation.kc_report import summary, verdict_sentence, write_report
+    from vsim_recordings.kc_dataset import read_kc_dataset
 
     vehicle = load_vehicle(args.vehicle or DEFAULT_VEHICLE)
     result = diagnose_kc(read_kc_dataset(args.rigdir), vehicle, progress=progress)

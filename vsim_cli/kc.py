@@ -5,23 +5,27 @@ from __future__ import annotations
 import argparse
 import json
 
-from vehicle.model.builder import BuildOptions
-from vehicle.model.definition import DEFAULT_VEHICLE, load_vehicle
-from vehicle.simulation.kc import format_table, vehicle_kc
-from vsim_cli.model import BUSHING_MODELS
+from vehicle.model.definition import BUSHING_MODELS
+from vsim_core.shipped import DEFAULT_VEHICLE
 
 
 def _kc(args: argparse.Namespace) -> int:
-    metrics = vehicle_kc(load_vehicle(args.vehicle), BuildOptions(bushing_model=args.bushings))
+    from vehicle.model.elements import BuildOptions
+    from vehicle.model.vehicle_file import load_vehicle
+    from vsim_analysis import kc_test
+    from vsim_presentation.kc_table import format_table
+
+    metrics = kc_test.vehicle_kc(load_vehicle(args.vehicle), BuildOptions(bushing_model=args.bushings))
     print(json.dumps(metrics, indent=2) if args.json else format_table(metrics))
     return 0
 
 
-def register(subparsers) -> None:
+def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``kc``."""
     kc = subparsers.add_parser("kc", help="K&C metrics of a vehicle on the virtual rig (spec §4)",
                                description="Runs bump, roll, lateral-force, longitudinal-force and "
-                                           "aligning-torque triangles on both axles (vehicle/simulation/kc.py).")
+                                           "aligning-torque triangles on both axles (vehicle/scenarios/kc_tests.py; "
+                                           "metrics: vsim_analysis/kc_metrics.py).")
     kc.add_argument("--vehicle", default=str(DEFAULT_VEHICLE), help="vehicle YAML file (default: %(default)s)")
     kc.add_argument("--bushings", choices=BUSHING_MODELS, default=None,
                     help="put this model on every bushing direction (models/vehicles/README.md)")

@@ -1,36 +1,46 @@
-"""`vsim`: the command-line entry point.
+"""`vsim`: the command-line entry point: the parser of every command, and input errors as one line.
 
-Each command group lives in its own module exposing ``register(subparsers)``; the module adds its
-sub-command with ``set_defaults(func=...)`` where ``func(args) -> int`` is the exit code.
+Each command lives in its own module exposing ``register(subparsers)``, which adds the command with
+``set_defaults(func=...)`` where ``func(args) -> int`` is the exit code. Commands import what they
+run when they run, so that ``vsim --help`` loads neither MuJoCo nor matplotlib.
 """
 
 from __future__ import annotations
 
 import argparse
-import importlib
 import sys
+from types import ModuleType
 
+from vsim_cli import (bushing_fit, bushing_run, compare, diagnose, kc, model_export, plot, rig_import, rig_measure, run,
+                      view)
 from vsim_core.errors import InputError
 
-#: Modules that register sub-commands, in the order they appear in ``vsim --help``.
-COMMAND_MODULES = (
-    "vsim_cli.bushing",
-    "vsim_cli.view",
-    "vsim_cli.model",
-    "vsim_cli.kc",
-    "vsim_cli.run",
-    "vsim_cli.diagnose",
-    "vsim_cli.rig",
-    "vsim_cli.compare",
-)
+#: Command groups: name -> (help, description, their commands' modules).
+GROUPS: dict[str, tuple[str, str, tuple[ModuleType, ...]]] = {
+    "bushing": ("virtual bushing bench and identification",
+                "Rubber-bushing models (STS, RT, STVS, ...) on a virtual bench.", (bushing_run, bushing_fit)),
+    "model": ("vehicle models", "Vehicle models.", (model_export,)),
+    "rig": ("measured data: import a K&C rig's CSV export, or measure on the virtual rig",
+            "Measured K&C rig data (data/README.md).", (rig_import, rig_measure)),
+}
+#: Commands and groups in the order of ``vsim --help``.
+ORDER: tuple[ModuleType | str, ...] = ("bushing", view, plot, "model", kc, run, diagnose, "rig", compare)
 
 
 def build_parser() -> argparse.ArgumentParser:
-    """The full ``vsim`` argument parser with every registered command group."""
-    parser = argparse.ArgumentParser(prog="vsim", description=__doc__.splitlines()[0])
+    """The full ``vsim`` argument parser with every command."""
+    parser = argparse.ArgumentParser(prog="vsim", description="Full-vehicle transient simulation with hysteretic, "
+                                                              "viscoelastic rubber bushings.")
     sub = parser.add_subparsers(dest="command", required=True)
-    for name in COMMAND_MODULES:
-        importlib.import_module(name).register(sub)
+    for entry in ORDER:
+        if isinstance(entry, str):
+            help_, description, modules = GROUPS[entry]
+            group = sub.add_parser(entry, help=help_, description=description)
+            commands = group.add_subparsers(dest=f"{entry}_command", required=True)
+            for module in modules:
+                module.register(commands)
+        else:
+            entry.register(sub)
     return parser
 
 

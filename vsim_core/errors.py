@@ -1,12 +1,7 @@
-"""Errors raised on bad user input: they name the file, the key, the value and what was expected;
-and reading a user's YAML file with such errors."""
+"""The one exception type for bad user input: it names the file (and line), the key, the value and
+what was expected."""
 
 from __future__ import annotations
-
-from pathlib import Path
-from typing import Any
-
-import yaml
 
 
 class InputError(ValueError):
@@ -18,18 +13,8 @@ class InputError(ValueError):
         self.source = source
         self.key = key
 
-
-def read_yaml(path: Path, missing: str) -> Any:
-    """The parsed content of a user's YAML file; InputError naming the file when it does not exist
-    (with the message ``missing``) or is not valid YAML."""
-    if not path.is_file():
-        raise InputError(missing, source=str(path))
-    return parse_yaml(path.read_text(), str(path))
-
-
-def parse_yaml(text: str, source: str) -> Any:
-    """The parsed YAML ``text``; InputError naming ``source`` when it is not valid YAML."""
-    try:
-        return yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        raise InputError(f"not valid YAML: {exc}", source=source) from exc
+    @property
+    def bare(self) -> str:
+        """The message without its ``source: key:`` prefix."""
+        where = ": ".join(part for part in (self.source, self.key) if part)
+        return str(self).removeprefix(f"{where}: ") if where else str(self)

@@ -21,18 +21,12 @@ from typing import Callable, Sequence
 import numpy as np
 from scipy.optimize import least_squares
 
-from bushings.effects import ExtendedBank
-from bushings.parameters import ParameterSet
+from bushings.extended_bank import ExtendedBank
+from bushings.parameter_sets import ParameterSet
+from vsim_diagnosis.catalogue import Cause, applicable
+from vsim_diagnosis.verdict import Outcome, decide, split
 from vsim_recordings.bench_dataset import BenchDataset
-from vsim_diagnosis.causes import Cause, applicable
 
-#: Relative held-out error reduction below which a cause explains nothing significant.
-MIN_GAIN = 0.10
-#: A cause is named when the mismatch beyond noise it leaves on held-out tests is at most this
-#: fraction of the baseline's (i.e. it explains at least 1 − 0.35² ≈ 88 % of the excess variance).
-MAX_EXCESS_LEFT = 0.35
-#: A baseline whose held-out error is within this factor of the noise floor fits the data.
-NOISE_FACTOR = 1.5
 #: Penalty per fitted parameter on the held-out error used for ranking.
 PARAMETER_PENALTY = 0.02
 #: Longest step used to simulate a rest between tests [s].
@@ -135,7 +129,7 @@ class Candidate:
 
 
 @dataclass
-class BenchDiagnosis:
+class BenchDiagnosis(Outcome):
     """The outcome: a cause (or none, or unexplained) with its evidence."""
 
     verdict: str                        #: a catalogue id, "none" or "unexplained"
@@ -150,16 +144,13 @@ class BenchDiagnosis:
     wall_s: float = 0.0
 
     @property
-    def named(self) -> bool:
-        """True when a catalogue cause is named (then ``best`` is it, refitted on every test)."""
-        return self.verdict not in ("none", "unexplained")
-
-    @property
     def heldout_error_before(self) -> float:
+        """The baseline's relative RMS error on the held-out tests."""
         return aggregate(self.baseline_errors, self.heldout)
 
     @property
     def heldout_error_after(self) -> float:
+        """The held-out error with the best cause (the baseline's when nothing is missing)."""
         return self.best.heldout_error if self.best is not None and self.verdict != "none" else self.heldout_error_before
 
 
@@ -246,11 +237,6 @@ def fit_cause(replay: Replay, base: ParameterSet, cause: Cause, train: np.ndarra
     return values, std
 
 
-def split(n_records: int) -> np.ndarray:
-    """Held-out records: every other one, starting with the second (the first is the virgin part's)."""
-    return np.arange(n_records) % 2 == 1
-
-
 def diagnose_bench(data: BenchDataset, baseline: ParameterSet,
                    progress: Callable[[str], None] | None = None) -> BenchDiagnosis:
     """Diagnose a bench dataset against a baseline parameter set (see the module docstring)."""
@@ -292,13 +278,3 @@ def diagnose_bench(data: BenchDataset, baseline: ParameterSet,
                                              f"on {data.path.name} ({len(replay.names)} bench tests)")
     return BenchDiagnosis(best.cause.id if verdict == "named" else verdict, baseline, replay, heldout,
                           base_errors, noise, ranking, best, data.part, time.perf_counter() - started)
-
-
-def decide(before: float, after: float, floor: float) -> str:
-    """``named``, ``none`` or ``unexplained`` from held-out errors before and after the best cause
-    and the noise floor (all relative RMS)."""
-    excess_before = math.sqrt(max(before ** 2 - floor ** 2, 0.0))
-    excess_after = math.sqrt(max(after ** 2 - floor ** 2, 0.0))
-    if after <= before * (1.0 - MIN_GAIN) and excess_after <= MAX_EXCESS_LEFT * excess_before:
-        return "named"
-    return "none" if before <= NOISE_FACTOR * floor else "unexplained"

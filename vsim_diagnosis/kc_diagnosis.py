@@ -6,7 +6,7 @@
    compared in units of its measurement noise, estimated from the data (sample-to-sample
    differences of the residual, which a smooth model error hardly affects); each channel's zero
    error in each recording is a nuisance, removed.
-2. Screening: every catalogue cause at every place it can sit (:mod:`vsim_diagnosis.kc_causes`)
+2. Screening: every catalogue cause at every place it can sit (:mod:`vsim_diagnosis.kc_catalogue`)
    is run once on the training tests (every other one) at mid-range magnitude (a sided cause, whose
    sign picks another effect, once per sign); its magnitude is fitted by taking the effect
    proportional to it (to its logarithm for a factor on a design value).
@@ -22,7 +22,7 @@ a constant probe force is absorbed by the stick phase, and the mapped prediction
 the rear pivot bushing came out up to 18 times too small, with the wrong sign in half of the
 channels. Full runs cost more and are right.
 
-The verdict follows :func:`vsim_diagnosis.bench_diagnosis.decide` with the noise as the floor.
+The verdict follows :func:`vsim_diagnosis.verdict.decide` with the noise as the floor.
 """
 
 from __future__ import annotations
@@ -33,19 +33,17 @@ import os
 import time
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING, Callable, Sequence
+from typing import Callable, Sequence
 
 import numpy as np
 
 from vehicle.model.definition import VehicleDefinition
-from vsim_diagnosis.bench_diagnosis import decide
-from vsim_diagnosis.kc_causes import (BUSHING_CAUSES, VEHICLE_CAUSES, Hypothesis, extended_vehicle, locations,
-                                            parameters)
-from vehicle.simulation.runner import simulate
-from vehicle.scenarios.scenario_file import Scenario
-
-if TYPE_CHECKING:
-    from vsim_recordings.kc_dataset import KCDataset
+from vehicle.scenarios.scenario import Scenario
+from vsim_diagnosis.kc_catalogue import (BUSHING_CAUSES, VEHICLE_CAUSES, Hypothesis, extended_vehicle, locations,
+                                         parameters)
+from vsim_diagnosis.verdict import Outcome, decide, split
+from vsim_recordings.kc_dataset import KCDataset
+from vsim_recordings.recorder import simulate
 
 #: Measured channel families compared (the rig inputs are imposed, not compared).
 COMPARED = ("wheel_travel", "camber", "toe", "half_track", "steer", "wheel_centre", "pad_height", "pad_fz")
@@ -93,6 +91,7 @@ class Layout:
 
     @classmethod
     def of(cls, data: KCDataset, vehicle: VehicleDefinition) -> "Layout":
+        """The compared channels of a dataset, case by case, and the baseline ``vehicle``'s run of each case."""
         first = data.tests[0].run
         channels = [n for n in first.signals if n.rsplit("_", 1)[0] in COMPARED or n.rsplit("_", 2)[0] in COMPARED]
         measured, recording, tests, start = [], [], [], 0
@@ -111,6 +110,7 @@ class Layout:
         return cls(channels, np.vstack(measured), np.concatenate(recording), test, tests)
 
     def jobs(self, vehicle: VehicleDefinition, tests: Sequence[int]) -> list[Job]:
+        """The runs of ``tests`` (indices) on ``vehicle``."""
         return [replace(self.tests[i].job, vehicle=vehicle) for i in tests]
 
     def stack(self, results: Sequence[dict[str, np.ndarray]], tests: Sequence[int]) -> np.ndarray:
@@ -142,6 +142,7 @@ class Candidate:
         return self.simulated is not None
 
     def penalised(self, error: float) -> float:
+        """``error`` raised by the parameter penalty of this hypothesis's cause."""
         return error * (1.0 + PARAMETER_PENALTY * len(parameters(self.hypothesis.cause)))
 
     @property
@@ -151,7 +152,7 @@ class Candidate:
 
 
 @dataclass
-class KCDiagnosis:
+class KCDiagnosis(Outcome):
     """The outcome of :func:`diagnose_kc`."""
 
     verdict: str                     #: a cause id, "none" or "unexplained"
@@ -168,11 +169,8 @@ class KCDiagnosis:
     wall_s: float = 0.0
 
     @property
-    def named(self) -> bool:
-        return self.verdict not in ("none", "unexplained")
-
-    @property
     def heldout_error_after(self) -> float:
+        """The held-out error with the named cause (the baseline's when none is named)."""
         return self.best.heldout_error if self.named else self.heldout_error_before
 
 
@@ -212,11 +210,6 @@ class _Scorer:
         """The RMS residual on the held-out tests (1 = the noise)."""
         r = self.residual(predicted, np.ones(len(predicted), dtype=bool))[self.held_rows]
         return float(math.sqrt(np.mean(r ** 2)))
-
-
-def split(n_tests: int) -> np.ndarray:
-    """Held-out tests: every other one, starting with the second."""
-    return np.arange(n_tests) % 2 == 1
 
 
 def _nominal(cause: str) -> dict[str, float]:

@@ -1,7 +1,7 @@
 """The virtual rig (spec measured-data §1): a truth model = a baseline + effects from the catalogue
 (or outside it) + measurement imperfections, played through the standard campaign and written in
 exactly the format of real rig data, with no trace of the truth. This module holds the bench level;
-the K&C level is :mod:`vsim_diagnosis.virtual_kc_rig`, and :func:`load_truth` reads either.
+the K&C level is :mod:`vsim_diagnosis.virtual_kc_rig`, and :mod:`vsim_diagnosis.truths` reads either.
 
 TRUTH.yaml (bench level)::
 
@@ -20,20 +20,18 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Callable, Mapping
+from typing import Any, Callable, Mapping
 
 import numpy as np
 
-from bushings.effects import ExtendedBank
-from vsim_core.errors import InputError, read_yaml
-from bushings.parameters import ParameterSet, load_parameter_set
-from bushings.bench.records import BenchRecord
 from bushings.bench.campaign import CAMPAIGN, BenchTest
+from bushings.bench.records import BenchRecord
+from bushings.extended_bank import ExtendedBank
+from bushings.parameter_sets import ParameterSet, load_parameter_set
+from vsim_core.errors import InputError
+from vsim_diagnosis.catalogue import CAUSES, Parameter
+from vsim_diagnosis.measurement import parse_measurement, quantise, truth_number
 from vsim_recordings.bench_dataset import BenchTestRecord, write_bench_dataset
-from vsim_diagnosis.causes import CAUSES, Parameter
-
-if TYPE_CHECKING:
-    from vsim_diagnosis.virtual_kc_rig import KCTruth
 
 #: Effects the virtual rig can hide that the diagnosis's catalogue does not hold (to test that an
 #: unexplained mismatch is reported as such).
@@ -83,16 +81,6 @@ def truth_model(baseline: ParameterSet, effects: list[tuple[str, dict[str, float
             model = ParameterSet(model.name, model.model, model.quantity, model.values, model.source,
                                  effects={**model.effects, cause: values[cause]})
     return model
-
-
-def truth_number(value: Any, source: str, key: str, *, lower: float = -math.inf, positive: bool = False) -> float:
-    """A finite number of a truth file, ``>= lower`` (or ``> 0`` if ``positive``); errors name file and key."""
-    ok = (not isinstance(value, bool) and isinstance(value, (int, float)) and math.isfinite(value)
-          and (value > 0.0 if positive else value >= lower))
-    if not ok:
-        expected = "> 0" if positive else f">= {lower:g}" if lower > -math.inf else ""
-        raise InputError(f"expected a finite number {expected}".rstrip() + f", got {value!r}", source=source, key=key)
-    return float(value)
 
 
 def parse_truth(data: Any, source: str, base_dir: Path | None = None) -> Truth:
@@ -147,38 +135,6 @@ def parse_truth(data: Any, source: str, base_dir: Path | None = None) -> Truth:
     truth = Truth(source, baseline, effects, measurement, seed, str(data.get("part", "bushing under test")))
     truth.model.channel()  # validate the combination now, naming this file
     return truth
-
-
-def parse_measurement(raw: Any, defaults: Mapping[str, float], source: str) -> dict[str, float]:
-    """A truth's ``measurement`` mapping over the rig's defaults: known keys, numbers >= 0."""
-    measurement = dict(defaults)
-    if raw is None:
-        return measurement
-    if not isinstance(raw, Mapping):
-        raise InputError(f"expected a mapping, got {raw!r}", source=source, key="measurement")
-    for key, value in raw.items():
-        if key not in defaults:
-            raise InputError(f"unknown key {key!r}; expected {', '.join(defaults)}", source=source,
-                             key=f"measurement.{key}")
-        measurement[key] = truth_number(value, source, f"measurement.{key}", lower=0.0)
-    return measurement
-
-
-def load_truth(path: Path) -> "Truth | KCTruth":
-    """Read and validate a truth YAML file of either level: a :class:`Truth` (``level: bench``) or a
-    :class:`vsim_diagnosis.virtual_kc_rig.KCTruth` (``level: kc``)."""
-    path = Path(path)
-    data = read_yaml(path, "no such truth file")
-    if isinstance(data, Mapping) and data.get("level") == "kc":
-        from vsim_diagnosis.virtual_kc_rig import parse_kc_truth
-
-        return parse_kc_truth(data, str(path), path.parent)
-    return parse_truth(data, str(path), path.parent)
-
-
-def quantise(x: np.ndarray, step: float) -> np.ndarray:
-    """``x`` on a sensor's resolution grid (unchanged for a zero step)."""
-    return np.round(x / step) * step if step > 0.0 else x
 
 
 def measure_bench(truth: Truth, output: Path, *, overwrite: bool = False, tests: tuple[BenchTest, ...] = CAMPAIGN,

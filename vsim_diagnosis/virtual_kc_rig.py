@@ -33,22 +33,20 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
+from vehicle.model.definition import VehicleDefinition
+from vehicle.model.vehicle_file import load_vehicle
+from vehicle.scenarios.channels import INPUT_CHANNELS
+from vehicle.scenarios.scenario import Scenario
+from vehicle.scenarios.scenario_file import load_scenario
 from vsim_core.errors import InputError
-from vsim_core.shipped import KC_SCENARIO_DIR
-from vehicle.model.definition import DEFAULT_VEHICLE, VehicleDefinition, load_vehicle
-from vsim_diagnosis.kc_causes import (
-    BUSHING_CAUSES,
-    DIRECTIONS,
-    VEHICLE_CAUSES,
-    Hypothesis,
-    extended_vehicle,
-    locations,
-    parameters,
-)
-from vsim_recordings.bench_dataset import whole_directory
+from vsim_core.files import atomic_directory
+from vsim_core.shipped import DEFAULT_VEHICLE, KC_SCENARIO_DIR
+from vsim_diagnosis.kc_catalogue import (BUSHING_CAUSES, DIRECTIONS, VEHICLE_CAUSES, Hypothesis, extended_vehicle,
+                                         locations, parameters)
+from vsim_diagnosis.measurement import parse_measurement, quantise, truth_number
 from vsim_recordings.kc_dataset import write_kc_rig_yaml
-from vsim_diagnosis.virtual_bench import parse_measurement, quantise, truth_number
-from vehicle.scenarios.scenario_file import INPUT_CHANNELS, Scenario, load_scenario
+from vsim_recordings.recorder import simulate
+from vsim_recordings.rig_recordings import measured_channels, write_rig_recording
 
 #: The K&C campaign the virtual rig plays when a truth names no scenarios, in this order.
 DEFAULT_SCENARIOS = tuple(KC_SCENARIO_DIR / f"{name}.yaml" for name in ("pumping", "roll", "lateral_force",
@@ -258,9 +256,6 @@ def measure_kc(truth: KCTruth, output: str | os.PathLike[str], *, overwrite: boo
     whole (a temporary folder renamed at the end); an existing ``output`` is refused unless
     ``overwrite``. ``progress(i, n, scenario name)`` is called before each scenario.
     """
-    from vsim_recordings.rig_recordings import measured_channels, write_rig_recording
-    from vehicle.simulation.runner import simulate
-
     root = Path(output)
     channels = measured_channels()
     m = truth.measurement
@@ -269,7 +264,7 @@ def measure_kc(truth: KCTruth, output: str | os.PathLike[str], *, overwrite: boo
                if name not in INPUT_CHANNELS}
     vehicle = truth.vehicle
     rig = rig_description(m)
-    with whole_directory(root, overwrite=overwrite) as tmp:
+    with atomic_directory(root, overwrite=overwrite) as tmp:
         files = []
         for i, scenario in enumerate(truth.scenarios):
             if progress is not None:

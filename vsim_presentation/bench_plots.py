@@ -8,17 +8,11 @@ from typing import Mapping
 import numpy as np
 from matplotlib.figure import Figure
 
-from bushings.bench.bench_file import atomic_output
+from bushings.bench.bench_file import Bench
 from bushings.frequency import equivalent_damping
 from bushings.parameters import ChannelParams
-from bushings.bench.programmes import MM
-
-
-def save_figure(fig: Figure, path: Path, dpi: int = 120) -> Path:
-    """Write the figure as an image atomically, so that a reader never sees half a file."""
-    with atomic_output(path) as tmp:
-        fig.savefig(tmp, dpi=dpi)
-    return path
+from vsim_core.units import MM
+from vsim_presentation.figures import save_figure
 
 
 def _save(fig: Figure, path: Path) -> Path:
@@ -82,3 +76,11 @@ def plot_sweep(columns: Mapping[str, np.ndarray], channel: ChannelParams, out_di
         else "time-domain first harmonic"
     fig.suptitle(f"{stem}: dynamic stiffness and loss factor ({channel.model}); {note}", fontsize=10)
     return [_save(fig, out_dir / f"{stem}_sweep.png")]
+
+
+def plot_bench(bench: Bench, columns: Mapping[str, np.ndarray], out_dir: Path, stem: str) -> list[Path]:
+    """The pictures of a bench run (:func:`bushings.bench.bench_file.run_bench`'s ``columns``): a sweep's
+    maps, or a time series' loop and histories. Returns the PNG paths."""
+    if bench.programme.kind == "sweep":
+        return plot_sweep(columns, bench.channel, out_dir, stem)
+    return plot_time_series(columns, bench.programme.kind, out_dir, stem)

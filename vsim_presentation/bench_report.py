@@ -11,10 +11,10 @@ from typing import Any
 import numpy as np
 from matplotlib.figure import Figure
 
-from bushings.bench.bench_file import atomic_output
-from bushings.parameters import save_parameter_set
-from vsim_presentation.bench_plots import save_figure
+from bushings.parameter_sets import save_parameter_set
 from vsim_diagnosis.bench_diagnosis import BenchDiagnosis, aggregate
+from vsim_presentation.diagnosis_report import Report
+from vsim_presentation.figures import save_figure
 
 #: Held-out records overlaid in the report (the largest baseline errors first).
 OVERLAYS = 4
@@ -146,40 +146,28 @@ def write_report(d: BenchDiagnosis, out_dir: Path) -> list[Path]:
                _ranking(d, out_dir / "ranking.png")]
     model_path = write_extended_model(d, out_dir / "extended_model.yaml")
     result = summary(d)
-    lines = [f"# Diagnosis: {d.part}", "", verdict_sentence(d), "",
-             f"Baseline: `{d.baseline.name}` ({d.baseline.model}); {len(d.replay.names)} tests, "
-             f"{int(d.heldout.sum())} held out from every fit (every other test). Errors are RMS of measured − "
-             f"simulated force relative to half the test's peak-to-peak force; noise floor "
-             f"{result['noise_floor']:.2%}.", ""]
+    report = Report(f"Diagnosis: {d.part}", verdict_sentence(d),
+                    f"Baseline: `{d.baseline.name}` ({d.baseline.model}); {len(d.replay.names)} tests, "
+                    f"{int(d.heldout.sum())} held out from every fit (every other test). Errors are RMS of measured − "
+                    f"simulated force relative to half the test's peak-to-peak force; noise floor "
+                    f"{result['noise_floor']:.2%}.")
     if model_path is not None:
-        lines += [f"Extended model: [`{model_path.name}`]({model_path.name}) (a parameter set: "
-                  f"`vsim bushing run` benches and vehicles can use it).", ""]
-    lines += ["## Ranking (fitted on the training tests, scored on the held-out ones)", "",
-              "| cause | parameters | held-out error | score (with parameter penalty) | fitted values |",
-              "|---|---|---|---|---|",
-              f"| baseline | 0 | {d.heldout_error_before:.3%} | | |"]
-    for c in d.ranking:
-        vals = ", ".join(f"{p.name} = {c.values[p.name]:.4g} {p.unit}" for p in c.cause.parameters)
-        lines.append(f"| {c.cause.id} | {len(c.cause.parameters)} | {c.heldout_error:.3%} | {c.score:.3%} | {vals} |")
-    lines += ["", "![ranking](ranking.png)", "", "## Tests", "",
-              "| test | held out | amplitude [mm] | static [mm] | speed [mm/s] | error before | error after |",
-              "|---|---|---|---|---|---|---|"]
-    for t, f in zip(result["tests"], features):
-        lines.append(f"| {t['name']} | {'yes' if t['heldout'] else ''} | {f['amplitude_mm']:.3g} | {f['static_mm']:.3g} | "
-                     f"{f['speed_mm_s']:.3g} | {t['error_before']:.3%} | {t['error_after']:.3%} |")
-    lines += ["", "## Loops and relaxations (held-out tests with the largest baseline error)", "",
-              "![overlays](overlays.png)", "", "## Residual against speed, amplitude and static load", "",
-              "![residuals](residuals.png)", ""]
-    return written + write_report_text(out_dir, lines, result) + ([model_path] if model_path else [])
-
-
-def write_report_text(out_dir: Path, lines: list[str], result: dict[str, Any]) -> list[Path]:
-    """``report.md`` (the markdown ``lines``) and ``diagnosis.json`` (``result``), each written atomically."""
-    import json
-
-    written = []
-    for name, text in (("report.md", "\n".join(lines)), ("diagnosis.json", json.dumps(result, indent=2))):
-        with atomic_output(out_dir / name) as tmp:
-            tmp.write_text(text)
-        written.append(out_dir / name)
-    return written
+        report.paragraph(f"Extended model: [`{model_path.name}`]({model_path.name}) (a parameter set: "
+                         f"`vsim bushing run` benches and vehicles can use it).")
+    report.section("Ranking (fitted on the training tests, scored on the held-out ones)")
+    report.table(("cause", "parameters", "held-out error", "score (with parameter penalty)", "fitted values"),
+                 [("baseline", "0", f"{d.heldout_error_before:.3%}", "", "")]
+                 + [(c.cause.id, str(len(c.cause.parameters)), f"{c.heldout_error:.3%}", f"{c.score:.3%}",
+                     ", ".join(f"{p.name} = {c.values[p.name]:.4g} {p.unit}" for p in c.cause.parameters))
+                    for c in d.ranking])
+    report.picture("ranking.png")
+    report.section("Tests")
+    report.table(("test", "held out", "amplitude [mm]", "static [mm]", "speed [mm/s]", "error before", "error after"),
+                 [(t["name"], "yes" if t["heldout"] else "", f"{f['amplitude_mm']:.3g}", f"{f['static_mm']:.3g}",
+                   f"{f['speed_mm_s']:.3g}", f"{t['error_before']:.3%}", f"{t['error_after']:.3%}")
+                  for t, f in zip(result["tests"], features)])
+    report.section("Loops and relaxations (held-out tests with the largest baseline error)")
+    report.picture("overlays.png")
+    report.section("Residual against speed, amplitude and static load")
+    report.picture("residuals.png")
+    return written + report.write(out_dir, result) + ([model_path] if model_path else [])

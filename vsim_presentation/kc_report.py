@@ -10,12 +10,12 @@ from typing import Any
 import numpy as np
 from matplotlib.figure import Figure
 
-from bushings.bench.bench_file import atomic_output
-from vsim_presentation.bench_plots import save_figure
 from vehicle.model.definition import VehicleDefinition
-from vsim_presentation.bench_report import write_report_text
-from vsim_diagnosis.kc_causes import parameters
+from vsim_core.files import atomic_output
+from vsim_diagnosis.kc_catalogue import extended_vehicle_yaml, parameters
 from vsim_diagnosis.kc_diagnosis import KCDiagnosis
+from vsim_presentation.diagnosis_report import Report
+from vsim_presentation.figures import save_figure
 
 #: Channels overlaid in the report (the largest baseline mismatch on held-out tests first).
 OVERLAYS = 4
@@ -136,17 +136,15 @@ def _ranking(d: KCDiagnosis, out: Path) -> Path:
 
 def write_report(d: KCDiagnosis, baseline: VehicleDefinition, out_dir: Path, dataset: str) -> list[Path]:
     """Write report.md, its PNGs, diagnosis.json and (for a named cause) extended_vehicle.yaml."""
-    from vsim_diagnosis.kc_causes import extended_vehicle_yaml
-
     out_dir.mkdir(parents=True, exist_ok=True)
     written = [_overlays(d, out_dir / "overlays.png"), _residuals(d, out_dir / "residuals.png"),
                _ranking(d, out_dir / "ranking.png")]
     result = summary(d)
-    lines = [f"# K&C diagnosis of {dataset}", "", verdict_sentence(d), "",
-             f"Baseline: `{baseline.path}`; {len(d.test_names)} tests (recorded cases), {int(d.heldout.sum())} held "
-             f"out from every fit (every other one). Errors are RMS of measured − simulated over every measured "
-             f"channel but the rig inputs, each in units of its own measurement noise (estimated from the data), "
-             f"each channel's zero in each recording removed: 1 is a perfect model.", ""]
+    report = Report(f"K&C diagnosis of {dataset}", verdict_sentence(d),
+                    f"Baseline: `{baseline.path}`; {len(d.test_names)} tests (recorded cases), {int(d.heldout.sum())} "
+                    f"held out from every fit (every other one). Errors are RMS of measured − simulated over every "
+                    f"measured channel but the rig inputs, each in units of its own measurement noise (estimated from "
+                    f"the data), each channel's zero in each recording removed: 1 is a perfect model.")
     if d.named:
         model = out_dir / "extended_vehicle.yaml"
         note = (f"{baseline.path} extended by {d.best.hypothesis.label} {dict(d.best.hypothesis.values)}, fitted by "
@@ -154,24 +152,23 @@ def write_report(d: KCDiagnosis, baseline: VehicleDefinition, out_dir: Path, dat
         with atomic_output(model) as tmp:
             tmp.write_text(extended_vehicle_yaml(baseline, [d.best.hypothesis], note))
         written.append(model)
-        lines += [f"Extended model: [`{model.name}`]({model.name}) (a vehicle file: `vsim run` uses it "
-                  f"through a scenario's `vehicle:` key).", ""]
-    lines += ["## Ranking", "",
-              "Every cause at every place it can sit was run once on the training tests and its magnitude fitted; "
-              "the best were run on every test and scored on the held-out ones.", "",
-              "| hypothesis | parameters | held-out error | training error | fitted values |", "|---|---|---|---|---|",
-              f"| baseline | 0 | {d.heldout_error_before:.3f} | | |"]
-    for c in d.ranking[:12]:
-        vals = ", ".join(f"{k} = {v:.4g}" for k, v in c.hypothesis.values.items())
-        held = f"{c.heldout_error:.3f}" if c.verified else "(not run)"
-        lines.append(f"| {c.hypothesis.label} | {len(parameters(c.hypothesis.cause))} | {held} | "
-                     f"{c.screened_error:.3f} | {vals} |")
-    lines += ["", "![ranking](ranking.png)", "", "## Tests", "", "| test | held out | error before | error after |",
-              "|---|---|---|---|"]
-    for t in result["tests"]:
-        lines.append(f"| {t['name']} | {'yes' if t['heldout'] else ''} | {t['error_before']:.3f} | "
-                     f"{t['error_after']:.3f} |")
-    lines += ["", "## Channels with the largest mismatch (held-out test with the largest baseline error)", "",
-              "![overlays](overlays.png)", "", "## Error against amplitude and static load", "",
-              "![residuals](residuals.png)", ""]
-    return written + write_report_text(out_dir, lines, result)
+        report.paragraph(f"Extended model: [`{model.name}`]({model.name}) (a vehicle file: `vsim run` uses it "
+                         f"through a scenario's `vehicle:` key).")
+    report.section("Ranking")
+    report.paragraph("Every cause at every place it can sit was run once on the training tests and its magnitude "
+                     "fitted; the best were run on every test and scored on the held-out ones.")
+    report.table(("hypothesis", "parameters", "held-out error", "training error", "fitted values"),
+                 [("baseline", "0", f"{d.heldout_error_before:.3f}", "", "")]
+                 + [(c.hypothesis.label, str(len(parameters(c.hypothesis.cause))),
+                     f"{c.heldout_error:.3f}" if c.verified else "(not run)", f"{c.screened_error:.3f}",
+                     ", ".join(f"{k} = {v:.4g}" for k, v in c.hypothesis.values.items())) for c in d.ranking[:12]])
+    report.picture("ranking.png")
+    report.section("Tests")
+    report.table(("test", "held out", "error before", "error after"),
+                 [(t["name"], "yes" if t["heldout"] else "", f"{t['error_before']:.3f}", f"{t['error_after']:.3f}")
+                  for t in result["tests"]])
+    report.section("Channels with the largest mismatch (held-out test with the largest baseline error)")
+    report.picture("overlays.png")
+    report.section("Error against amplitude and static load")
+    report.picture("residuals.png")
+    return written + report.write(out_dir, result)

@@ -19,8 +19,7 @@ import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
 
-from vsim_recordings.run_reader import Run
-from vsim_recordings.run_writer import GeomSpec, rotation_matrix
+from vsim_recordings.run_format import GeomSpec, Run, rotation_matrix
 
 TIMELINE = "sim_time"
 

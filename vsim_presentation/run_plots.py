@@ -11,8 +11,8 @@ matplotlib.use("Agg")  # files only: no display needed, and no GUI backend picke
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from vsim_presentation.bench_plots import save_figure  # noqa: E402
-from vsim_recordings.run_reader import Run  # noqa: E402
+from vsim_presentation.figures import save_figure
+from vsim_recordings.run_format import Run
 
 PAIR_PANEL_IN = (4.5, 3.4)
 TIME_PANEL_IN = (10.0, 3.2)

@@ -1,1 +1,1 @@
-"""Recorded runs: the MCAP run format, its writer and reader, rig recordings, CSV import, measured datasets."""
+"""Recorded runs: the MCAP run format, recording a scenario, rig recordings, CSV import, measured datasets."""

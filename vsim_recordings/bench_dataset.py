@@ -18,21 +18,18 @@ from __future__ import annotations
 
 import math
 import os
-import shutil
-import tempfile
-from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Iterator, Sequence
+from typing import Any, Sequence
 
 import numpy as np
-import yaml
 
-from vsim_core.errors import InputError, read_yaml
 from bushings.bench.records import BenchRecord, read_bench_csv
+from vsim_core.errors import InputError
+from vsim_core.files import atomic_directory
+from vsim_recordings.datasets import read_manifest, write_manifest
 
-RIG_FILE = "rig.yaml"
-_KEYS = {"level", "part", "quantity", "rig", "records"}
+_KEYS = ("level", "part", "quantity", "rig", "records")
 _RECORD_KEYS = {"file", "programme", "rest_before_s"}
 
 
@@ -57,34 +54,11 @@ class BenchDataset:
     rig: dict[str, Any] = field(default_factory=dict)
 
 
-def dataset_level(directory: str | os.PathLike[str]) -> str:
-    """``bench`` or ``kc``: the level a measured directory declares in its rig.yaml."""
-    data = _read_yaml(Path(directory) / RIG_FILE)
-    level = data.get("level")
-    if level not in ("bench", "kc"):
-        raise InputError(f"expected level bench or kc, got {level!r}", source=str(Path(directory) / RIG_FILE),
-                         key="level")
-    return level
-
-
-def _read_yaml(path: Path) -> dict[str, Any]:
-    data = read_yaml(path, f"no {RIG_FILE} here: a measured directory describes its tests in {RIG_FILE}")
-    if not isinstance(data, dict):
-        raise InputError("expected a mapping", source=str(path))
-    return data
-
-
 def read_bench_dataset(directory: str | os.PathLike[str]) -> BenchDataset:
     """Read and validate a bench dataset; errors name the file and key (or CSV line and column)."""
     root = Path(directory)
-    path = root / RIG_FILE
-    data = _read_yaml(path)
+    path, data = read_manifest(root, "bench", _KEYS)
     source = str(path)
-    unknown = sorted(set(data) - _KEYS)
-    if unknown:
-        raise InputError(f"unknown key {unknown[0]!r}; expected {', '.join(sorted(_KEYS))}", source=source, key=unknown[0])
-    if data.get("level") != "bench":
-        raise InputError(f"expected level: bench, got {data.get('level')!r}", source=source, key="level")
     quantity = data.get("quantity", "translation")
     if quantity != "translation":
         raise InputError(f"the bench works in mm and N; got quantity {quantity!r}", source=source, key="quantity")
@@ -116,7 +90,7 @@ def write_bench_dataset(directory: str | os.PathLike[str], part: str, records: S
     """Write a dataset as a whole: into a temporary folder renamed at the end, so that a reader
     never sees a partial one. Forces are written to 0.001 N, deflections to 0.1 nm."""
     root = Path(directory)
-    with whole_directory(root, overwrite=overwrite) as tmp:
+    with atomic_directory(root, overwrite=overwrite) as tmp:
         entries = []
         width = len(str(len(records)))
         for i, r in enumerate(records, start=1):
@@ -126,27 +100,5 @@ def write_bench_dataset(directory: str | os.PathLike[str], part: str, records: S
                        fmt=("%.6f", "%.7f", "%.3f"), header="t_s,e_mm,F_N", comments="")
             entries.append({"file": name, "programme": r.programme, "rest_before_s": r.rest_before_s})
         manifest = {"level": "bench", "part": part, "quantity": "translation", "rig": rig, "records": entries}
-        (tmp / RIG_FILE).write_text(yaml.safe_dump(manifest, sort_keys=False))
+        write_manifest(tmp, manifest)
     return root
-
-
-@contextmanager
-def whole_directory(root: Path, *, overwrite: bool = False) -> Iterator[Path]:
-    """A temporary folder next to ``root`` to write a dataset into, renamed to ``root`` when the block
-    ends without error (replacing it only if ``overwrite``) and removed otherwise: a reader never
-    sees a partial dataset. The folder has the usual permissions (umask), not mkdtemp's 0700."""
-    if root.exists() and not overwrite:
-        raise InputError("exists; pass --overwrite to replace it", source=str(root))
-    root.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{root.name}.", dir=root.parent))
-    umask = os.umask(0)
-    os.umask(umask)
-    os.chmod(tmp, 0o777 & ~umask)
-    try:
-        yield tmp
-        if root.exists():
-            shutil.rmtree(root)
-        os.replace(tmp, root)
-    finally:
-        if tmp.exists():
-            shutil.rmtree(tmp)

@@ -16,19 +16,21 @@ module is the one place that reads and writes the format.
 from __future__ import annotations
 
 import os
-import tempfile
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Mapping, Sequence
 
 import yaml
 
-from vsim_core.errors import InputError, read_yaml
-from vehicle.model.definition import DEFAULT_VEHICLE
-from vsim_recordings.run_reader import Run, load_run
-from vehicle.scenarios.scenario_file import Scenario, load_scenario
+from vehicle.scenarios.scenario import Scenario
+from vehicle.scenarios.scenario_file import parse_scenario
+from vsim_core.documents import Document
+from vsim_core.errors import InputError
+from vsim_core.shipped import DEFAULT_VEHICLE
+from vsim_recordings.datasets import read_manifest, write_manifest
+from vsim_recordings.run_format import Run
+from vsim_recordings.run_reader import load_run
 
-RIG_FILE = "rig.yaml"
 LEVEL = "kc"
 _KEYS = ("level", "vehicle", "rig", "recordings")
 
@@ -56,10 +58,8 @@ class KCDataset:
 def write_kc_rig_yaml(directory: str | os.PathLike[str], vehicle_text: str, rig: Mapping[str, Any],
                       recordings: Sequence[str]) -> Path:
     """Write the ``rig.yaml`` of a K&C dataset into ``directory`` (whose recordings the caller writes)."""
-    manifest = {"level": LEVEL, "vehicle": str(vehicle_text), "rig": dict(rig), "recordings": list(recordings)}
-    path = Path(directory) / RIG_FILE
-    path.write_text(yaml.safe_dump(manifest, sort_keys=False, allow_unicode=True))
-    return path
+    return write_manifest(directory, {"level": LEVEL, "vehicle": str(vehicle_text), "rig": dict(rig),
+                                      "recordings": list(recordings)})
 
 
 def read_kc_dataset(directory: str | os.PathLike[str]) -> KCDataset:
@@ -67,17 +67,8 @@ def read_kc_dataset(directory: str | os.PathLike[str]) -> KCDataset:
     a recording that is missing, unreadable, not a rig recording, incomplete, or whose scenario
     cannot be rebuilt)."""
     root = Path(directory)
-    path = root / RIG_FILE
+    path, data = read_manifest(root, LEVEL, _KEYS)
     source = str(path)
-    data = read_yaml(path, f"no {RIG_FILE} here: a measured directory describes its tests in {RIG_FILE}")
-    if not isinstance(data, dict):
-        raise InputError(f"expected a mapping with keys {', '.join(_KEYS)}, got {type(data).__name__}", source=source)
-    unknown = [k for k in data if k not in _KEYS]
-    if unknown:
-        raise InputError(f"unknown key {unknown[0]!r}; expected {', '.join(_KEYS)}", source=source,
-                         key=str(unknown[0]))
-    if data.get("level") != LEVEL:
-        raise InputError(f"expected level: {LEVEL}, got {data.get('level')!r}", source=source, key="level")
     vehicle_text = data.get("vehicle", "")
     if not isinstance(vehicle_text, str):
         raise InputError(f"expected free text (the car measured), got {vehicle_text!r}", source=source, key="vehicle")
@@ -108,7 +99,7 @@ def _load(file: Path, source: str, key: str) -> Run:
     try:
         run = load_run(file)
     except InputError as exc:
-        raise InputError(f"{file.name}: {_bare(exc)}", source=source, key=key) from exc
+        raise InputError(f"{file.name}: {exc.bare}", source=source, key=key) from exc
     if run.metadata.source != "rig":
         raise InputError(f"{file.name} is a {run.metadata.source} run, not a rig recording (source: rig); "
                          f"a measured dataset holds measurements only", source=source, key=key)
@@ -119,14 +110,8 @@ def _load(file: Path, source: str, key: str) -> Run:
     return run
 
 
-def _bare(exc: InputError) -> str:
-    """The message of ``exc`` without its ``source: key:`` prefix."""
-    where = ": ".join(part for part in (exc.source, exc.key) if part)
-    return str(exc).removeprefix(f"{where}: ") if where else str(exc)
-
-
 def recorded_scenario(run: Run, *, source: str | None = None, key: str | None = None) -> Scenario:
-    """The scenario a recording played, rebuilt from its stored text by :func:`load_scenario`.
+    """The scenario a recording played, rebuilt from its stored text by :func:`parse_scenario`.
 
     Paths in the text (the scenario's ``vehicle``, a CSV case's ``path``) are relative to the file
     the scenario was read from (``extra.scenario_file``: relative to the recording's folder, as the
@@ -138,9 +123,10 @@ def recorded_scenario(run: Run, *, source: str | None = None, key: str | None = 
     """
     text = run.metadata.scenario_yaml
     try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        raise InputError(f"{run.path.name}: its scenario is not valid YAML: {exc}", source=source, key=key) from exc
+        data = Document(text, run.path.name).data
+    except InputError as exc:
+        sub = f", {exc.key}" if exc.key else ""
+        raise InputError(f"{run.path.name}: its scenario{sub}: {exc.bare}", source=source, key=key) from None
     if not isinstance(data, dict):
         raise InputError(f"{run.path.name}: no scenario recorded (scenario_yaml is {text[:40]!r})", source=source,
                          key=key)
@@ -154,16 +140,14 @@ def recorded_scenario(run: Run, *, source: str | None = None, key: str | None = 
     for part in (data.get("defaults"), *(data.get("cases") or [])):
         if isinstance(part, dict) and isinstance(part.get("path"), str):
             part["path"] = _resolve(part["path"], base)
-    with tempfile.TemporaryDirectory(prefix="vsim-scenario-") as tmp:
-        copy = Path(tmp) / f"{run.path.stem}.yaml"
-        copy.write_text(yaml.safe_dump(data, sort_keys=False, allow_unicode=True))
-        try:
-            scenario = load_scenario(copy)
-        except InputError as exc:
-            sub = f", {exc.key}" if exc.key else ""
-            raise InputError(f"{run.path.name}: its scenario{sub}: {_bare(exc)}", source=source, key=key) from None
+    where = file or Path(recorded or run.path)
+    try:
+        scenario = parse_scenario(yaml.safe_dump(data, sort_keys=False, allow_unicode=True), where)
+    except InputError as exc:
+        sub = f", {exc.key}" if exc.key else ""
+        raise InputError(f"{run.path.name}: its scenario{sub}: {exc.bare}", source=source, key=key) from None
     name = data["name"] if isinstance(data.get("name"), str) else str(run.metadata.extra.get("scenario", ""))
-    return replace(scenario, name=name or scenario.name, path=file or Path(recorded or run.path), text=text)
+    return replace(scenario, name=name or scenario.name, path=where, text=text)
 
 
 def _scenario_file(run: Run, recorded: str) -> Path | None:

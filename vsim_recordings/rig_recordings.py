@@ -15,11 +15,14 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
-from bushings.bench.bench_file import atomic_output
+from vehicle.scenarios.channels import INPUT_CHANNELS
+from vehicle.scenarios.scenario import RIG_TIMESTEP_S, Scenario
+from vehicle.scenarios.schedule import CaseSchedule, schedule
 from vsim_core.errors import InputError
-from vsim_recordings.run_writer import RunWriter, SignalSpec
-from vehicle.simulation.runner import CaseSchedule, SignalLayout, run_metadata, schedule
-from vehicle.scenarios.scenario_file import INPUT_CHANNELS, RIG_TIMESTEP_S, Scenario
+from vsim_core.files import atomic_output
+from vsim_recordings.run_format import SignalSpec
+from vsim_recordings.run_signals import SignalLayout, run_metadata
+from vsim_recordings.run_writer import RunWriter
 
 #: The runner's group of bookkeeping signals: not measured.
 _RUN_GROUP = "run"

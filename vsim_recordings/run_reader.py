@@ -1,11 +1,11 @@
-"""Load a run recorded by :class:`vsim_recordings.run_writer.RunWriter` back into numpy arrays: a simulated run,
-or a measured rig recording (``data/README.md``: no bodies, no model in its metadata)."""
+"""Reading a run file (written by :class:`vsim_recordings.run_writer.RunWriter`) back into a
+:class:`vsim_recordings.run_format.Run`: a simulated run, or a measured rig recording
+(``data/README.md``: no bodies, no model in its metadata)."""
 
 from __future__ import annotations
 
 import json
 import os
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -13,62 +13,9 @@ from mcap.exceptions import McapError
 from mcap.reader import make_reader
 
 from vsim_core.errors import InputError
-from vsim_recordings.run_writer import (
-    FORMAT_VERSION,
-    PARTIAL_SUFFIX,
-    RUN_RECORD,
-    SIGNAL_TOPIC_PREFIX,
-    STATUS_RECORD,
-    TF_TOPIC,
-    FrameTransformsLayout,
-    GeomSpec,
-    JointStateLayout,
-    RunMetadata,
-    SignalSpec,
-    signal_label,
-)
-
-
-@dataclass
-class Run:
-    """A recorded run: N steps, S signals, B bodies.
-
-    ``t_s`` (N,) simulation time in s, at the MCAP resolution of 1 ns; ``signals[name]`` (N,) in
-    ``units[name]``; ``body_pos`` (N, B, 3) world positions in m; ``body_quat_wxyz`` (N, B, 4).
-    ``complete`` is false for a run stopped early (divergence, Ctrl-C, exception), with the cause
-    in ``reason``.
-    """
-
-    path: Path
-    t_s: np.ndarray
-    signals: dict[str, np.ndarray]
-    units: dict[str, str]
-    groups: dict[str, str]
-    specs: list[SignalSpec]
-    body_names: list[str]
-    body_pos: np.ndarray
-    body_quat_wxyz: np.ndarray
-    geometry: list[GeomSpec]
-    metadata: RunMetadata
-    complete: bool
-    reason: str
-
-    def label(self, name: str) -> str:
-        """``"name [unit]"`` for axis labels and legends."""
-        return f"{name} [{self.units[name]}]"
-
-    def pairs(self) -> list[tuple[str, str]]:
-        """(x, y) signal pairs to plot against each other, in signal order.
-
-        Each signal with an ``x_axis`` hint (e.g. camber against wheel travel), then each bushing
-        loop: ``<stem>_force`` against ``<stem>_deflection`` when both were recorded.
-        """
-        out = [(s.x_axis, s.name) for s in self.specs if s.x_axis is not None]
-        for s in self.specs:
-            stem = s.name.removesuffix("_deflection")
-            if stem != s.name and f"{stem}_force" in self.signals:
-                out.append((s.name, f"{stem}_force"))
-        return out
+from vsim_recordings.message_layouts import FrameTransformsLayout, JointStateLayout, timestamp_len
+from vsim_recordings.run_format import (FORMAT_VERSION, PARTIAL_SUFFIX, RUN_RECORD, SIGNAL_TOPIC_PREFIX, STATUS_RECORD,
+                                        TF_TOPIC, GeomSpec, Run, RunMetadata, SignalSpec, signal_label)
 
 
 def _run_record(records: dict[str, dict[str, str]], path: Path) -> dict[str, str]:
@@ -128,10 +75,8 @@ def load_run(path: str | os.PathLike[str]) -> Run:
     poses = np.empty((n_steps, len(bodies), 7))
     tf_layouts: dict[int, FrameTransformsLayout] = {}
     for i, data in enumerate(payloads.get(TF_TOPIC, [])[:n_steps]):
-        timestamp_len = _timestamp_len(data)
-        layout = tf_layouts.get(timestamp_len) or tf_layouts.setdefault(
-            timestamp_len, FrameTransformsLayout(bodies, timestamp_len)
-        )
+        size = timestamp_len(data)
+        layout = tf_layouts.get(size) or tf_layouts.setdefault(size, FrameTransformsLayout(bodies, size))
         decoded = layout.decode(data)
         if decoded is None:
             raise InputError(f"{TF_TOPIC} message {i} does not match the recorded body list", source=str(path))
@@ -164,13 +109,3 @@ def load_run(path: str | os.PathLike[str]) -> Run:
         complete=status["complete"] == "true",
         reason=status["reason"],
     )
-
-
-def _timestamp_len(frame_transforms: bytes) -> int:
-    """Bytes taken by the first transform's ``timestamp`` field (tag, length, payload)."""
-    # Byte 0 tags the first transform, a varint gives its length, then come the timestamp's tag
-    # and its one-byte length.
-    i = 1
-    while frame_transforms[i] & 0x80:
-        i += 1
-    return 2 + frame_transforms[i + 2]

@@ -1,4 +1,4 @@
-"""Virtual bushing bench: a bench YAML file (model, parameters, time step, programme) → a table.
+"""A bench file (one bushing law, a time step, a programme) and its run on the virtual bench → a table.
 
 The file is in the thesis's units (N, mm, s); it is validated and converted to SI once, by
 :func:`load_bench`. Time-series programmes give the columns ``t_s, e_mm, F_N``; a sweep gives
@@ -8,21 +8,22 @@ cycle, :func:`bushings.frequency.first_harmonic`).
 
 from __future__ import annotations
 
-import contextlib
 import math
-import os
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Iterator, Mapping
+from typing import Any, Mapping
 
 import numpy as np
 
-from bushings.effects import NO_EFFECTS, Effects, ExtendedBank
-from vsim_core.errors import InputError, read_yaml
+from bushings.bench.programmes import Sweep, TimeSeries, read_programme
+from bushings.effects import NO_EFFECTS, Effects
+from bushings.extended_bank import ExtendedBank
 from bushings.frequency import first_harmonic
-from bushings.parameters import MODELS, ChannelParams, load_parameter_set, to_si
-from bushings.bench.programmes import MM, Sweep, TimeSeries, parse_programme
+from bushings.parameter_sets import load_parameter_set
+from bushings.parameters import MODELS, ChannelParams, to_si
+from vsim_core.documents import Document, Fields
+from vsim_core.errors import InputError
+from vsim_core.units import MM
 
 _BENCH_KEYS = ("model", "params", "dt_s", "programme")
 
@@ -39,46 +40,45 @@ class Bench:
 
 
 def parse_bench(data: Any, source: str, base_dir: Path | None = None) -> Bench:
-    """Validate a bench mapping; errors name ``source`` and the key.
+    """Validate a bench mapping built in code (:func:`read_bench`); errors name ``source`` and the key."""
+    return read_bench(Document.of_data(data, source), base_dir)
+
+
+def read_bench(doc: Document, base_dir: Path | None = None) -> Bench:
+    """Validate a bench document; errors name its file:line and the key.
 
     ``params`` is the name (or path) of a parameter set, read as ``model`` if given, or an inline
     mapping in N, mm, s (``model`` then required).
     """
-    if not isinstance(data, Mapping):
-        raise InputError(f"expected a mapping with keys {', '.join(_BENCH_KEYS)}", source=source)
-    unknown = sorted(set(data) - set(_BENCH_KEYS))
-    if unknown:
-        raise InputError(f"unknown key {unknown[0]!r}; expected {', '.join(_BENCH_KEYS)}",
-                         source=source, key=unknown[0])
+    f = doc.top(_BENCH_KEYS)
     for key in ("params", "dt_s", "programme"):
-        if key not in data:
-            raise InputError("missing key", source=source, key=key)
-    model = data.get("model")
+        f.raw(key)
+    model = f.raw("model", None)
     if model is not None and model not in MODELS:
-        raise InputError(f"unknown model {model!r}; expected one of {', '.join(MODELS)}", source=source, key="model")
-    params = data["params"]
+        raise f.fail("model", f"unknown model {model!r}; expected one of {', '.join(MODELS)}")
+    params = f.raw("params")
     effects = NO_EFFECTS
     if isinstance(params, Mapping):
         if model is None:
-            raise InputError("missing key (needed with inline params)", source=source, key="model")
-        channel = to_si(model, params, source=source)
+            raise f.fail("model", "missing key (needed with inline params)")
+        channel = to_si(model, params, source=doc.where(f.path("params")))
     elif isinstance(params, str):
-        channel, effects = _named_set(params, model, source, base_dir)
+        channel, effects = _named_set(params, model, f, base_dir)
     else:
-        raise InputError(f"expected a parameter-set name or a mapping, got {params!r}", source=source, key="params")
+        raise f.fail("params", f"expected a parameter-set name or a mapping, got {params!r}")
     if channel.quantity != "translation":
-        raise InputError(f"the bench works in mm; set {params!r} is a {channel.quantity}", source=source, key="params")
-    dt = data["dt_s"]
+        raise f.fail("params", f"the bench works in mm; set {params!r} is a {channel.quantity}")
+    dt = f.raw("dt_s")
     if isinstance(dt, bool) or not isinstance(dt, (int, float)) or not 0.0 < dt < math.inf:
-        raise InputError(f"expected a positive time step in s, got {dt!r}", source=source, key="dt_s")
-    programme = parse_programme(data["programme"], float(dt), source, base_dir)
+        raise f.fail("dt_s", f"expected a positive time step in s, got {dt!r}")
+    programme = read_programme(doc, f.path("programme"), float(dt), base_dir)
     if effects.active and isinstance(programme, Sweep):
-        raise InputError(f"set {params!r} has effects (state extensions), which a sweep's per-point restarts "
-                         f"would misrepresent; play its sines as time-series programmes", source=source, key="params")
-    return Bench(source, channel, float(dt), programme, effects)
+        raise f.fail("params", f"set {params!r} has effects (state extensions), which a sweep's per-point restarts "
+                               f"would misrepresent; play its sines as time-series programmes")
+    return Bench(doc.source, channel, float(dt), programme, effects)
 
 
-def _named_set(name: str, model: str | None, source: str, base_dir: Path | None) -> tuple[ChannelParams, Effects]:
+def _named_set(name: str, model: str | None, f: Fields, base_dir: Path | None) -> tuple[ChannelParams, Effects]:
     """A parameter set (SI law and effects) by name, or by path relative to the bench file; errors
     name both files."""
     path = Path(name)
@@ -88,12 +88,12 @@ def _named_set(name: str, model: str | None, source: str, base_dir: Path | None)
         pset = load_parameter_set(name)
         return pset.channel(model), pset.effects_si()
     except InputError as exc:
-        raise InputError(str(exc), source=source, key="params") from exc
+        raise f.fail("params", str(exc)) from exc
 
 
 def load_bench(path: Path) -> Bench:
     """Read and validate a bench YAML file."""
-    return parse_bench(read_yaml(path, "no such bench file"), str(path), path.parent)
+    return read_bench(Document.read(path, "no such bench file"), path.parent)
 
 
 def run_bench(bench: Bench) -> dict[str, np.ndarray]:
@@ -107,28 +107,3 @@ def run_bench(bench: Bench) -> dict[str, np.ndarray]:
                 "k_dyn_n_per_mm": result.k_dyn_n_per_m * MM, "tan_delta": result.tan_delta}
     force = ExtendedBank([bench.channel], [bench.effects]).run(prog.e_m, bench.dt_s)[:, 0]
     return {"t_s": prog.t_s, "e_mm": prog.e_m / MM, "F_N": force}
-
-
-@contextlib.contextmanager
-def atomic_output(path: Path) -> Iterator[Path]:
-    """Yield a temporary path beside ``path``; rename it to ``path`` only if the block succeeds,
-    so that a reader never sees a half-written file."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=path.suffix, dir=path.parent)
-    os.close(fd)
-    umask = os.umask(0)  # mkstemp creates 0600; give the file the usual permissions
-    os.umask(umask)
-    os.chmod(tmp, 0o666 & ~umask)
-    try:
-        yield Path(tmp)
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-
-
-def write_table(path: Path, columns: Mapping[str, np.ndarray]) -> None:
-    """Write the columns as CSV with a header line, atomically."""
-    with atomic_output(path) as tmp:
-        np.savetxt(tmp, np.column_stack(list(columns.values())), delimiter=",", fmt="%.10g",
-                   header=",".join(columns), comments="")

@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from bushings.bench.programmes import MM, firtree, multisine, piecewise_linear, sine, step, triangle
+from bushings.bench.programmes import parse_programme
 
 
 @dataclass(frozen=True)
@@ -21,39 +21,14 @@ class BenchTest:
     """One record of the campaign: a programme, its sampling step and the rest before it."""
 
     name: str
-    programme: dict[str, Any]     #: the programme as a bench YAML mapping (mm, s, Hz), for people
+    programme: dict[str, Any]     #: the programme as a bench file writes it (mm, s, Hz)
     dt_s: float                   #: the rig's sampling step [s]
     rest_before_s: float          #: rest at zero deflection before the test [s]
 
     def signal(self, dt_s: float | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Time [s] from 0 and deflection [m], sampled every dt_s (default: the rig's step)."""
-        return build_signal(self.programme, dt_s or self.dt_s)
-
-
-def build_signal(p: dict[str, Any], dt_s: float) -> tuple[np.ndarray, np.ndarray]:
-    """Sample a campaign programme mapping (a bench programme, optionally with ``static_mm``: a
-    sine played about a static offset reached and left by 1 mm/s ramps) in SI."""
-    kind = p["type"]
-    if kind == "triangle":
-        return triangle(p["amplitude_mm"] * MM, p["speed_mm_s"] * MM, p["cycles"], dt_s)
-    if kind == "sine" and "static_mm" in p:
-        ramp, static = abs(p["static_mm"]), p["static_mm"] * MM
-        t_ramp, t_sine = piecewise_linear([0.0, ramp, ramp + 1.0], [0.0, static, static], dt_s)
-        ts, es = sine(p["amplitude_mm"] * MM, p["frequency_hz"], p["cycles"], dt_s)
-        tb, eb = piecewise_linear([0.0, ramp], [static, 0.0], dt_s)
-        t0 = t_ramp[-1] + dt_s
-        t1 = t0 + ts[-1] + dt_s
-        return np.r_[t_ramp, t0 + ts, t1 + tb], np.r_[t_sine, static + es, eb]
-    if kind == "sine":
-        return sine(p["amplitude_mm"] * MM, p["frequency_hz"], p["cycles"], dt_s)
-    if kind == "bisine":
-        c = p["components"]
-        return multisine([x["amplitude_mm"] * MM for x in c], [x["frequency_hz"] for x in c], p["duration_s"], dt_s)
-    if kind == "step":
-        return step(p["amplitude_mm"] * MM, p["rise_time_s"], p["hold_s"], dt_s)
-    if kind == "firtree":
-        return firtree(p["amplitude_mm"] * MM, p["speed_mm_s"] * MM, p["step_mm"] * MM, p["hold_s"], p["cycles"], dt_s)
-    raise ValueError(f"unknown campaign programme {kind!r}")
+        programme = parse_programme(self.programme, dt_s or self.dt_s, f"the campaign's test {self.name}")
+        return programme.t_s, programme.e_m
 
 
 def _sine(a: float, f: float, cycles: int, **extra: float) -> dict[str, Any]:

@@ -14,6 +14,7 @@ converted to SI only by :func:`bushings.to_si`; records and simulations are SI.
 
 from __future__ import annotations
 
+import datetime as dt
 import math
 import time
 from dataclasses import dataclass, field, replace
@@ -22,12 +23,12 @@ from typing import Mapping, Sequence
 import numpy as np
 from scipy.optimize import least_squares
 
-from vsim_core.errors import InputError
-from bushings.parameters import DEFAULT_CELLS, ParameterSet, to_si
 from bushings.bench.records import BenchRecord, simulate_record
+from bushings.parameter_sets import ParameterSet
+from bushings.parameters import DEFAULT_CELLS, to_si
+from vsim_core.errors import InputError
+from vsim_core.units import MM
 
-#: Metres per user length unit (mm): parameter sets are in N, mm, s.
-MM = 1e-3
 #: Parameters adjusted by :func:`fit`, per model (N is fixed).
 FIT_PARAMETERS: dict[str, tuple[str, ...]] = {
     "sts": ("K0", "Kpa", "Kr", "Ff"),
@@ -203,6 +204,16 @@ def rt_initial(sts: ParameterSet, v0_mm_s: float = 0.333, pw: float = 0.1) -> Pa
                         values=values, source=f"{sts.source}; RT initialised with Co = Ff/V0^pw")
 
 
+def starting_set(pset: ParameterSet, model: str) -> ParameterSet:
+    """A set to start a fit of ``model`` from: an STS set converted by eq. 5.10 for the STVS, or to an
+    RT start (:func:`stvs_initial`, :func:`rt_initial`); any other set as it is."""
+    if pset.model == "sts" and model == "stvs":
+        return stvs_initial(pset)
+    if pset.model == "sts" and model == "rt":
+        return rt_initial(pset)
+    return pset
+
+
 def initial_guesses(records: Sequence[BenchRecord], model: str, n_cells: int = DEFAULT_CELLS) -> list[ParameterSet]:
     """Starting points for :func:`fit`: direct STS identification on the slowest cyclic record,
     then for the STVS eq. 5.10 twice (slider share 0.8 as the thesis's text says, 0.2 as its
@@ -259,9 +270,14 @@ class FitResult:
     message: str = ""                    #: optimiser's termination message
     correlation: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))  #: of the fitted parameters
 
-    def parameter_set(self, name: str, source: str) -> ParameterSet:
-        """The fitted parameters as a :class:`ParameterSet`."""
-        return ParameterSet(name=name, model=self.model, quantity="translation", values=dict(self.values), source=source)
+    def parameter_set(self, name: str, record_paths: Sequence[str]) -> ParameterSet:
+        """The fitted parameters as a :class:`ParameterSet` (rounded to 5 significant digits) whose
+        source says what was fitted to what, when, and how well."""
+        errors = ", ".join(f"{e.source} {e.rms_N:.3g} N ({e.percent:.2f} %)" for e in self.errors)
+        source = (f"fitted by vsim bushing fit ({self.model}) on {dt.date.today().isoformat()} to "
+                  f"{', '.join(record_paths)}; RMS fit error {errors}")
+        params = {k: (int(v) if k == "N" else float(f"{v:.5g}")) for k, v in self.values.items()}
+        return ParameterSet(name, self.model, "translation", params, source)
 
 
 class _Problem:

@@ -4,7 +4,8 @@ A programme mapping (from a bench YAML file, in mm and s) is validated and conve
 by :func:`parse_programme`. Time-series programmes become a :class:`TimeSeries` (time [s] and
 deflection [m] on a uniform grid of step dt_s, starting at rest at e = 0); a frequency ``sweep``
 becomes a :class:`Sweep` of (amplitude, frequency) pairs, each analysed by
-:mod:`bushings.frequency`.
+:mod:`bushings.frequency`. A sine may carry ``static_mm``: it is then played about that static
+offset, reached and left by 1 mm/s ramps (the standard campaign's static-offset sines).
 """
 
 from __future__ import annotations
@@ -16,12 +17,14 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from vsim_core.errors import InputError
-from bushings.bench.records import read_csv_columns
+from vsim_core.documents import Document, Fields, KeyPath, check_number
+from vsim_core.tables import read_csv_columns
+from vsim_core.units import MM
 
-MM = 1e-3  #: metres per millimetre
 #: Fewest samples per period of the fastest sine component that a bench accepts.
 MIN_SAMPLES_PER_PERIOD = 20
+#: Speed of the ramps to and from a sine's static offset [mm/s], and the rest before the sine [s].
+STATIC_RAMP_MM_S, STATIC_REST_S = 1.0, 1.0
 
 
 @dataclass(frozen=True)
@@ -78,6 +81,20 @@ def sine(amplitude_m: float, frequency_hz: float, cycles: int, dt_s: float) -> t
     return multisine([amplitude_m], [frequency_hz], cycles / frequency_hz, dt_s)
 
 
+def sine_about(static_m: float, ramp_s: float, amplitude_m: float, frequency_hz: float, cycles: int,
+               dt_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """A sine A·sin(2π f t) of ``cycles`` periods about a static offset: a ramp from 0 to the offset in
+    ``ramp_s``, a rest of :data:`STATIC_REST_S`, the sine, and a ramp back to 0 in ``ramp_s``.
+    Returns time [s] and deflection [m]."""
+    ramp = ramp_s
+    t_ramp, e_ramp = piecewise_linear([0.0, ramp, ramp + STATIC_REST_S], [0.0, static_m, static_m], dt_s)
+    ts, es = sine(amplitude_m, frequency_hz, cycles, dt_s)
+    tb, eb = piecewise_linear([0.0, ramp], [static_m, 0.0], dt_s)
+    t0 = t_ramp[-1] + dt_s
+    t1 = t0 + ts[-1] + dt_s
+    return np.r_[t_ramp, t0 + ts, t1 + tb], np.r_[e_ramp, static_m + es, eb]
+
+
 def step(height_m: float, rise_time_s: float, hold_s: float, dt_s: float) -> tuple[np.ndarray, np.ndarray]:
     """Relaxation step: a ramp from 0 to ``height_m`` over ``rise_time_s`` (at least one time step),
     then held for ``hold_s``; returns time [s] (0 at the start of the ramp) and deflection [m]."""
@@ -120,115 +137,110 @@ def read_csv_record(path: Path) -> tuple[np.ndarray, np.ndarray]:
 _REQUIRED = object()
 _KEYS: dict[str, dict[str, Any]] = {
     "triangle": {"amplitude_mm": _REQUIRED, "speed_mm_s": _REQUIRED, "cycles": 3},
-    "sine": {"amplitude_mm": _REQUIRED, "frequency_hz": _REQUIRED, "cycles": 5},
+    "sine": {"amplitude_mm": _REQUIRED, "frequency_hz": _REQUIRED, "cycles": 5, "static_mm": None},
     "bisine": {"components": _REQUIRED, "cycles": 3, "duration_s": None},
     "step": {"amplitude_mm": _REQUIRED, "rise_time_s": _REQUIRED, "hold_s": _REQUIRED},
     "firtree": {"amplitude_mm": 3.0, "speed_mm_s": 10.0, "step_mm": 1.0, "hold_s": 60.0, "cycles": 1},
     "sweep": {"amplitudes_mm": _REQUIRED, "frequencies_hz": _REQUIRED, "cycles": 5, "points_per_cycle": 400},
     "csv": {"path": _REQUIRED},
 }
-_UNSET = object()
-
-
-class _Reader:
-    """Typed access to a programme mapping; errors name the file and ``programme.<key>``."""
-
-    def __init__(self, data: Mapping[str, Any], kind: str, source: str):
-        self.data, self.kind, self.source = data, kind, source
-
-    def fail(self, key: str, message: str) -> InputError:
-        return InputError(message, source=self.source, key=f"programme.{key}")
-
-    def number(self, key: str, *, positive: bool = True, nonzero: bool = True, integer: bool = False,
-               value: Any = _UNSET) -> float:
-        raw = self.data.get(key, _KEYS[self.kind][key]) if value is _UNSET else value
-        if isinstance(raw, bool) or not isinstance(raw, (int, float)) or not math.isfinite(raw):
-            raise self.fail(key, f"expected a finite number, got {raw!r}")
-        if integer and raw != int(raw):
-            raise self.fail(key, f"expected a whole number, got {raw!r}")
-        if (positive and raw < 0) or (nonzero and raw == 0):
-            raise self.fail(key, f"expected a {'positive' if positive else 'non-zero'} number, got {raw!r}")
-        return float(raw)
-
-    def numbers(self, key: str) -> np.ndarray:
-        raw = self.data[key]
-        if not isinstance(raw, list) or not raw:
-            raise self.fail(key, f"expected a non-empty list of positive numbers, got {raw!r}")
-        return np.array([self.number(key, value=v) for v in raw])
 
 
 def parse_programme(data: Any, dt_s: float, source: str, base_dir: Path | None = None) -> TimeSeries | Sweep:
-    """Validate a bench ``programme`` mapping (mm, s, Hz) and build it in SI, sampled at dt_s.
+    """Validate a ``programme`` mapping (mm, s, Hz) written in code or a file named ``source`` and
+    build it in SI, sampled at dt_s (see :func:`read_programme`)."""
+    return read_programme(Document.of_data({"programme": data}, source), ("programme",), dt_s, base_dir)
+
+
+def read_programme(doc: Document, path: KeyPath, dt_s: float, base_dir: Path | None = None) -> TimeSeries | Sweep:
+    """The programme mapping at ``path`` of ``doc`` (mm, s, Hz) built in SI, sampled at dt_s.
 
     ``base_dir`` resolves a relative csv ``path`` (the bench file's folder). Raises InputError
-    naming ``source`` and the offending key for an unknown type or key, a missing key, a value
-    of the wrong sign or kind, or a sine too coarsely sampled by dt_s.
+    naming the file and the offending key for an unknown type or key, a missing key, a value of the
+    wrong sign or kind, or a sine too coarsely sampled by dt_s.
     """
+    data = doc.data
+    for part in path:
+        data = data[part]
     if not isinstance(data, Mapping):
-        raise InputError(f"expected a mapping with a type key, got {data!r}", source=source, key="programme")
+        raise doc.error(path, f"expected a mapping with a type key, got {data!r}")
     kind = data.get("type")
     if kind not in _KEYS:
-        raise InputError(f"unknown programme type {kind!r}; expected one of {', '.join(_KEYS)}",
-                         source=source, key="programme.type")
+        raise doc.error(path + ("type",), f"unknown programme type {kind!r}; expected one of {', '.join(_KEYS)}")
     allowed = _KEYS[kind]
-    unknown = sorted(set(data) - set(allowed) - {"type"})
-    if unknown:
-        raise InputError(f"unknown key {unknown[0]!r} for a {kind} programme; expected {', '.join(allowed)}",
-                         source=source, key=f"programme.{unknown[0]}")
+    f = Fields(doc, {k: (v, path + (k,)) for k, v in data.items()}, path)
+    f.check_keys(("type", *allowed), f" for a {kind} programme")
     missing = [k for k, v in allowed.items() if v is _REQUIRED and k not in data]
     if missing:
-        raise InputError(f"missing key for a {kind} programme", source=source, key=f"programme.{missing[0]}")
-    r = _Reader(data, kind, source)
+        raise f.fail(missing[0], f"missing key for a {kind} programme")
+
+    def number(key: str, **kind_of: bool) -> float:
+        return f.number(key, allowed[key], **(kind_of or {"positive": True}))
+
     if kind == "sweep":
-        return Sweep(np.unique(r.numbers("amplitudes_mm")) * MM, np.unique(r.numbers("frequencies_hz")),
-                     int(r.number("cycles", integer=True)), int(r.number("points_per_cycle", integer=True)))
+        return Sweep(np.unique(_numbers(f, "amplitudes_mm")) * MM, np.unique(_numbers(f, "frequencies_hz")),
+                     int(number("cycles", positive=True, integer=True)),
+                     int(number("points_per_cycle", positive=True, integer=True)))
     if kind == "csv":
         if not isinstance(data["path"], str):
-            raise r.fail("path", f"expected a file path, got {data['path']!r}")
-        path = Path(data["path"])
-        t, e = read_csv_record(path if path.is_absolute() or base_dir is None else base_dir / path)
+            raise f.fail("path", f"expected a file path, got {data['path']!r}")
+        csv = Path(data["path"])
+        t, e = read_csv_record(csv if csv.is_absolute() or base_dir is None else base_dir / csv)
         return TimeSeries(kind, *piecewise_linear(t, e, dt_s))
     if kind == "triangle":
-        t, e = triangle(r.number("amplitude_mm") * MM, r.number("speed_mm_s") * MM,
-                        int(r.number("cycles", integer=True)), dt_s)
+        t, e = triangle(number("amplitude_mm") * MM, number("speed_mm_s") * MM,
+                        int(number("cycles", positive=True, integer=True)), dt_s)
     elif kind == "sine":
-        frequency = r.number("frequency_hz")
-        _check_sampling(r, "frequency_hz", frequency, dt_s)
-        t, e = sine(r.number("amplitude_mm") * MM, frequency, int(r.number("cycles", integer=True)), dt_s)
+        frequency = number("frequency_hz")
+        _check_sampling(f, "frequency_hz", frequency, dt_s)
+        amplitude, cycles = number("amplitude_mm") * MM, int(number("cycles", positive=True, integer=True))
+        if f.has("static_mm"):
+            static_mm = f.number("static_mm")
+            t, e = sine_about(static_mm * MM, abs(static_mm) / STATIC_RAMP_MM_S, amplitude, frequency, cycles, dt_s)
+        else:
+            t, e = sine(amplitude, frequency, cycles, dt_s)
     elif kind == "bisine":
-        amplitudes, frequencies = _components(r)
-        _check_sampling(r, "components", max(frequencies), dt_s)
-        if "duration_s" in data and "cycles" in data:
-            raise r.fail("duration_s", "give either cycles (of the slowest component) or duration_s, not both")
-        duration = (r.number("duration_s") if "duration_s" in data
-                    else r.number("cycles", integer=True) / min(frequencies))
+        amplitudes, frequencies = _components(f)
+        _check_sampling(f, "components", max(frequencies), dt_s)
+        if f.has("duration_s") and f.has("cycles"):
+            raise f.fail("duration_s", "give either cycles (of the slowest component) or duration_s, not both")
+        duration = (number("duration_s") if f.has("duration_s")
+                    else number("cycles", positive=True, integer=True) / min(frequencies))
         t, e = multisine(amplitudes, frequencies, duration, dt_s)
     elif kind == "step":
-        t, e = step(r.number("amplitude_mm", positive=False) * MM, r.number("rise_time_s", nonzero=False),
-                    r.number("hold_s"), dt_s)
+        t, e = step(number("amplitude_mm", nonzero=True) * MM, number("rise_time_s", nonneg=True),
+                    number("hold_s"), dt_s)
     else:
-        amplitude, level = r.number("amplitude_mm"), r.number("step_mm")
+        amplitude, level = number("amplitude_mm"), number("step_mm")
         if abs(amplitude / level - round(amplitude / level)) > 1e-9:
-            raise r.fail("step_mm", f"expected amplitude_mm ({amplitude}) to be a whole multiple of step_mm ({level})")
-        t, e = firtree(amplitude * MM, r.number("speed_mm_s") * MM, level * MM, r.number("hold_s", nonzero=False),
-                       int(r.number("cycles", integer=True)), dt_s)
+            raise f.fail("step_mm", f"expected amplitude_mm ({amplitude}) to be a whole multiple of step_mm ({level})")
+        t, e = firtree(amplitude * MM, number("speed_mm_s") * MM, level * MM, number("hold_s", nonneg=True),
+                       int(number("cycles", positive=True, integer=True)), dt_s)
     return TimeSeries(kind, t, e)
 
 
-def _components(r: _Reader) -> tuple[list[float], list[float]]:
-    raw = r.data["components"]
+def _numbers(f: Fields, key: str) -> np.ndarray:
+    raw = f.raw(key)
+    if not isinstance(raw, list) or not raw:
+        raise f.fail(key, f"expected a non-empty list of positive numbers, got {raw!r}")
+    return np.array([check_number(f.doc, f.path(key) + (i,), v, positive=True) for i, v in enumerate(raw)])
+
+
+def _components(f: Fields) -> tuple[list[float], list[float]]:
+    raw = f.raw("components")
     if not isinstance(raw, list) or not raw or not all(isinstance(c, Mapping) for c in raw):
-        raise r.fail("components", f"expected a list of {{amplitude_mm, frequency_hz}} mappings, got {raw!r}")
+        raise f.fail("components", f"expected a list of {{amplitude_mm, frequency_hz}} mappings, got {raw!r}")
     amplitudes, frequencies = [], []
-    for c in raw:
+    for i, c in enumerate(raw):
         if set(c) != {"amplitude_mm", "frequency_hz"}:
-            raise r.fail("components", f"expected exactly the keys amplitude_mm and frequency_hz, got {dict(c)!r}")
-        amplitudes.append(r.number("components", value=c["amplitude_mm"]) * MM)
-        frequencies.append(r.number("components", value=c["frequency_hz"]))
+            raise f.fail("components", f"expected exactly the keys amplitude_mm and frequency_hz, got {dict(c)!r}")
+        item = Fields.of(f.doc, f.path("components") + (i,), c, ("amplitude_mm", "frequency_hz"))
+        amplitudes.append(item.number("amplitude_mm", positive=True) * MM)
+        frequencies.append(item.number("frequency_hz", positive=True))
     return amplitudes, frequencies
 
 
-def _check_sampling(r: _Reader, key: str, frequency_hz: float, dt_s: float) -> None:
+def _check_sampling(f: Fields, key: str, frequency_hz: float, dt_s: float) -> None:
     if frequency_hz * dt_s * MIN_SAMPLES_PER_PERIOD > 1.0 + 1e-9:
-        raise r.fail(key, f"{frequency_hz} Hz is sampled by fewer than {MIN_SAMPLES_PER_PERIOD} points per period "
+        raise f.fail(key, f"{frequency_hz} Hz is sampled by fewer than {MIN_SAMPLES_PER_PERIOD} points per period "
                           f"at dt_s = {dt_s}; expected dt_s <= {1.0 / (MIN_SAMPLES_PER_PERIOD * frequency_hz):.3g}")

@@ -6,7 +6,6 @@ once here.
 
 from __future__ import annotations
 
-import csv
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -15,8 +14,8 @@ from typing import Sequence
 import numpy as np
 
 from bushings.bank import BushingBank
-from vsim_core.errors import InputError
 from bushings.parameters import ChannelParams
+from vsim_core.tables import read_csv_columns
 
 #: Columns a bench record must have (extra columns are ignored).
 RECORD_COLUMNS = ("t_s", "e_mm", "F_N")
@@ -43,52 +42,6 @@ class BenchRecord:
             return self
         idx = np.unique(np.r_[np.arange(0, len(self.t), stride), len(self.t) - 1])
         return BenchRecord(self.source, self.t[idx], self.e[idx], self.F[idx])
-
-
-def read_csv_columns(path: str | Path, columns: Sequence[str], min_rows: int) -> dict[str, np.ndarray]:
-    """Read the named numeric columns of a CSV file with a header line (other columns ignored).
-
-    Values stay in the file's units. Raises InputError naming the file, line and column for a
-    missing column, a non-number, a NaN, a time (first column) that does not increase strictly,
-    or fewer than ``min_rows`` data lines.
-    """
-    path = Path(path)
-    source = str(path)
-    try:
-        text = path.read_text()
-    except OSError as exc:
-        raise InputError(f"cannot read: {exc.strerror}", source=source) from exc
-    rows = csv.reader(text.splitlines())
-    header = [h.strip() for h in next(rows, [])]
-    missing = [c for c in columns if c not in header]
-    if missing:
-        raise InputError(f"missing column(s) {', '.join(missing)}; expected a header with {','.join(columns)}, "
-                         f"got {','.join(header) or 'an empty file'}", source=source, key="line 1")
-    cols = [header.index(c) for c in columns]
-    data: list[list[float]] = []
-    for line, row in enumerate(rows, start=2):
-        if not row or not "".join(row).strip():
-            continue
-        values = []
-        for name, col in zip(columns, cols):
-            where = f"line {line}, column {name}"
-            if col >= len(row):
-                raise InputError(f"missing value (expected {len(header)} columns)", source=source, key=where)
-            try:
-                value = float(row[col])
-            except ValueError:
-                raise InputError(f"expected a number, got {row[col]!r}", source=source, key=where) from None
-            if not math.isfinite(value):
-                raise InputError(f"expected a finite number, got {row[col]!r}", source=source, key=where)
-            values.append(value)
-        if data and not values[0] > data[-1][0]:
-            raise InputError(f"time must increase strictly: {values[0]!r} s follows {data[-1][0]!r} s",
-                             source=source, key=f"line {line}, column {columns[0]}")
-        data.append(values)
-    if len(data) < min_rows:
-        raise InputError(f"too short: {len(data)} samples, expected at least {min_rows}", source=source)
-    arr = np.array(data).reshape(-1, len(columns))
-    return {name: arr[:, j] for j, name in enumerate(columns)}
 
 
 def read_bench_csv(path: str | Path) -> BenchRecord:

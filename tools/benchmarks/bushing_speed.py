@@ -24,7 +24,7 @@ from typing import Callable
 import numpy as np
 
 from bushings import BushingBank, load_parameter_set
-from bushings.effects import ExtendedBank
+from bushings.extended_bank import ExtendedBank
 from bushings.reference import explicit_reference
 
 H_S = 1e-3

@@ -34,7 +34,7 @@ def main() -> int:
             figures[f"{name}_note"] = f"{path.relative_to(ROOT)} is not shipped yet"
             continue
         started = time.perf_counter()
-        done = subprocess.run([sys.executable, "-m", "vsim_cli.main", "diagnose", str(path), *baseline, "--json"],
+        done = subprocess.run([sys.executable, "-m", "vsim_cli", "diagnose", str(path), *baseline, "--json"],
                               capture_output=True, text=True)
         wall = time.perf_counter() - started
         if done.returncode:

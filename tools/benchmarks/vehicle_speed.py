@@ -9,7 +9,7 @@
   cars alternating, after a warm-up period each;
 * ``ratio_stvs_to_linear``: ratio of their step times; ``step_us_*``: the step times [µs];
 * ``camber_change_on_half_step_deg``: largest difference between the camber loops computed at H
-  and at H/2 (60 mm, 0.1 Hz pumping, vehicle.simulation.kc.run_triangle, STVS; both branches compared at
+  and at H/2 (60 mm, 0.1 Hz pumping, vehicle.simulation.kc_triangles.run_triangle, STVS; both branches compared at
   the same pad heights over ±55 mm, four wheels); ``closure_error_max_m``: largest loop-closure error on that loop at H.
 
 Targets (issue 3): rtf_stvs_all ≥ 10, ratio_stvs_to_linear ≤ 1.5, camber change ≤ 0.005 deg.
@@ -24,10 +24,13 @@ import time
 
 import numpy as np
 
-from vehicle.model.builder import CORNERS, BuildOptions
-from vehicle.model.definition import load_vehicle
-from vehicle.simulation.kc import Triangle, branches, run_triangle
+from vehicle.model.definition import CORNERS
+from vehicle.model.elements import BuildOptions
+from vehicle.model.vehicle_file import load_vehicle
+from vehicle.scenarios.kc_tests import Triangle
+from vehicle.simulation.kc_triangles import run_triangle
 from vehicle.simulation.rig import KCRig
+from vsim_analysis.kc_test import branches
 
 AMPLITUDE = 0.06     #: pumping amplitude [m]
 PERIOD = 10.0        #: [s] (0.1 Hz)

@@ -26,18 +26,17 @@ left's (:func:`mirror_signs`).
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from dataclasses import dataclass, field
 
 import mujoco
 import numpy as np
 
-from bushings.effects import NO_EFFECTS, Effects
-from vehicle.model.definition import DIRECTIONS, BushingDef, Spring, VehicleDefinition
+from bushings.effects import NO_EFFECTS
+from vehicle.model.definition import DIRECTIONS, SIDES, BushingDef, Spring, VehicleDefinition
+from vehicle.model.elements import BuildOptions, Channel, CrossTerm, Element, joint_stiffness
+from vehicle.model.geometry import frame_from, mirror, mirror_axes, mirror_signs, mirrored_law, wheel_axis
 
-SIDES = (("left", 1.0), ("right", -1.0))
-CORNERS = ("front_left", "front_right", "rear_left", "rear_right")
 #: Stiffness of a "rigid" bushing translation [N/m] (kinematics mode).
 RIGID_TRANSLATION = 1e9
 #: Loop closures and rig drives: time constant at the refsafe floor (2 h) and impedance close to
@@ -47,56 +46,6 @@ SLEEVE_MASS = 0.4          #: mass of a closed bushing's sleeve [kg], taken from
 BEAM_CENTRE_MASS = 1.0    #: share of each arm's mass carried by the beam-centre body [kg]
 PAD_MASS = 1.0             #: rig pad and carriage masses [kg] (gravity compensated)
 _NO_COLLISION = dict(contype=0, conaffinity=0)
-
-
-@dataclass(frozen=True)
-class BuildOptions:
-    """How to build: rig or road, clamped or free body, bushing model override, time step."""
-
-    rig: bool = True                    #: add the K&C rig (pads, rack drive, wheel locks)
-    clamped: bool = True                #: body fixed to the world; otherwise a free joint
-    bushing_model: str | None = None    #: read every named bushing set as this model
-    rigid_bushings: bool = False        #: translations rigid (kinematics); rotations unchanged
-    timestep: float = 1e-3              #: [s]
-
-
-@dataclass
-class Channel:
-    """One bushing direction: a joint of the model and its force law."""
-
-    name: str                            #: e.g. ``e1_front_left.y``
-    joint: str
-    params: object                       #: bushings.ChannelParams (SI)
-    effects: Effects = NO_EFFECTS        #: state extensions of the law (bushings.effects, SI)
-
-    @property
-    def linear(self) -> bool:
-        """True when the whole law fits in the joint's stiffness and damping."""
-        p = self.params
-        return (p.model == "linear" and not math.isfinite(p.S_sup) and not math.isfinite(p.S_inf)
-                and not self.effects.active)
-
-
-@dataclass(frozen=True)
-class CrossTerm:
-    """A cross stiffness between two bushing joints: τ_a += −k·q_b, τ_b += −k·q_a (explicit)."""
-
-    joint_a: str
-    joint_b: str
-    stiffness: float                     #: k [N/m or N·m/rad], this side's sign included
-
-
-@dataclass
-class Element:
-    """A spring or damper acting along a scalar coordinate (a slide joint or a tendon)."""
-
-    name: str
-    kind: str                            #: "joint" or "tendon"
-    target: str                          #: joint or tendon name
-    sign: float                          #: compression = sign × (coordinate − design value)
-    spring: Spring | None = None
-    preload: float = 0.0                 #: [N]
-    damper_curve: object | None = None   #: definition.Curve of compression speed → force
 
 
 @dataclass
@@ -116,83 +65,6 @@ class CarModel:
     def xml(self) -> str:
         """The MJCF of the model."""
         return self.spec.to_xml()
-
-
-def joint_stiffness(channel: Channel) -> float:
-    """Stiffness to put in a bushing joint: the whole law if linear (implicit), else the
-    reference tangent K0 + Kpa (the rest is applied explicitly by :mod:`vehicle.simulation.coupling`)."""
-    p = channel.params
-    return p.K0 if channel.linear else p.K0 + p.Kpa
-
-
-def mirror(p, sign: float) -> np.ndarray:
-    """A left-side point or vector on the side ``sign`` (+1 left, −1 right)."""
-    return np.array([p[0], sign * p[1], p[2]], dtype=float)
-
-
-def _reversed_axis(axes) -> int:
-    """Index of the bushing axis closest to the lateral direction (reversed on the right side)."""
-    return int(np.argmax(np.abs(np.asarray(axes, float)[:, 1])))
-
-
-def mirror_axes(axes, sign: float) -> np.ndarray:
-    """Bushing axes (rows x, y, z) on side ``sign``, kept right-handed.
-
-    A reflection makes the frame left-handed; the axis closest to the lateral direction is then
-    reversed, so the longitudinal and vertical axes keep their world sense on both sides.
-    """
-    rows = np.array([mirror(a, sign) for a in axes])
-    if sign < 0:
-        rows[_reversed_axis(axes)] *= -1.0
-    return rows
-
-
-def mirror_signs(axes, sign: float) -> np.ndarray:
-    """Per direction (x, y, z, rx, ry, rz), +1 or −1: in the mirror image of a left-side motion, a
-    direction's deflection on side ``sign`` is this sign times the left one's.
-
-    On the right the reversed axis (:func:`mirror_axes`) flips its translation, and a reflection
-    flips every rotation (a pseudovector) except the one about the reversed axis.
-    """
-    signs = np.ones(6)
-    if sign < 0:
-        k = _reversed_axis(axes)
-        signs[k] = -1.0
-        signs[3:] = -1.0
-        signs[3 + k] = 1.0
-    return signs
-
-
-def mirrored_law(params, effects: Effects, sign: float):
-    """(law, effects) of a direction whose deflection is the left one's times ``sign`` (see
-    :func:`mirror_signs`): F(e) becomes −F(−e), so the elastic law's sides, the preload and the
-    asymmetry swap; the rest of a law is odd already."""
-    if sign > 0:
-        return params, effects
-    p = params.replace(N_sup=-params.N_inf, N_inf=-params.N_sup, S_sup=-params.S_inf, S_inf=-params.S_sup,
-                       P_sup=params.P_inf, P_inf=params.P_sup)
-    return p, dataclasses.replace(effects, preload=-effects.preload, asymmetry=-effects.asymmetry)
-
-
-def wheel_axis(toe: float, camber: float, sign: float) -> np.ndarray:
-    """Outward unit spin axis of a wheel with toe-in ``toe`` and camber ``camber`` [rad]."""
-    return np.array([math.cos(camber) * math.sin(toe), sign * math.cos(camber) * math.cos(toe),
-                     -math.sin(camber)])
-
-
-def frame_from(primary: np.ndarray, secondary: np.ndarray, order: str = "zx") -> np.ndarray:
-    """Rotation matrix (columns = local axes in world) with ``order[0]`` along ``primary``."""
-    a = primary / np.linalg.norm(primary)
-    b = secondary - a * (a @ secondary)
-    b /= np.linalg.norm(b)
-    cols = {order[0]: a, order[1]: b}
-    if order == "zx":
-        cols["y"] = np.cross(a, b)
-    elif order == "yx":
-        cols["z"] = np.cross(b, a)
-    elif order == "xy":
-        cols["z"] = np.cross(a, b)
-    return np.column_stack([cols["x"], cols["y"], cols["z"]])
 
 
 def _quat(rot: np.ndarray) -> np.ndarray:

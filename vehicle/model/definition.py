@@ -1,34 +1,24 @@
-"""Vehicle definition: load and validate a vehicle YAML file (format: models/vehicles/README.md).
+"""The vehicle definition: what a vehicle file holds, validated, in SI and ISO 8855 (x forward, y left,
+z up); hardpoints are the left side's, the right side being their mirror image.
 
-Everything returned is SI (m, kg, N, s, rad) and ISO 8855 (x forward, y left, z up); hardpoints
-are the left side's, the right side being their mirror image. Bushing directions keep their
-parameters in the bushing library's user-facing form and are converted by
-:meth:`DirectionDef.channel` (and their law extensions by :meth:`DirectionDef.effects_si`). Bad
-input raises :class:`InputError` naming file, key and value.
-
-The catalogue's extensions (spec measured-data.md §2) are parameters of the definition, off by
-default: bushing law effects and directional coupling per bushing, the front struts' friction and a
-factor on the twist beam's torsion; :func:`with_extensions` sets them without a file (a truth
-vehicle and its hypotheses from one baseline).
+Bushing directions keep their parameters in the bushing library's user-facing form and are
+converted by :meth:`DirectionDef.channel` (and their law extensions by :meth:`DirectionDef.effects_si`).
+The file is read by :mod:`vehicle.model.vehicle_file`, which also sets the catalogue's extensions
+(spec measured-data.md §2) without a file.
 """
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Callable, Mapping, Sequence
+from typing import Any, Mapping
 
 import numpy as np
-import yaml
 
+from bushings.effects import Effects, effects_to_si
+from bushings.parameter_sets import load_parameter_set
+from bushings.parameters import MODELS, ChannelParams, to_si
 from vsim_core.errors import InputError
-from vsim_core.shipped import DEFAULT_VEHICLE
-
-if TYPE_CHECKING:
-    from bushings.effects import Effects
-
-#: Folder of the vehicle files shipped with the project.
 
 FRONT_POINTS = ("wheel_centre", "lower_ball_joint", "wishbone_front_pivot", "wishbone_rear_pivot",
                 "strut_top", "strut_lower", "tie_rod_outer", "tie_rod_inner")
@@ -36,13 +26,16 @@ REAR_POINTS = ("wheel_centre", "arm_pivot", "beam_centre", "spring_lower", "spri
                "damper_lower", "damper_upper")
 FRONT_MASSES = ("wishbone", "knuckle", "strut_rod", "rack")
 REAR_MASSES = ("arm", "hub")
+#: The car's sides (+1 left, −1 right for mirroring) and its corners.
+SIDES = (("left", 1.0), ("right", -1.0))
+CORNERS = ("front_left", "front_right", "rear_left", "rear_right")
+#: Models ``--bushings`` may put on every bushing direction (:meth:`DirectionDef.channel`).
+BUSHING_MODELS = ("linear", "sts", "rt", "stvs")
 #: Bushing directions: translations along, then rotations about, the bushing's own x, y, z axes.
 DIRECTIONS = ("x", "y", "z", "rx", "ry", "rz")
 #: Parts a bushing may connect (`child`); the parent is always the body.
 BUSHING_PARTS = ("front.wishbone", "rear.arm")
 Vec3 = tuple[float, float, float]
-#: Source named in the errors of :func:`with_extensions`.
-EXTENSIONS_SOURCE = "with_extensions"
 
 
 @dataclass(frozen=True)
@@ -100,7 +93,7 @@ class Families:
 NO_FAMILIES = Families({}, 1.0)
 
 
-def scaled_like(reference, K0: float, lever_arm: float = 1.0):
+def scaled_like(reference: ChannelParams, K0: float, lever_arm: float = 1.0) -> ChannelParams:
     """``reference`` (SI :class:`bushings.ChannelParams` of a translation) scaled to stiffness ``K0``.
 
     Forces scale by ``a`` at equal deflections; with ``lever_arm`` ℓ the result is a rotation law
@@ -136,13 +129,10 @@ class DirectionDef:
     def effects_si(self) -> Effects:
         """The law's :class:`bushings.effects.Effects` (SI): its set's ``effects`` with this
         direction's own ``effects`` keys over them. They apply whatever model the law is read as."""
-        from bushings.effects import effects_to_si
-        from bushings.parameters import load_parameter_set
-
         own = load_parameter_set(self.set_name).effects if self.set_name is not None else {}
         return effects_to_si({**own, **self.effects}, self.quantity, self.source)
 
-    def channel(self, override_model: str | None = None):
+    def channel(self, override_model: str | None = None) -> ChannelParams:
         """SI :class:`bushings.ChannelParams` of this direction, optionally read as another model.
 
         ``override_model`` (run-time ``--bushings``) reads the direction's own set or inline
@@ -150,8 +140,6 @@ class DirectionDef:
         drops Co and pw; anything read as ``linear`` keeps K0); otherwise the vehicle's family
         set of that model is scaled to the direction's own K0 (:class:`Families`).
         """
-        from bushings.parameters import MODELS, load_parameter_set, to_si
-
         pset = load_parameter_set(self.set_name) if self.set_name is not None else None
         if pset is not None and pset.quantity != self.quantity:
             raise InputError(f"parameter set {self.set_name!r} is a {pset.quantity} set; this "
@@ -206,6 +194,8 @@ class BushingDef:
 
 @dataclass(frozen=True)
 class Tyre:
+    """The wheel and tyre: loaded radius and the wheel's mass and inertia."""
+
     radius: float                        #: loaded radius [m]
     wheel_mass: float                    #: [kg]
     wheel_inertia: tuple[float, float]   #: about the spin axis and a diameter [kg·m²]
@@ -213,6 +203,8 @@ class Tyre:
 
 @dataclass(frozen=True)
 class Body:
+    """The sprung body: mass, CG, inertia and where its ride height is measured."""
+
     mass: float                          #: sprung mass [kg]
     cg: Vec3                             #: [m]
     inertia: Vec3                        #: principal inertias about the CG [kg·m²]
@@ -222,6 +214,8 @@ class Body:
 
 @dataclass(frozen=True)
 class FrontAxle:
+    """The pseudo-McPherson front axle (left side): hardpoints, alignment, masses, spring, damper, bar, steering."""
+
     hardpoints: Mapping[str, Vec3]       #: left side [m]
     static_toe: float                    #: toe-in [rad]
     static_camber: float                 #: top outward positive [rad]
@@ -235,6 +229,8 @@ class FrontAxle:
 
 @dataclass(frozen=True)
 class RearAxle:
+    """The twist-beam rear axle (left side): hardpoints, alignment, masses, the beam's torsion, spring, damper."""
+
     hardpoints: Mapping[str, Vec3]
     static_toe: float                    #: [rad]
     static_camber: float                 #: [rad]
@@ -269,368 +265,6 @@ class VehicleDefinition:
         return np.array(getattr(self, axle).hardpoints[name])
 
 
-class _Reader:
-    """Checks one mapping of the file: typed getters that name the dotted key on error."""
-
-    def __init__(self, data: Any, source: str, key: str, allowed: tuple[str, ...]):
-        self.source, self.key = source, key
-        if not isinstance(data, Mapping):
-            raise InputError(f"expected a mapping, got {data!r}", source=source, key=key or None)
-        unknown = sorted(set(data) - set(allowed))
-        if unknown:
-            raise InputError(f"unknown key {unknown[0]!r}; expected one of {', '.join(allowed)}",
-                             source=source, key=self.sub(unknown[0]))
-        self.data = data
-
-    def sub(self, name: str) -> str:
-        return f"{self.key}.{name}" if self.key else name
-
-    def raw(self, name: str, default: Any = ...) -> Any:
-        if name not in self.data:
-            if default is ...:
-                raise InputError("missing key", source=self.source, key=self.sub(name))
-            return default
-        return self.data[name]
-
-    def number(self, name: str, *, positive: bool = False, nonneg: bool = False, default: Any = ...) -> float:
-        value = self.raw(name, default)
-        return _number(value, self.source, self.sub(name), positive=positive, nonneg=nonneg)
-
-    def vector(self, name: str, n: int = 3) -> tuple[float, ...]:
-        return _vector(self.raw(name), self.source, self.sub(name), n)
-
-    def reader(self, name: str, allowed: tuple[str, ...]) -> "_Reader":
-        return _Reader(self.raw(name), self.source, self.sub(name), allowed)
-
-
-def _number(value: Any, source: str, key: str, *, positive: bool = False, nonneg: bool = False) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise InputError(f"expected a finite number, got {value!r}", source=source, key=key)
-    if positive and value <= 0:
-        raise InputError(f"expected a positive number, got {value!r}", source=source, key=key)
-    if nonneg and value < 0:
-        raise InputError(f"expected a non-negative number, got {value!r}", source=source, key=key)
-    return float(value)
-
-
-def _vector(value: Any, source: str, key: str, n: int) -> tuple[float, ...]:
-    if not isinstance(value, (list, tuple)) or len(value) != n:
-        raise InputError(f"expected a list of {n} numbers, got {value!r}", source=source, key=key)
-    return tuple(_number(v, source, f"{key}[{i}]") for i, v in enumerate(value))
-
-
-def _curve(value: Any, source: str, key: str) -> Curve:
-    if not isinstance(value, (list, tuple)) or len(value) < 2:
-        raise InputError(f"expected a list of at least two [x, F] points, got {value!r}", source=source, key=key)
-    pts = [_vector(p, source, f"{key}[{i}]", 2) for i, p in enumerate(value)]
-    xs = [p[0] for p in pts]
-    if any(b <= a for a, b in zip(xs, xs[1:])):
-        raise InputError(f"expected strictly increasing x values, got {xs}", source=source, key=key)
-    return Curve(tuple(xs), tuple(p[1] for p in pts))
-
-
-def _spring(r: _Reader) -> Spring:
-    if ("rate" in r.data) == ("curve" in r.data):
-        raise InputError("give exactly one of `rate` [N/m] or `curve` [[compression m, force N], ...]",
-                         source=r.source, key=r.key)
-    if "rate" in r.data:
-        k = r.number("rate", positive=True)
-        curve = Curve((-1.0, 1.0), (-k, k))
-    else:
-        curve = _curve(r.raw("curve"), r.source, r.sub("curve"))
-    preload = r.raw("preload", "auto")
-    if preload == "auto":
-        return Spring(curve, None)
-    return Spring(curve, _number(preload, r.source, r.sub("preload")))
-
-
-def _points(r: _Reader, names: tuple[str, ...]) -> dict[str, Vec3]:
-    points = {name: r.vector(name) for name in names}
-    for name, p in points.items():
-        if p[1] <= 0 and name != "beam_centre":
-            raise InputError(f"expected a left-side point (y > 0), got {list(p)}", source=r.source, key=r.sub(name))
-    return points
-
-
-def _masses(r: _Reader, names: tuple[str, ...]) -> dict[str, float]:
-    return {name: r.number(name, positive=True) for name in names}
-
-
-def _per_side(value: Any, source: str, key: str) -> tuple[float, float]:
-    """A non-negative value for both sides, or ``{left: a, right: b}``: (left, right)."""
-    if isinstance(value, Mapping):
-        r = _Reader(value, source, key, ("left", "right"))
-        return r.number("left", nonneg=True), r.number("right", nonneg=True)
-    v = _number(value, source, key, nonneg=True)
-    return v, v
-
-
-def _mapping(value: Any, source: str, key: str) -> dict[str, Any]:
-    if not isinstance(value, Mapping):
-        raise InputError(f"expected a mapping, got {value!r}", source=source, key=key)
-    return dict(value)
-
-
-def _checked(d: DirectionDef, source: str, key: str) -> DirectionDef:
-    """``d`` after building its law and effects once, so that errors name ``source`` and ``key``."""
-    try:
-        d.channel()
-        d.effects_si()
-    except InputError as exc:
-        if exc.source and exc.source.startswith(source):
-            raise
-        raise InputError(str(exc), source=source, key=key) from exc
-    return d
-
-
-def _direction(value: Any, source: str, key: str, quantity: str, families: Families) -> DirectionDef:
-    r = _Reader(value, source, key, ("set", "model", "params", "effects"))
-    if ("set" in r.data) == ("params" in r.data):
-        raise InputError("give either `set` (a parameter set of models/bushings/) or `model` with `params`",
-                         source=source, key=key)
-    model = r.raw("model", None)
-    if model is not None and not isinstance(model, str):
-        raise InputError(f"expected a model name, got {model!r}", source=source, key=r.sub("model"))
-    effects = _mapping(r.raw("effects", {}), source, r.sub("effects"))
-    if "set" in r.data:
-        name = r.raw("set")
-        if not isinstance(name, str):
-            raise InputError(f"expected a parameter-set name, got {name!r}", source=source, key=r.sub("set"))
-        d = DirectionDef(quantity, name, model, None, f"{source}: {key}", families, effects)
-    else:
-        if model is None:
-            raise InputError("missing key (inline parameters need a model)", source=source, key=r.sub("model"))
-        if not isinstance(r.raw("params"), Mapping):
-            raise InputError(f"expected a mapping of parameters, got {r.raw('params')!r}",
-                             source=source, key=r.sub("params"))
-        d = DirectionDef(quantity, None, model, dict(r.raw("params")), f"{source}: {key}", families, effects)
-    return _checked(d, source, key)
-
-
-def _coupling(value: Any, source: str, key: str, directions: Mapping[str, DirectionDef]) -> tuple[CrossStiffness, ...]:
-    """A bushing's ``coupling`` list: ``[{directions: [a, b], stiffness: k}]``, k in N/mm between two
-    translations or N·m/deg between two rotations (mixed pairs are refused: no common unit)."""
-    from bushings.parameters import LENGTH_UNIT_SI, UNIT_LABELS
-
-    if not isinstance(value, (list, tuple)):
-        raise InputError(f"expected a list of {{directions: [a, b], stiffness: k}}, got {value!r}", source=source,
-                         key=key)
-    terms: list[CrossStiffness] = []
-    for i, item in enumerate(value):
-        r = _Reader(item, source, f"{key}[{i}]", ("directions", "stiffness"))
-        pair = r.raw("directions")
-        if (not isinstance(pair, (list, tuple)) or len(pair) != 2 or any(p not in DIRECTIONS for p in pair)
-                or pair[0] == pair[1] or any({pair[0], pair[1]} == set(t.directions) for t in terms)):
-            raise InputError(f"expected two different directions of {', '.join(DIRECTIONS)}, not coupled "
-                             f"already, got {pair!r}", source=source, key=r.sub("directions"))
-        a, b = directions[pair[0]], directions[pair[1]]
-        if a.quantity != b.quantity:
-            raise InputError(f"cannot couple a translation with a rotation ({pair[0]}, {pair[1]}): their "
-                             f"stiffness has no common unit", source=source, key=r.sub("directions"))
-        unit = LENGTH_UNIT_SI[a.quantity]
-        k = r.number("stiffness") / unit
-        # the coupled tangent [[K0_a, k], [k, K0_b]] must stay positive definite at large amplitude
-        bound = math.sqrt(a.channel().K0 * b.channel().K0)
-        if not abs(k) < bound:
-            force, length = UNIT_LABELS[a.quantity]
-            raise InputError(f"expected |stiffness| < sqrt(K0_{pair[0]}·K0_{pair[1]}) = {bound * unit:.6g} "
-                             f"{force}/{length} (the coupled law must stay positive definite), got {k * unit!r}",
-                             source=source, key=r.sub("stiffness"))
-        terms.append(CrossStiffness((pair[0], pair[1]), k))
-    return tuple(terms)
-
-
-def _axis(value: Any, source: str, key: str, points: Mapping[str, np.ndarray]) -> np.ndarray:
-    if isinstance(value, Mapping):
-        r = _Reader(value, source, key, ("from", "to"))
-        ends = []
-        for end in ("from", "to"):
-            ref = r.raw(end)
-            if ref not in points:
-                raise InputError(f"unknown hardpoint {ref!r}; expected one of {', '.join(sorted(points))}",
-                                 source=source, key=r.sub(end))
-            ends.append(points[ref])
-        v = ends[1] - ends[0]
-    else:
-        v = np.array(_vector(value, source, key, 3))
-    if np.linalg.norm(v) < 1e-9:
-        raise InputError(f"expected a non-zero direction, got {value!r}", source=source, key=key)
-    return v / np.linalg.norm(v)
-
-
-def _bushing(value: Any, source: str, key: str, points: Mapping[str, np.ndarray], families: Families) -> BushingDef:
-    r = _Reader(value, source, key, ("name", "parent", "child", "location", "axes", "directions", "coupling"))
-    name = r.raw("name")
-    if not isinstance(name, str) or not name.isidentifier():
-        raise InputError(f"expected an identifier, got {name!r}", source=source, key=r.sub("name"))
-    if r.raw("parent") != "body":
-        raise InputError(f"expected 'body', got {r.raw('parent')!r}", source=source, key=r.sub("parent"))
-    child = r.raw("child")
-    if child not in BUSHING_PARTS:
-        raise InputError(f"expected one of {', '.join(BUSHING_PARTS)}, got {child!r}", source=source,
-                         key=r.sub("child"))
-    loc = r.raw("location")
-    if isinstance(loc, str):
-        if loc not in points:
-            raise InputError(f"unknown hardpoint {loc!r}; expected one of {', '.join(sorted(points))}",
-                             source=source, key=r.sub("location"))
-        location = tuple(float(v) for v in points[loc])
-    else:
-        location = _vector(loc, source, r.sub("location"), 3)
-    ax = r.reader("axes", ("x", "y"))
-    x = _axis(ax.raw("x"), source, ax.sub("x"), points)
-    y = _axis(ax.raw("y"), source, ax.sub("y"), points)
-    y = y - x * float(x @ y)
-    if np.linalg.norm(y) < 1e-6:
-        raise InputError("axes.y is parallel to axes.x", source=source, key=ax.sub("y"))
-    y /= np.linalg.norm(y)
-    z = np.cross(x, y)
-    dr = r.reader("directions", DIRECTIONS)
-    directions = {}
-    for d in DIRECTIONS:
-        quantity = "translation" if len(d) == 1 else "rotation"
-        directions[d] = _direction(dr.raw(d), source, dr.sub(d), quantity, families)
-    coupling = _coupling(r.raw("coupling", []), source, r.sub("coupling"), directions)
-    return BushingDef(name, "body", child, location,
-                      (tuple(x.tolist()), tuple(y.tolist()), tuple(z.tolist())), directions, coupling)
-
-
-def _families(top: _Reader) -> Families:
-    if "bushing_families" not in top.data:
-        return NO_FAMILIES
-    from bushings.parameters import MODELS, load_parameter_set
-
-    r = top.reader("bushing_families", ("sets", "rotation_lever_arm"))
-    sets = r.raw("sets")
-    if not isinstance(sets, Mapping) or any(m not in MODELS or not isinstance(n, str) for m, n in sets.items()):
-        raise InputError(f"expected a mapping of model ({', '.join(MODELS)}) to parameter-set name, got {sets!r}",
-                         source=r.source, key=r.sub("sets"))
-    for m, n in sets.items():
-        try:
-            load_parameter_set(n).channel(m)
-        except InputError as exc:
-            raise InputError(str(exc), source=r.source, key=r.sub(f"sets.{m}")) from exc
-    return Families(dict(sets), r.number("rotation_lever_arm", positive=True))
-
-
-def load_vehicle(path: str | Path = DEFAULT_VEHICLE) -> VehicleDefinition:
-    """Load and validate a vehicle file; raises :class:`InputError` naming file, key and value."""
-    path = Path(path)
-    source = str(path)
-    if not path.is_file():
-        raise InputError("no such vehicle file", source=source)
-    try:
-        data = yaml.safe_load(path.read_text())
-    except yaml.YAMLError as exc:
-        raise InputError(f"not valid YAML: {exc}", source=source) from exc
-    top = _Reader(data, source, "", ("name", "description", "tyre", "body", "front", "rear", "bushing_families",
-                                     "bushings"))
-
-    t = top.reader("tyre", ("radius", "wheel_mass", "wheel_inertia"))
-    inertia = t.vector("wheel_inertia", 2)
-    if min(inertia) <= 0:
-        raise InputError(f"expected positive inertias, got {list(inertia)}", source=source, key=t.sub("wheel_inertia"))
-    tyre = Tyre(t.number("radius", positive=True), t.number("wheel_mass", positive=True), inertia)
-
-    b = top.reader("body", ("mass", "cg", "inertia", "ride_height_point", "design_ride_height"))
-    body = Body(b.number("mass", positive=True), b.vector("cg"), b.vector("inertia"),
-                b.vector("ride_height_point"), b.number("design_ride_height"))
-
-    f = top.reader("front", ("hardpoints", "static_toe", "static_camber", "masses", "spring", "damper",
-                             "anti_roll_bar", "steering", "strut_friction"))
-    front = FrontAxle(
-        hardpoints=_points(f.reader("hardpoints", FRONT_POINTS), FRONT_POINTS),
-        static_toe=math.radians(f.number("static_toe")), static_camber=math.radians(f.number("static_camber")),
-        masses=_masses(f.reader("masses", FRONT_MASSES), FRONT_MASSES),
-        spring=_spring(f.reader("spring", ("rate", "curve", "preload"))),
-        damper=Damper(_curve(f.reader("damper", ("curve",)).raw("curve"), source, "front.damper.curve")),
-        anti_roll_rate=f.reader("anti_roll_bar", ("rate",)).number("rate", nonneg=True),
-        rack_travel_per_rev=f.reader("steering", ("rack_travel_per_rev",)).number("rack_travel_per_rev",
-                                                                                  positive=True),
-        strut_friction=_per_side(f.raw("strut_friction", 0.0), source, f.sub("strut_friction")))
-    rr = top.reader("rear", ("hardpoints", "static_toe", "static_camber", "masses", "beam_torsional_stiffness",
-                             "beam_torsion_scale", "spring", "damper"))
-    rear = RearAxle(
-        hardpoints=_points(rr.reader("hardpoints", REAR_POINTS), REAR_POINTS),
-        static_toe=math.radians(rr.number("static_toe")), static_camber=math.radians(rr.number("static_camber")),
-        masses=_masses(rr.reader("masses", REAR_MASSES), REAR_MASSES),
-        beam_torsional_stiffness=rr.number("beam_torsional_stiffness", positive=True),
-        spring=_spring(rr.reader("spring", ("rate", "curve", "preload"))),
-        damper=Damper(_curve(rr.reader("damper", ("curve",)).raw("curve"), source, "rear.damper.curve")),
-        beam_torsion_scale=rr.number("beam_torsion_scale", positive=True, default=1.0))
-
-    points = {f"front.{k}": np.array(v) for k, v in front.hardpoints.items()}
-    points |= {f"rear.{k}": np.array(v) for k, v in rear.hardpoints.items()}
-    raw = top.raw("bushings")
-    if not isinstance(raw, list) or not raw:
-        raise InputError(f"expected a non-empty list of bushings, got {raw!r}", source=source, key="bushings")
-    families = _families(top)
-    bushings = tuple(_bushing(v, source, f"bushings[{i}]", points, families) for i, v in enumerate(raw))
-    names = [bu.name for bu in bushings]
-    if len(set(names)) != len(names):
-        raise InputError(f"duplicate bushing names in {names}", source=source, key="bushings")
-    for part in BUSHING_PARTS:
-        if not any(bu.child == part for bu in bushings):
-            raise InputError(f"no bushing connects {part} to the body", source=source, key="bushings")
-    name = top.raw("name")
-    if not isinstance(name, str):
-        raise InputError(f"expected a name, got {name!r}", source=source, key="name")
-    return VehicleDefinition(name, str(top.raw("description", "")), path, tyre, body, front, rear, bushings)
-
-
-def with_extensions(v: VehicleDefinition, *, strut_friction: float | Mapping[str, float] | None = None,
-                    beam_torsion_scale: float | None = None,
-                    effects: Mapping[str, Mapping[str, float]] | None = None,
-                    coupling: Mapping[str, Sequence[Mapping[str, Any]]] | None = None,
-                    laws: Mapping[str, Any] | None = None) -> VehicleDefinition:
-    """``v`` with the catalogue's extensions set, without writing a file (None keeps one as it is).
-
-    ``strut_friction`` [N] and ``beam_torsion_scale`` as the keys ``front.strut_friction`` (a number
-    for both struts or ``{left: a, right: b}``) and ``rear.beam_torsion_scale``; ``effects`` maps
-    ``"bushing.direction"`` to effect keys in parameter-set units (``{"e1_rear.z": {"mullins": 0.2}}``),
-    laid over the direction's own; ``coupling`` maps a bushing name to its new ``coupling`` list
-    (``{"e1_rear": [{"directions": ["x", "z"], "stiffness": 50.0}]}``, N/mm or N·m/deg), which
-    replaces the old one; ``laws`` maps ``"bushing.direction"`` to a
-    :class:`bushings.parameters.ParameterSet` that replaces the direction's law, its effects included
-    (a catalogue cause applied to the direction's own set). Values are checked as in a vehicle file;
-    errors name ``with_extensions``.
-    """
-    src = EXTENSIONS_SOURCE
-    front, rear = v.front, v.rear
-    if strut_friction is not None:
-        front = replace(front, strut_friction=_per_side(strut_friction, src, "strut_friction"))
-    if beam_torsion_scale is not None:
-        rear = replace(rear, beam_torsion_scale=_number(beam_torsion_scale, src, "beam_torsion_scale", positive=True))
-    bushings = {b.name: b for b in v.bushings}
-
-    def bushing(name: str, key: str) -> BushingDef:
-        if name not in bushings:
-            raise InputError(f"unknown bushing {name!r}; expected one of {', '.join(bushings)}", source=src, key=key)
-        return bushings[name]
-
-    def set_direction(target: str, key: str, change: Callable[[DirectionDef], DirectionDef]) -> None:
-        name, _, direction = str(target).partition(".")
-        b = bushing(name, key)
-        if direction not in DIRECTIONS:
-            raise InputError(f"expected 'bushing.direction' with a direction of {', '.join(DIRECTIONS)}, got "
-                             f"{target!r}", source=src, key=key)
-        d = _checked(change(b.directions[direction]), src, key)
-        bushings[name] = replace(b, directions={**b.directions, direction: d})
-
-    for target, pset in (laws or {}).items():
-        key = f"laws.{target}"
-
-        def law(d: DirectionDef) -> DirectionDef:
-            if pset.quantity != d.quantity:
-                raise InputError(f"parameter set {pset.name!r} is a {pset.quantity} set; {target} needs a "
-                                 f"{d.quantity} set", source=src, key=key)
-            return replace(d, set_name=None, model=pset.model, params=dict(pset.values), source=f"{src}: {key}",
-                           effects=dict(pset.effects))
-        set_direction(target, key, law)
-    for target, values in (effects or {}).items():
-        key = f"effects.{target}"
-        set_direction(target, key, lambda d: replace(d, effects={**d.effects, **_mapping(values, src, key)}))
-    for name, terms in (coupling or {}).items():
-        b = bushing(name, f"coupling.{name}")
-        bushings[name] = replace(b, coupling=_coupling(terms, src, f"coupling.{name}", b.directions))
-    return replace(v, front=front, rear=rear, bushings=tuple(bushings.values()))
+def is_rotation(channel: str) -> bool:
+    """Whether a bushing channel (``e1_front_left.rx``: a bushing and one of :data:`DIRECTIONS`) is a rotation."""
+    return channel.split(".")[1].startswith("r")

@@ -16,8 +16,8 @@ import numpy as np
 from scipy.optimize import brentq, fsolve
 from scipy.spatial.transform import Rotation
 
-from vehicle.model.builder import wheel_axis
 from vehicle.model.definition import VehicleDefinition
+from vehicle.model.geometry import wheel_axis
 
 
 @dataclass(frozen=True)

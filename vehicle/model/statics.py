@@ -13,8 +13,9 @@ import dataclasses
 import mujoco
 import numpy as np
 
-from vehicle.model.builder import BuildOptions, build
+from vehicle.model.builder import build
 from vehicle.model.definition import VehicleDefinition
+from vehicle.model.elements import BuildOptions
 from vehicle.model.kinematics import front_corner, rear_heave
 
 GRAVITY = 9.81

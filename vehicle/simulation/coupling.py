@@ -6,7 +6,7 @@ joint stiffness and damping implicitly, forces written to ``qfrc_applied`` expli
 * a linear bushing direction lives entirely in its joint (stiffness K0, damping C);
 * any other direction keeps a reference stiffness K_ref = K0 + Kpa (its tangent at small
   amplitude, the largest tangent of the ladder family) and its damping C in the joint; before each
-  step ONE compiled call of the bushing bank (:func:`bushings.effects.step_extended`: the law with
+  step ONE compiled call of the bushing bank (:func:`bushings.extended_bank.step_extended`: the law with
   its state extensions, if any) gives F(e) at the current deflections and only F(e) − K_ref·e is
   applied explicitly. That remainder's stiffness lies in [−Kpa, 0] ⊂ (−K_ref, 0], so the explicit
   part can never destabilise the implicit one (laws that may stiffen beyond K_ref, the nonlinear
@@ -30,7 +30,10 @@ from typing import Sequence
 import mujoco
 import numpy as np
 
-from vehicle.model.builder import CarModel, CrossTerm
+from bushings.extended_bank import ExtendedBank
+from vehicle.model.builder import CarModel
+from vehicle.model.elements import CrossTerm
+from vehicle.simulation import stepping
 
 
 def _pad_curves(curves) -> tuple[np.ndarray, np.ndarray]:
@@ -61,15 +64,13 @@ class BushingForces:
     Each channel's joint must carry its reference stiffness (K0 for linear laws, K0 + Kpa
     otherwise, see :func:`vehicle.model.builder.joint_stiffness`). The parallel damping C is taken where
     the model put it: in the joint if the joint has damping (implicit), else in the bank (explicit).
-    The bank is an :class:`bushings.effects.ExtendedBank`: a channel with a preload is mounted at
+    The bank is an :class:`bushings.extended_bank.ExtendedBank`: a channel with a preload is mounted at
     the design position (deflection 0) on every reset, with zero force there. ``cross`` are the
     bushings' cross stiffnesses between channels (:class:`vehicle.model.builder.CrossTerm`).
     """
 
     def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, channels, cross: Sequence[CrossTerm] = ()):
         self.model, self.data = model, data
-        from bushings.effects import ExtendedBank
-
         ids = np.array([mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, c.joint) for c in channels], dtype=np.int64)
         self.jnt = ids
         self.qpos = model.jnt_qposadr[ids]
@@ -183,8 +184,6 @@ class ForceCoupling:
     def kernel_arrays(self) -> tuple:
         """Arguments of :func:`vehicle.simulation.stepping.coupling_step` after ``h`` (views of the model and
         data, and this coupling's tables), rebuilt when the bank is swapped (see BushingForces.bank)."""
-        from vehicle.simulation import stepping
-
         b = self.bushings
         if self._kernel_bank is not b.bank:
             self._kernel_bank = b.bank
@@ -196,8 +195,6 @@ class ForceCoupling:
 
     def apply(self, dt: float) -> None:
         """Compute and write the forces for the next step of length ``dt`` [s] (one compiled call)."""
-        from vehicle.simulation import stepping
-
         stepping.coupling_step(dt, *self.kernel_arrays())
         b = self.bushings
         if b.bank is not None:

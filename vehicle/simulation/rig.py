@@ -11,18 +11,19 @@ from __future__ import annotations
 import dataclasses
 import math
 from contextlib import contextmanager
-from dataclasses import dataclass
 from typing import Iterator
 
 import mujoco
 import numpy as np
 
-from vehicle.simulation import stepping
-from vehicle.model.builder import CORNERS, BuildOptions, CarModel, build
-from vehicle.simulation.coupling import ForceCoupling
-from vehicle.model.definition import VehicleDefinition
+from vehicle.model.builder import CarModel, build
+from vehicle.model.definition import CORNERS, VehicleDefinition
+from vehicle.model.elements import BuildOptions
 from vehicle.model.kinematics import wheel_angles
 from vehicle.model.statics import resolve_preloads
+from vehicle.simulation import stepping
+from vehicle.simulation.coupling import ForceCoupling
+from vehicle.simulation.outputs import RigOutputs, WheelOutputs
 
 _NO_INPUTS = np.zeros((0, 17))
 _INACTIVE = np.zeros(5, dtype=bool)
@@ -30,34 +31,6 @@ _ALL_ACTIVE = np.ones(5, dtype=bool)
 # a plain int: comparing an array with the pybind enum goes element by element through Python (100 µs)
 _EQUALITY_ROW = int(mujoco.mjtConstraint.mjCNSTR_EQUALITY)
 _SIGN = {"front_left": 1.0, "front_right": -1.0, "rear_left": 1.0, "rear_right": -1.0}
-
-
-@dataclass(frozen=True)
-class WheelOutputs:
-    """What the rig measures at one wheel."""
-
-    camber: float               #: [rad], top outward positive
-    toe: float                  #: [rad], toe-in positive
-    steer: float                #: yaw of the wheel heading [rad], to the left positive
-    half_track: float           #: |y| of the wheel centre [m]
-    wheel_centre: np.ndarray    #: [m], world (= body, clamped) frame
-    pad_force: np.ndarray       #: force of the pad on the wheel (Fx, Fy, Fz) [N]
-    pad_height: float           #: measured pad (contact-point) displacement [m], bump positive
-    pad_torque: float = 0.0     #: aligning torque applied about the vertical [N·m]
-
-
-@dataclass(frozen=True)
-class RigOutputs:
-    """One sample of the rig."""
-
-    time: float                              #: [s]
-    wheels: dict[str, WheelOutputs]
-    bushing_names: tuple[str, ...]           #: ``bushing_side.direction``
-    bushing_deflection: np.ndarray           #: [m or rad] in each bushing's frame
-    bushing_force: np.ndarray                #: [N or N·m], resisting the deflection
-    spring_force: dict[str, float]           #: [N], pushing apart
-    damper_force: dict[str, float]           #: [N], pushing apart
-    closure_error: float                     #: largest loop-closure position error [m]
 
 
 class KCRig:
@@ -100,7 +73,7 @@ class KCRig:
         d.xfrc_applied[self.wheel_body, 5] = mz
 
     def set_inputs(self, u: np.ndarray) -> None:
-        """Set every rig input at once from ``u`` (SI, in the order of ``vehicle.scenarios.scenario_file.INPUT_CHANNELS``,
+        """Set every rig input at once from ``u`` (SI, in the order of ``vehicle.scenarios.channels.INPUT_CHANNELS``,
         as :meth:`play` reads its rows)."""
         self.set_pads(u[0:4])
         self.set_pad_loads(fx=u[4:8], fy=u[8:12], mz=u[12:16])
@@ -134,7 +107,7 @@ class KCRig:
 
     def play(self, inputs: np.ndarray) -> None:
         """Advance one time step per row of ``inputs`` (rig inputs in the order of
-        ``vehicle.scenarios.scenario_file.INPUT_CHANNELS``, SI), each row set before its step."""
+        ``vehicle.scenarios.channels.INPUT_CHANNELS``, SI), each row set before its step."""
         inputs = np.ascontiguousarray(inputs, dtype=float)
         if inputs.ndim != 2 or inputs.shape[1] != _NO_INPUTS.shape[1]:  # the compiled loop does not check
             raise ValueError(f"expected rig inputs of shape (steps, {_NO_INPUTS.shape[1]}), got {inputs.shape}")

@@ -2,7 +2,7 @@
 
 A numpy coupling called from a Python loop cost ~150–250 µs per step on the rig, more than
 ``mj_step``; here the rig inputs, the bushing bank step (the laws with their state extensions,
-:func:`bushings.effects.step_extended`), the bushings' cross stiffnesses, the damper and spring
+:func:`bushings.extended_bank.step_extended`), the bushings' cross stiffnesses, the damper and spring
 laws and ``mj_step`` (called through ctypes on the model's and data's addresses) all run in
 compiled code, so a step costs ``mj_step`` plus the bank kernel. :func:`run` gives bit-identical
 results to calling ``ForceCoupling.apply`` and ``mujoco.mj_step`` from Python (tests/test_vehicle_rig.py).
@@ -21,10 +21,10 @@ import numba as nb
 import numpy as np
 from numba.core import caching
 
-from bushings import effects as _fx
+from bushings import extended_bank as _xb
 
 # coupling_step compiles the bushing kernels into itself: its cache must follow their files too
-caching.CacheImpl._locator_classes.insert(0, _fx.kernel_stamped_locator(__file__))
+caching.CacheImpl._locator_classes.insert(0, _xb.kernel_stamped_locator(__file__))
 
 _LIB = ctypes.CDLL(str(next(Path(mujoco.__file__).parent.glob("libmujoco.so*"))))
 _mj_step = _LIB.mj_step
@@ -61,7 +61,7 @@ def coupling_step(h, qpos, qvel, qfrc, ten_length, ten_velocity, ten_J, ten_J_ro
     """Write the non-implicit forces for the next step of ``h`` [s] (see vehicle.simulation.coupling).
 
     ``bush`` = (qpos adr, dof adr, joint ids, base stiffness, K_ref, saturating, e work) of the
-    bank channels, ``bank`` = :meth:`bushings.effects.ExtendedBank.kernel_args`, ``cross`` = (qpos adr
+    bank channels, ``bank`` = :meth:`bushings.extended_bank.ExtendedBank.kernel_args`, ``cross`` = (qpos adr
     (P, 2), dof adr (P, 2), stiffness (P,)) of the cross stiffnesses, ``damp`` = (is joint, dof or
     tendon index, sign, xs, ys, intercept out [N], work), ``spring`` = (is joint, index, qpos adr,
     design, sign, xs, ys, rate, y0, nonlinear?, remainder work).
@@ -71,7 +71,7 @@ def coupling_step(h, qpos, qvel, qfrc, ten_length, ten_velocity, ten_J, ten_J_ro
     if bq.shape[0]:
         for c in range(bq.shape[0]):
             e[c] = qpos[bq[c]]
-        _fx.step_extended(e, h, *bank)
+        _xb.step_extended(e, h, *bank)
         force, tangent = bank[3], bank[4]
         for c in range(bq.shape[0]):
             if sat[c]:
@@ -108,7 +108,7 @@ def _run(mj_step, n, inputs, active, eq_data, pad_eq, rack_eq, xfrc, carriage, w
         dof_damping, tendon_damping, bush, bank, cross, damp, spring):
     """Advance ``n`` steps, row i of ``inputs`` set before step i (none if ``inputs`` has no rows).
 
-    A row holds the rig inputs in the order of ``vehicle.scenarios.scenario_file.INPUT_CHANNELS`` (17 values):
+    A row holds the rig inputs in the order of ``vehicle.scenarios.channels.INPUT_CHANNELS`` (17 values):
     pad heights [m], Fx, Fy [N] at the carriages, Mz [N·m] at the wheels, four corners each, then
     the rack [m]; ``active[g]`` says whether group g (pads, Fx, Fy, Mz, rack) is driven (else left
     as is). ``mj_step`` is MuJoCo's, passed as a ctypes function so that the compiled code can be
@@ -145,7 +145,7 @@ def coupling_arrays(coupling) -> tuple:
     idx = b.bank_idx if on else np.zeros(0, np.int64)
     bush = (b.qpos[idx].astype(np.int64), b.dof[idx].astype(np.int64), b.jnt[idx].astype(np.int64), b.K[idx].copy(),
             b.K_ref if on else np.zeros(0), b.saturating if on else np.zeros(0, np.bool_), np.zeros(idx.size))
-    bank = (b.bank if on else _fx.ExtendedBank([])).kernel_args()
+    bank = (b.bank if on else _xb.ExtendedBank([])).kernel_args()
     # the cross stiffnesses are linear and stay on when the laws are off
     cross = (b.qpos[b.cross_channels].astype(np.int64), b.dof[b.cross_channels].astype(np.int64), b.cross_k)
     c = coupling

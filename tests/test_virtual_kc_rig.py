@@ -13,24 +13,18 @@ import numpy as np
 import pytest
 import yaml
 
-from vsim_core.errors import InputError
+from vehicle.scenarios.channels import INPUT_CHANNELS
 from vsim_cli.main import main as vsim
-from vehicle.model.definition import DEFAULT_VEHICLE
+from vsim_core.errors import InputError
+from vsim_core.shipped import DEFAULT_VEHICLE
+from vsim_diagnosis.truths import load_truth
+from vsim_diagnosis.virtual_kc_rig import (DEFAULT_SCENARIOS, MEASUREMENT_DEFAULTS, KCTruth, measure_kc, parse_kc_truth,
+                                           sensor)
 from vsim_recordings.kc_dataset import read_kc_dataset
-from vsim_diagnosis.virtual_kc_rig import (
-    DEFAULT_SCENARIOS,
-    MEASUREMENT_DEFAULTS,
-    KCTruth,
-    measure_kc,
-    parse_kc_truth,
-    sensor,
-)
-from vsim_diagnosis.virtual_bench import load_truth
+from vsim_recordings.recorder import simulate
+from vsim_recordings.rig_recordings import DERIVED, measured_channels
 from vsim_recordings.run_reader import load_run
 from vsim_recordings.run_writer import RunWriter
-from vsim_recordings.rig_recordings import DERIVED, measured_channels
-from vehicle.simulation.runner import simulate
-from vehicle.scenarios.scenario_file import INPUT_CHANNELS
 
 SCALE = 0.2
 PUMPING = """name: tiny_pumping

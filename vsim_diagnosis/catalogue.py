@@ -15,7 +15,7 @@ from typing import Any, Callable, Mapping
 import numpy as np
 
 from bushings.effects import BROAD_TAUS_S, broad_relaxation_branches
-from bushings.parameters import ParameterSet
+from bushings.parameter_sets import ParameterSet
 
 
 @dataclass(frozen=True)
@@ -50,13 +50,19 @@ class Parameter:
 
 
 @dataclass(frozen=True)
-class Cause:
-    """A catalogue entry: its parameters, which baselines it applies to, and how it extends them."""
+class Entry:
+    """What the catalogue says of any cause: its physics, its signature in the data, its parameters."""
 
     id: str
     physics: str
     signature: str
     parameters: tuple[Parameter, ...]
+
+
+@dataclass(frozen=True)
+class Cause(Entry):
+    """A cause in a bushing's law: which baselines it applies to, and how it extends them."""
+
     applies: Callable[[ParameterSet], bool]
     #: (params, effects, fitted values) -> extended (params, effects), all in parameter-set units
     extend: Callable[[dict[str, Any], dict[str, Any], Mapping[str, float]], tuple[dict[str, Any], dict[str, Any]]]

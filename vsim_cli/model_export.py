@@ -5,27 +5,28 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from vehicle.model.builder import BuildOptions, build
-from vehicle.model.definition import load_vehicle
-from vehicle.model.statics import resolve_preloads
-
-BUSHING_MODELS = ("linear", "sts", "rt", "stvs")
+from vehicle.model.definition import BUSHING_MODELS
 
 
 def _export(args: argparse.Namespace) -> int:
+    from vehicle.model.builder import build
+    from vehicle.model.elements import BuildOptions
+    from vehicle.model.statics import resolve_preloads
+    from vehicle.model.vehicle_file import load_vehicle
+    from vsim_core.files import atomic_output
+
     vehicle = resolve_preloads(load_vehicle(args.vehicle))
     car = build(vehicle, BuildOptions(rig=not args.road, clamped=not args.free, bushing_model=args.bushings))
-    Path(args.output).write_text(car.xml())
+    with atomic_output(Path(args.output)) as tmp:
+        tmp.write_text(car.xml())
     print(f"wrote {args.output}: {car.model.nbody - 1} bodies, {car.model.nv} DOF, "
           f"{len(car.channels)} bushing directions, {car.model.neq} equality constraints")
     return 0
 
 
-def register(subparsers) -> None:
-    """Add ``model export``."""
-    model = subparsers.add_parser("model", help="vehicle models")
-    sub = model.add_subparsers(dest="model_command", required=True)
-    export = sub.add_parser("export", help="write the MJCF of a vehicle definition")
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add ``export`` (of the ``model`` group)."""
+    export = subparsers.add_parser("export", help="write the MJCF of a vehicle definition")
     export.add_argument("vehicle", help="vehicle YAML file (models/vehicles/)")
     export.add_argument("-o", "--output", required=True, help="MJCF file to write")
     export.add_argument("--bushings", choices=BUSHING_MODELS, default=None,

@@ -1,6 +1,6 @@
 """The catalogue at the K&C level: where each cause can sit in a vehicle, and the vehicle it makes.
 
-A *bushing* cause of :mod:`vsim_diagnosis.causes` sits in one bushing direction (the left
+A *bushing* cause of :mod:`vsim_diagnosis.catalogue` sits in one bushing direction (the left
 one's, mirrored on the right as the vehicle mirrors every law) and extends that direction's law.
 The vehicle adds three causes of its own: ``coupling`` (a cross stiffness between two directions
 of one bushing), ``strut_friction`` (Coulomb friction of the strut rods) and ``beam_torsion`` (a
@@ -16,16 +16,17 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any, Mapping
 
 import numpy as np
 import yaml
 
+from bushings.parameter_sets import ParameterSet, load_parameter_set
+from vehicle.model.definition import BushingDef, DirectionDef, VehicleDefinition
+from vehicle.model.vehicle_file import with_extensions
+from vsim_core.documents import Document
 from vsim_core.errors import InputError
-from bushings.parameters import ParameterSet, load_parameter_set
-from vehicle.model.definition import BushingDef, DirectionDef, VehicleDefinition, with_extensions
-from vsim_diagnosis.causes import CAUSES, Parameter, draw_parameters
+from vsim_diagnosis.catalogue import CAUSES, Entry, Parameter, draw_parameters
 
 #: Bushing causes at the K&C level (see the module docstring for self_heating).
 BUSHING_CAUSES = tuple(c for c in CAUSES if c != "self_heating")
@@ -34,13 +35,9 @@ DIRECTIONS = ("x", "y", "z")
 
 
 @dataclass(frozen=True)
-class VehicleCause:
+class VehicleCause(Entry):
     """A cause the vehicle holds outside its bushing laws."""
 
-    id: str
-    physics: str
-    signature: str
-    parameters: tuple[Parameter, ...]
     located: bool            #: sits in one bushing (``coupling``) rather than in the whole axle
 
 
@@ -99,6 +96,7 @@ class Hypothesis:
 
     @property
     def label(self) -> str:
+        """``cause@bushing.direction`` (or the axle cause alone), for people."""
         where = {1: "{0}", 2: "{0}.{1}", 3: "{0}.{1}/{2}"}.get(len(self.location), "").format(*self.location)
         return f"{self.cause}@{where}" if where else self.cause
 
@@ -216,7 +214,7 @@ def extended_vehicle_yaml(baseline: VehicleDefinition, hypotheses: list[Hypothes
     """The baseline's vehicle file with the hypotheses written in (inline laws, ``coupling`` lists,
     ``front.strut_friction``, ``rear.beam_torsion_scale``), headed by ``note``: a file ``vsim run``
     reads. Comments of the baseline file are not kept; its values are."""
-    data = yaml.safe_load(Path(baseline.path).read_text())
+    data = Document.read(baseline.path, "no such vehicle file").data
     entries = {b["name"]: b for b in data["bushings"]}
     extended = extended_vehicle(baseline, hypotheses)
     for h in hypotheses:

@@ -1,0 +1,69 @@
+"""What a built car model is made of besides MuJoCo's own objects: the options it was built with, its
+bushing channels (a joint and its force law), their cross stiffnesses, and its spring and damper
+elements. Readers of a model's parts need no MuJoCo."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from bushings.effects import NO_EFFECTS, Effects
+from bushings.parameters import ChannelParams
+from vehicle.model.definition import Curve, Spring
+
+
+@dataclass(frozen=True)
+class BuildOptions:
+    """How to build: rig or road, clamped or free body, bushing model override, time step."""
+
+    rig: bool = True                    #: add the K&C rig (pads, rack drive, wheel locks)
+    clamped: bool = True                #: body fixed to the world; otherwise a free joint
+    bushing_model: str | None = None    #: read every named bushing set as this model
+    rigid_bushings: bool = False        #: translations rigid (kinematics); rotations unchanged
+    timestep: float = 1e-3              #: [s]
+
+
+@dataclass
+class Channel:
+    """One bushing direction: a joint of the model and its force law."""
+
+    name: str                            #: e.g. ``e1_front_left.y``
+    joint: str
+    params: ChannelParams                #: the law (SI)
+    effects: Effects = NO_EFFECTS        #: state extensions of the law (bushings.effects, SI)
+
+    @property
+    def linear(self) -> bool:
+        """True when the whole law fits in the joint's stiffness and damping."""
+        p = self.params
+        return (p.model == "linear" and not math.isfinite(p.S_sup) and not math.isfinite(p.S_inf)
+                and not self.effects.active)
+
+
+@dataclass(frozen=True)
+class CrossTerm:
+    """A cross stiffness between two bushing joints: τ_a += −k·q_b, τ_b += −k·q_a (explicit)."""
+
+    joint_a: str
+    joint_b: str
+    stiffness: float                     #: k [N/m or N·m/rad], this side's sign included
+
+
+@dataclass
+class Element:
+    """A spring or damper acting along a scalar coordinate (a slide joint or a tendon)."""
+
+    name: str
+    kind: str                            #: "joint" or "tendon"
+    target: str                          #: joint or tendon name
+    sign: float                          #: compression = sign × (coordinate − design value)
+    spring: Spring | None = None
+    preload: float = 0.0                 #: [N]
+    damper_curve: Curve | None = None    #: compression speed [m/s] → force [N]
+
+
+def joint_stiffness(channel: Channel) -> float:
+    """Stiffness to put in a bushing joint: the whole law if linear (implicit), else the
+    reference tangent K0 + Kpa (the rest is applied explicitly by :mod:`vehicle.simulation.coupling`)."""
+    p = channel.params
+    return p.K0 if channel.linear else p.K0 + p.Kpa

@@ -1,0 +1,46 @@
+"""The standard K&C tests (spec vehicle.md §4): quasi-static triangles on both axles at once.
+
+Each test starts from the design pose with virgin bushings, rests :data:`SETTLE` s, then runs the
+triangle 0 → +A → −A → +A at a constant rate; the +A → −A leg gives the unloading (down) branch,
+the −A → +A leg the loading (up) branch.
+
+========  ======================================  ============  ======================  =========
+test      input (every wheel of both axles)        A             rate                    duration
+========  ======================================  ============  ======================  =========
+bump      pad heights in phase (bump +)            25 mm         25 mm/s (≈ thesis       5 s
+                                                                 60 mm at 0.1 Hz)
+roll      pads in opposite phase, right up         25 mm         25 mm/s                 5 s
+lateral   Fy at the contact points, +y (left)      2 kN/wheel    2 kN/s                  5 s
+longit.   Fx at the contact points, −x (braking)   1.5 kN/wheel  2 kN/s                  3.75 s
+aligning  Mz about the vertical, +z (to the left)  150 N·m       200 N·m/s               3.75 s
+========  ======================================  ============  ======================  =========
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+SETTLE = 0.5             #: rest before each test [s]
+SAMPLES_PER_LEG = 200    #: samples on each of the down and up legs
+
+
+@dataclass(frozen=True)
+class Triangle:
+    """One quasi-static triangle applied to all four wheels."""
+
+    name: str
+    input: str               #: ``pads``, ``fx``, ``fy`` or ``mz`` (see :meth:`vehicle.simulation.rig.KCRig.ramp`)
+    pattern: tuple[float, float, float, float]   #: per corner (order of CORNERS), times the amplitude
+    amplitude: float         #: [m, N or N·m]
+    rate: float              #: [m/s, N/s or N·m/s]
+
+
+TESTS = (
+    Triangle("bump", "pads", (1, 1, 1, 1), 0.025, 0.025),
+    Triangle("roll", "pads", (-1, 1, -1, 1), 0.025, 0.025),
+    Triangle("lateral", "fy", (1, 1, 1, 1), 2000.0, 2000.0),
+    Triangle("longitudinal", "fx", (-1, -1, -1, -1), 1500.0, 2000.0),
+    Triangle("aligning", "mz", (1, 1, 1, 1), 150.0, 200.0),
+)
+TEST = {t.name: t for t in TESTS}   #: the tests by name
+

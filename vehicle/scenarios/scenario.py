@@ -1,0 +1,126 @@
+"""A rig scenario as the simulation plays it: its cases, each a time history of the rig inputs (SI),
+the rest phases before them, and the limits beyond which a run has diverged."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Mapping
+
+import numpy as np
+
+from vehicle.model.elements import BuildOptions
+
+#: Scenario types driving one input quantity with a triangle or a sine, and that quantity.
+SIGNAL_TYPES = {"pumping": "pad_z", "roll": "pad_z", "lateral_force": "pad_fy",
+                "longitudinal_force": "pad_fx", "aligning_torque": "pad_mz"}
+#: What a bi-sine may drive: a signal type's pattern, or the rack.
+BISINE_INPUTS = (*SIGNAL_TYPES, "rack")
+TYPES = (*SIGNAL_TYPES, "rack_step", "double_rack_step", "bisine", "csv")
+SHAPES = ("triangle", "sine")
+
+#: The rig's time step [s]; output rates must divide 1/step.
+RIG_TIMESTEP_S = BuildOptions().timestep
+#: Largest sine frequency accepted [Hz]: 20 rig steps per period.
+MAX_FREQUENCY_HZ = 1.0 / (20 * RIG_TIMESTEP_S)
+
+
+@dataclass(frozen=True)
+class Waveform:
+    """A scalar input against time since the input start: piecewise-linear waypoints plus sines.
+
+    Beyond ``duration_s`` the value at ``duration_s`` is held. Values are SI.
+    """
+
+    times_s: tuple[float, ...]                     #: waypoint times, from 0, increasing [s]
+    values: tuple[float, ...]                      #: waypoint values [SI]
+    sines: tuple[tuple[float, float], ...] = ()    #: (amplitude [SI], frequency [Hz]) added
+
+    @property
+    def duration_s(self) -> float:
+        """Time of the last waypoint [s]."""
+        return self.times_s[-1]
+
+    def __call__(self, t_s: np.ndarray) -> np.ndarray:
+        t = np.minimum(np.asarray(t_s, dtype=float), self.duration_s)
+        out = np.interp(t, self.times_s, self.values)
+        for amplitude, frequency in self.sines:
+            out = out + amplitude * np.sin(2.0 * math.pi * frequency * t)
+        return out
+
+
+@dataclass(frozen=True)
+class InputTable:
+    """A CSV time series: every input channel at the listed times, linear in between (SI)."""
+
+    times_s: np.ndarray        #: (N,), from 0, strictly increasing [s]
+    values: np.ndarray         #: (N, len(INPUT_CHANNELS)) [m, N, N·m]
+
+
+@dataclass(frozen=True)
+class Case:
+    """One run of a scenario: its label, its parameters as written and its rig inputs (SI)."""
+
+    label: str
+    parameters: Mapping[str, Any]     #: the case's keys merged over ``defaults``, file units
+    cycles: int                       #: periods of a periodic input (1 otherwise); loops use the last
+    waveform: Waveform | None = None  #: scalar input, spread over the channels by ``pattern``
+    pattern: tuple[float, ...] = ()   #: gain of ``waveform`` on each of INPUT_CHANNELS
+    table: InputTable | None = None   #: or a full time series (csv)
+
+    @property
+    def duration_s(self) -> float:
+        """Length of the input phase [s] (settle phases not included)."""
+        return float(self.table.times_s[-1]) if self.table is not None else self.waveform.duration_s
+
+    def inputs(self, t_s: np.ndarray) -> np.ndarray:
+        """Rig inputs (len(t_s), len(INPUT_CHANNELS)) at times since the input start [s], SI."""
+        t = np.asarray(t_s, dtype=float)
+        if self.table is not None:
+            tt = np.minimum(t, self.table.times_s[-1])
+            return np.column_stack([np.interp(tt, self.table.times_s, col) for col in self.table.values.T])
+        return self.waveform(t)[:, None] * np.asarray(self.pattern)[None, :]
+
+
+@dataclass(frozen=True)
+class Settle:
+    """Rest phases before the input (the thesis holds 1 s, switches the bushing laws on, holds 1 s)."""
+
+    before_bushings_s: float = 1.0    #: bushing directions linear at their reference stiffness [s]
+    before_input_s: float = 1.0       #: bushing laws on (virgin), inputs still at rest [s]
+
+
+@dataclass(frozen=True)
+class Limits:
+    """Bounds beyond which a run is declared diverged."""
+
+    translation_m: float = 0.02       #: largest bushing translational deflection [m]
+    rotation_rad: float = math.radians(60.0)   #: largest bushing rotation [rad]
+    closure_error_m: float = 1e-3     #: largest loop-closure position error [m]
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A validated scenario file, SI inside."""
+
+    name: str
+    description: str
+    path: Path
+    text: str                         #: the file as written (stored in every recording)
+    type: str                         #: one of TYPES
+    vehicle: Path                     #: vehicle definition file
+    bushing_model: str | None         #: read every named bushing set as this model (None: as filed)
+    axles: tuple[str, ...]            #: axles receiving the input (rack inputs: ("front",))
+    output_rate_hz: float             #: recorded samples per second of simulated time
+    settle: Settle
+    limits: Limits
+    cases: tuple[Case, ...]
+
+    @property
+    def x_quantity(self) -> str | None:
+        """Per-corner signal that wheel outputs are plotted against (wheel travel, pad force or
+        torque), or None for time-only scenarios (rack steps, CSV)."""
+        kind = self.cases[0].parameters.get("input", self.type) if self.type == "bisine" else self.type
+        driven = SIGNAL_TYPES.get(kind)
+        return None if driven is None else ("wheel_travel" if driven == "pad_z" else driven)

@@ -1,0 +1,60 @@
+"""When things happen in a run of a scenario: each case's three phases (settle with the bushings
+linear, settle with their laws on, the input), in whole output intervals, one case after the other
+on one time axis."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from vehicle.scenarios.scenario import Scenario
+
+#: The phases of a case, in order (the ``phase`` signal of a recording is the index).
+PHASES = ("settle, bushings linear", "settle, bushing laws on", "input")
+
+
+@dataclass(frozen=True)
+class CaseSchedule:
+    """Step counts of a case's phases and its times in the file [s]."""
+
+    steps: tuple[int, int, int]     #: steps of each phase, multiples of the output interval
+    start_s: float                  #: time of its first sample in the file
+
+    def phase_start_s(self, phase: int, dt: float) -> float:
+        """Start of ``phase`` (index in PHASES) in the file [s], for rig steps of ``dt`` [s]."""
+        return self.start_s + sum(self.steps[:phase]) * dt
+
+    def end_s(self, dt: float) -> float:
+        """Time of the case's last sample in the file [s], for rig steps of ``dt`` [s]."""
+        return self.start_s + sum(self.steps) * dt
+
+
+@dataclass(frozen=True)
+class Progress:
+    """Where a run is, passed to the progress callback after every recorded sample."""
+
+    case: int              #: 1-based
+    cases: int
+    label: str
+    phase: int             #: index in PHASES
+    done_s: float          #: simulated time of the whole run so far [s]
+    total_s: float         #: simulated time of the whole run [s]
+
+
+def schedule(scenario: Scenario, duration_scale: float, dt: float) -> list[CaseSchedule]:
+    """Phase lengths of every case (settle times and inputs scaled by ``duration_scale``), each
+    rounded up to whole output intervals, and each case's start in the file: case k+1's first
+    sample follows case k's last one by one output interval."""
+    every = output_interval(scenario, dt)
+    out, start = [], 0.0
+    for case in scenario.cases:
+        seconds = (scenario.settle.before_bushings_s, scenario.settle.before_input_s, case.duration_s)
+        steps = tuple(every * math.ceil(round(s * duration_scale / dt, 6) / every) for s in seconds)
+        out.append(CaseSchedule(steps, start))
+        start += (sum(steps) + every) * dt
+    return out
+
+
+def output_interval(scenario: Scenario, dt: float) -> int:
+    """Rig steps of ``dt`` [s] between recorded samples."""
+    return max(1, round(1.0 / (scenario.output_rate_hz * dt)))

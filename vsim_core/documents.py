@@ -1,0 +1,187 @@
+"""The one reader of YAML files: a document's plain data with the line of every key, and typed access
+to its mappings whose errors name file:line, the dotted key, the value and what was expected.
+
+Every YAML file of the product (vehicles, scenarios, benches, parameter sets, truths, datasets, rig
+metadata) is read through :class:`Document`, which also refuses duplicate keys (YAML would let the
+last one win silently). Values built in code are checked with the same readers
+(:meth:`Document.of_data`: no lines to name).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any, Mapping
+
+import yaml
+
+from vsim_core.errors import InputError
+from vsim_core.files import read_text
+
+#: Where a value sits in a document: mapping keys and list indices from the top.
+KeyPath = tuple[Any, ...]
+
+
+def dotted(path: KeyPath) -> str:
+    """``("cases", 2, "amplitude_mm")`` → ``"cases[2].amplitude_mm"``."""
+    out = ""
+    for part in path:
+        out += f"[{part}]" if isinstance(part, int) else (f".{part}" if out else str(part))
+    return out
+
+
+class Document:
+    """A YAML document as plain data plus the line of every key path (from the composed nodes)."""
+
+    def __init__(self, text: str, source: str):
+        """Parse ``text``; InputError naming ``source`` when it is not valid YAML or repeats a key."""
+        self.source, self.text = source, text
+        loader = yaml.SafeLoader(text)
+        try:
+            node = loader.get_single_node()
+            self.data = loader.construct_document(node) if node is not None else None
+        except yaml.YAMLError as exc:
+            raise InputError(f"not valid YAML: {exc}", source=source) from exc
+        finally:
+            loader.dispose()
+        self.lines: dict[KeyPath, int] = {}
+        if node is not None:
+            self._index(node, ())
+
+    @classmethod
+    def read(cls, path: str | Path, missing: str = "no such file") -> "Document":
+        """The document in the file ``path``; InputError naming it (with the message ``missing`` when
+        it does not exist) if it cannot be read, is not UTF-8 text or not valid YAML."""
+        if not Path(path).is_file():
+            raise InputError(missing, source=str(path))
+        return cls(read_text(path), str(path))
+
+    @classmethod
+    def of_data(cls, data: Any, source: str) -> "Document":
+        """Data built in code, checked by the same readers; errors name ``source`` (no line)."""
+        doc = cls.__new__(cls)
+        doc.source, doc.text, doc.data, doc.lines = source, "", data, {}
+        return doc
+
+    def _index(self, node: yaml.Node, path: KeyPath) -> None:
+        self.lines[path] = node.start_mark.line + 1
+        if isinstance(node, yaml.MappingNode):
+            seen = set()
+            for key, value in node.value:
+                if key.value in seen:
+                    raise InputError(f"duplicate key {key.value!r}", source=f"{self.source}:{key.start_mark.line + 1}",
+                                     key=dotted(path + (key.value,)))
+                seen.add(key.value)
+                self._index(value, path + (key.value,))
+        elif isinstance(node, yaml.SequenceNode):
+            for i, item in enumerate(node.value):
+                self._index(item, path + (i,))
+
+    def where(self, path: KeyPath) -> str:
+        """``file:line`` of ``path`` (or of its closest enclosing node that has a line), else the file."""
+        at = path
+        while at not in self.lines and at:
+            at = at[:-1]
+        line = self.lines.get(at)
+        return f"{self.source}:{line}" if line else self.source
+
+    def error(self, path: KeyPath, message: str) -> InputError:
+        """An InputError at ``path``, naming its file:line and dotted key."""
+        return InputError(message, source=self.where(path), key=dotted(path) or None)
+
+    def top(self, allowed: tuple[str, ...]) -> "Fields":
+        """The document's top mapping, checked against the ``allowed`` keys."""
+        return Fields.of(self, (), self.data, allowed)
+
+
+def check_number(doc: Document, path: KeyPath, value: Any, *, positive: bool = False, nonneg: bool = False,
+                 nonzero: bool = False, integer: bool = False) -> float:
+    """``value`` (found at ``path`` of ``doc``) as a finite float with the properties asked for;
+    InputError at ``path`` otherwise."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise doc.error(path, f"expected a finite number, got {value!r}")
+    if integer and value != int(value):
+        raise doc.error(path, f"expected a whole number, got {value!r}")
+    for bad, what in ((positive and value <= 0, "positive"), (nonneg and value < 0, "non-negative"),
+                      (nonzero and value == 0, "non-zero")):
+        if bad:
+            raise doc.error(path, f"expected a {what} number, got {value!r}")
+    return float(value)
+
+
+def check_vector(doc: Document, path: KeyPath, value: Any, n: int) -> tuple[float, ...]:
+    """``value`` (found at ``path``) as a list of ``n`` finite numbers; InputError at ``path`` otherwise."""
+    if not isinstance(value, (list, tuple)) or len(value) != n:
+        raise doc.error(path, f"expected a list of {n} numbers, got {value!r}")
+    return tuple(check_number(doc, path + (i,), v) for i, v in enumerate(value))
+
+
+class Fields:
+    """Typed access to a mapping of a document; each value remembers where it was written."""
+
+    def __init__(self, doc: Document, values: Mapping[str, tuple[Any, KeyPath]], where: KeyPath):
+        """``values`` maps each key to (value, where it was written); ``where`` is the mapping's own path."""
+        self.doc, self.values, self.where = doc, values, where
+
+    @classmethod
+    def of(cls, doc: Document, path: KeyPath, data: Any, allowed: tuple[str, ...]) -> "Fields":
+        """The mapping ``data`` at ``path``, checked against the ``allowed`` keys."""
+        if not isinstance(data, Mapping):
+            raise doc.error(path, f"expected a mapping, got {data!r}")
+        fields = cls(doc, {k: (v, path + (k,)) for k, v in data.items()}, path)
+        fields.check_keys(allowed)
+        return fields
+
+    def check_keys(self, allowed: tuple[str, ...], context: str = "") -> None:
+        """InputError at the first key not in ``allowed`` (``context`` says for what)."""
+        for key, (_, path) in self.values.items():
+            if key not in allowed:
+                raise self.doc.error(path, f"unknown key {key!r}{context}; expected one of {', '.join(allowed)}")
+
+    def has(self, key: str) -> bool:
+        """Whether ``key`` was given."""
+        return key in self.values
+
+    def path(self, key: str) -> KeyPath:
+        """Where ``key``'s value was written (or would be)."""
+        return self.values[key][1] if key in self.values else self.where + (key,)
+
+    def raw(self, key: str, default: Any = ...) -> Any:
+        """The value as written, ``default`` when absent; InputError ``missing key`` without a default."""
+        if key not in self.values:
+            if default is ...:
+                raise self.doc.error(self.where + (key,), "missing key")
+            return default
+        return self.values[key][0]
+
+    def fail(self, key: str, message: str) -> InputError:
+        """An InputError at ``key`` (to raise)."""
+        return self.doc.error(self.path(key), message)
+
+    def number(self, key: str, default: Any = ..., *, positive: bool = False, nonneg: bool = False,
+               nonzero: bool = False, integer: bool = False) -> float:
+        """A finite number (:func:`check_number`)."""
+        return check_number(self.doc, self.path(key), self.raw(key, default), positive=positive, nonneg=nonneg,
+                            nonzero=nonzero, integer=integer)
+
+    def vector(self, key: str, n: int = 3) -> tuple[float, ...]:
+        """A list of ``n`` finite numbers."""
+        return check_vector(self.doc, self.path(key), self.raw(key), n)
+
+    def choice(self, key: str, options: tuple[str, ...], default: Any = ...) -> Any:
+        """One of ``options`` (or ``default`` when absent)."""
+        value = self.raw(key, default)
+        if value not in options and not (value is None and default is None):
+            raise self.fail(key, f"expected one of {', '.join(options)}, got {value!r}")
+        return value
+
+    def text(self, key: str, default: Any = ...) -> str:
+        """A string."""
+        value = self.raw(key, default)
+        if not isinstance(value, str):
+            raise self.fail(key, f"expected a string, got {value!r}")
+        return value
+
+    def fields(self, key: str, allowed: tuple[str, ...], default: Any = ...) -> "Fields":
+        """The mapping under ``key`` (``default`` when absent), checked against ``allowed``."""
+        return Fields.of(self.doc, self.path(key), self.raw(key, default), allowed)

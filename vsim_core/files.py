@@ -1,0 +1,67 @@
+"""Reading a user's file as text; writing files and folders atomically, so that a reader sees the old
+version or the new one, never half of it."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import shutil
+import tempfile
+from pathlib import Path
+from typing import Iterator
+
+from vsim_core.errors import InputError
+
+
+def read_text(path: str | Path) -> str:
+    """The text of a user's file; InputError naming it when it cannot be read or is not UTF-8."""
+    try:
+        return Path(path).read_text(encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise InputError(f"not UTF-8 text ({exc.reason} at byte {exc.start})", source=str(path)) from None
+    except OSError as exc:
+        raise InputError(f"cannot read: {exc.strerror}", source=str(path)) from exc
+
+
+def _usual_permissions(path: str | Path, mode: int) -> None:
+    """mkstemp and mkdtemp create private files (0600, 0700): give ``path`` the umask's permissions."""
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(path, mode & ~umask)
+
+
+@contextlib.contextmanager
+def atomic_output(path: Path) -> Iterator[Path]:
+    """Yield a temporary path beside ``path``; rename it to ``path`` only if the block succeeds,
+    so that a reader never sees a half-written file."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=path.suffix, dir=path.parent)
+    os.close(fd)
+    _usual_permissions(tmp, 0o666)
+    try:
+        yield Path(tmp)
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+
+
+@contextlib.contextmanager
+def atomic_directory(root: Path, *, overwrite: bool = False) -> Iterator[Path]:
+    """A temporary folder next to ``root`` to write a whole dataset into, renamed to ``root`` when the
+    block ends without error (replacing it only if ``overwrite``) and removed otherwise.
+
+    Raises InputError if ``root`` exists and not ``overwrite``."""
+    if root.exists() and not overwrite:
+        raise InputError("exists; pass --overwrite to replace it", source=str(root))
+    root.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{root.name}.", dir=root.parent))
+    _usual_permissions(tmp, 0o777)
+    try:
+        yield tmp
+        if root.exists():
+            shutil.rmtree(root)
+        os.replace(tmp, root)
+    finally:
+        if tmp.exists():
+            shutil.rmtree(tmp)

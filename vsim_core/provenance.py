@@ -1,0 +1,27 @@
+"""What software made a file: the installed version and the source tree's commit."""
+
+from __future__ import annotations
+
+import importlib.metadata
+import subprocess
+
+from vsim_core.shipped import ROOT
+
+
+def software_version() -> str:
+    """The installed vsim version, or ``unknown``."""
+    try:
+        return importlib.metadata.version("vsim")
+    except importlib.metadata.PackageNotFoundError:
+        return "unknown"
+
+
+def git_revision() -> str:
+    """The source tree's commit (``-dirty`` if tracked files changed), or ``unknown``."""
+    try:
+        rev = subprocess.run(["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True, text=True, check=True)
+        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=ROOT,
+                               capture_output=True, text=True, check=True)
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown"
+    return rev.stdout.strip() + ("-dirty" if dirty.stdout.strip() else "")

@@ -1,0 +1,53 @@
+"""The one table of units: every unit a file, a recording or the command line may use, its
+dimension and its size, and the conversions between units of one dimension.
+
+Sizes are kept relative to the recordings' units (mm, deg, N, N·m, s), so that the common factors
+come out exact: 1000 mm per m, 57.29577951308232 deg per rad (``math.degrees(1)``), 1e-3 m per mm.
+"""
+
+from __future__ import annotations
+
+import math
+
+#: unit -> (dimension, size in the dimension's recording unit)
+_SIZES: dict[str, tuple[str, float]] = {
+    "deg": ("angle", 1.0), "rad": ("angle", 180.0 / math.pi), "arcmin": ("angle", 1.0 / 60.0),
+    "mm": ("length", 1.0), "cm": ("length", 10.0), "m": ("length", 1e3),
+    "N": ("force", 1.0), "daN": ("force", 10.0), "kN": ("force", 1e3),
+    **{f"{prefix}N{dot}m": ("torque", size) for prefix, size in (("", 1.0), ("da", 10.0), ("k", 1e3))
+       for dot in ("·", ".", "")},
+    "s": ("time", 1.0), "ms": ("time", 1e-3),
+}
+#: The SI unit of each dimension.
+SI_UNIT = {"length": "m", "angle": "rad", "force": "N", "torque": "N·m", "time": "s"}
+#: Every unit known, in the table's order.
+UNITS = tuple(_SIZES)
+
+
+def dimension(unit: str) -> str:
+    """``length``, ``angle``, ``force``, ``torque`` or ``time``; KeyError for an unknown unit."""
+    return _SIZES[unit][0]
+
+
+def factor(from_unit: str, to_unit: str) -> float:
+    """``to_unit`` per ``from_unit`` (a value in ``from_unit`` times this is in ``to_unit``);
+    ValueError across dimensions."""
+    (a, size_a), (b, size_b) = _SIZES[from_unit], _SIZES[to_unit]
+    if a != b:
+        raise ValueError(f"{from_unit} ({a}) does not convert to {to_unit} ({b})")
+    return size_a / size_b
+
+
+def si(unit: str) -> float:
+    """SI per ``unit``: 1e-3 for mm, π/180 for deg."""
+    return factor(unit, SI_UNIT[dimension(unit)])
+
+
+def per_si(unit: str) -> float:
+    """``unit`` per SI: 1000 for mm, 180/π for deg."""
+    return factor(SI_UNIT[dimension(unit)], unit)
+
+
+#: Metres per millimetre and radians per degree, the thesis's units at the boundary.
+MM = si("mm")
+DEG = si("deg")

@@ -1,0 +1,144 @@
+"""Recording a scenario run: played on the rig (:class:`vehicle.simulation.runner.ScenarioRun`) and
+written sample by sample into one MCAP run file (:func:`run_scenario`), or kept in memory as the
+same :class:`vsim_recordings.run_format.Run` without the body poses (:func:`simulate`).
+
+The file is closed and marked incomplete when the run stops early: divergence, Ctrl-C or any other
+exception (:class:`vsim_recordings.run_writer.RunWriter`).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Callable
+
+import mujoco
+import numpy as np
+
+from vehicle.model.definition import VehicleDefinition
+from vehicle.model.vehicle_file import load_vehicle
+from vehicle.scenarios.scenario import Scenario
+from vehicle.scenarios.schedule import Progress
+from vehicle.simulation.rig import KCRig
+from vehicle.simulation.runner import ScenarioRun
+from vsim_recordings.run_format import GeomSpec, Run, RunMetadata, rotation_matrix
+from vsim_recordings.run_signals import SignalLayout, run_metadata
+from vsim_recordings.run_writer import RunWriter
+
+
+@dataclass(frozen=True)
+class RunResult:
+    """A finished run: the file, its simulated and wall-clock durations."""
+
+    path: Path
+    simulated_s: float
+    wall_s: float
+
+
+def default_output(scenario: Scenario) -> Path:
+    """``out/<scenario name>.mcap`` in the working directory."""
+    return Path("out") / f"{scenario.name}.mcap"
+
+
+def layout_of(rig: KCRig, x_quantity: str | None) -> SignalLayout:
+    """The signals a run on ``rig`` records."""
+    c = rig.coupling
+    return SignalLayout(x_quantity, [ch.name for ch in rig.car.channels], [e.name for e in c.springs],
+                        [e.name for e in c.dampers])
+
+
+def _metadata(play: ScenarioRun) -> RunMetadata:
+    return run_metadata(play.scenario, play.plan, play.duration_scale, play.dt, play.rig.car.channels)
+
+
+def run_scenario(scenario: Scenario, output: Path, *, bushing_model: str | None = None, overwrite: bool = False,
+                 duration_scale: float = 1.0, progress: Callable[[Progress], None] | None = None) -> RunResult:
+    """Run every case of ``scenario`` and record them in ``output`` (one MCAP file).
+
+    ``bushing_model`` overrides the scenario's choice; ``duration_scale`` multiplies every duration
+    (settle phases, periods, holds) for quick runs. Raises InputError if ``output`` exists and not
+    ``overwrite``, DivergenceError when the simulation diverges (the file is kept, incomplete).
+    """
+    output = Path(output)
+    if bushing_model is not None:
+        scenario = replace(scenario, bushing_model=bushing_model)
+    started = time.perf_counter()
+    play = ScenarioRun(scenario, load_vehicle(scenario.vehicle), duration_scale, progress)
+    layout = layout_of(play.rig, scenario.x_quantity)
+    output.parent.mkdir(parents=True, exist_ok=True)
+    bodies = play.bodies()
+    with RunWriter(output, signals=layout.specs, bodies=bodies, geometry=geometry_from_model(play.rig.model, bodies),
+                   metadata=_metadata(play), overwrite=overwrite) as writer:
+        for s in play.samples():
+            writer.write(s.time_s, layout.values(s), s.body_pos, s.body_quat_wxyz)
+    return RunResult(output, play.total_s, time.perf_counter() - started)
+
+
+def simulate(scenario: Scenario, vehicle: VehicleDefinition | None = None, *, duration_scale: float = 1.0,
+             progress: Callable[[Progress], None] | None = None) -> Run:
+    """Run every case of ``scenario`` on ``vehicle`` (default: the scenario's file) in memory.
+
+    The result is the :class:`Run` that :func:`run_scenario` would record, without the body poses:
+    the same signals, units and metadata (``vehicle_yaml`` empty when ``vehicle`` was given, as it
+    need not come from a file).
+    """
+    play = ScenarioRun(scenario, load_vehicle(scenario.vehicle) if vehicle is None else vehicle, duration_scale,
+                       progress)
+    layout = layout_of(play.rig, scenario.x_quantity)
+    times, rows = [], []
+    for s in play.samples():
+        times.append(s.time_s)
+        rows.append(layout.values(s))
+    specs = layout.specs
+    values = np.array(rows).reshape(len(rows), len(specs))
+    metadata = _metadata(play)
+    if vehicle is not None:
+        metadata = replace(metadata, vehicle_yaml="", extra={**metadata.extra, "vehicle_file": "(in memory)"})
+    signals = {s.name: values[:, i] for i, s in enumerate(specs)}
+    return Run(path=Path("(in memory)"), t_s=np.array(times), signals=signals,
+               units={s.name: s.unit for s in specs}, groups={s.name: s.group for s in specs}, specs=specs,
+               body_names=[], body_pos=np.empty((len(values), 0, 3)), body_quat_wxyz=np.empty((len(values), 0, 4)),
+               geometry=[], metadata=metadata, complete=True, reason="")
+
+
+def geometry_from_model(model: mujoco.MjModel, bodies: list[str]) -> list[GeomSpec]:
+    """The primitives of ``bodies`` in ``model``, in the body frames, for 3D replay.
+
+    Meshes become their bounding box; planes, height fields and other non-solid geoms are left out.
+    Raises ValueError naming a body that the model does not have.
+    """
+    kinds = {
+        mujoco.mjtGeom.mjGEOM_BOX: "box",
+        mujoco.mjtGeom.mjGEOM_SPHERE: "sphere",
+        mujoco.mjtGeom.mjGEOM_CAPSULE: "capsule",
+        mujoco.mjtGeom.mjGEOM_CYLINDER: "cylinder",
+        mujoco.mjtGeom.mjGEOM_ELLIPSOID: "ellipsoid",
+    }
+    out: list[GeomSpec] = []
+    for body in bodies:
+        body_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, body)
+        if body_id < 0:
+            raise ValueError(f"body {body!r} is not in the model")
+        for g in np.flatnonzero(model.geom_bodyid == body_id):
+            geom_type = int(model.geom_type[g])
+            pos = model.geom_pos[g].astype(float)
+            quat = model.geom_quat[g].astype(float)
+            if geom_type == mujoco.mjtGeom.mjGEOM_MESH:
+                centre, half = model.geom_aabb[g, :3], model.geom_aabb[g, 3:]
+                kind, size, pos = "box", half.astype(float), pos + rotation_matrix(quat) @ centre
+            elif geom_type in kinds:
+                kind, size = kinds[geom_type], model.geom_size[g].astype(float)
+            else:
+                continue
+            out.append(
+                GeomSpec(
+                    body=body,
+                    kind=kind,
+                    size_m=tuple(float(v) for v in size),
+                    pos_m=tuple(float(v) for v in pos),
+                    quat_wxyz=tuple(float(v) for v in quat),
+                    rgba=tuple(float(v) for v in model.geom_rgba[g]),
+                )
+            )
+    return out

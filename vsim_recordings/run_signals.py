@@ -1,0 +1,121 @@
+"""What a run of a scenario on the K&C rig records: its signals (names, recorded units, groups, the
+x-axis hint of the loops), one sample's values in that order, and the run's metadata.
+
+Recorded signals (units in each label): per corner (fl, fr, rl, rr) wheel travel, camber, toe,
+steer, half-track, wheel centre, measured pad height and vertical force; the rig inputs; spring and
+damper forces; every bushing direction's deflection and force (one group per bushing); case, phase,
+time since the input start and the loop-closure error. Camber, toe and half-track carry an
+``x_axis`` hint: wheel travel (pumping, roll) or the pad force or torque of the test. The ``case``
+signal (1-based) and the ``cases`` list of the run metadata (label, parameters, start,
+bushings-on, input-start and end times) tell the cases apart.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict
+from typing import Sequence
+
+import numpy as np
+
+from vehicle.model.definition import CORNERS, is_rotation
+from vehicle.model.elements import Channel
+from vehicle.scenarios.channels import CORNER_TAGS, INPUT_CHANNELS, input_quantity
+from vehicle.scenarios.scenario import Scenario
+from vehicle.scenarios.schedule import CaseSchedule
+from vehicle.simulation.outputs import Sample
+from vsim_core import units
+from vsim_core.provenance import git_revision, software_version
+from vsim_recordings.run_format import RunMetadata, SignalSpec
+
+#: Recorded unit of each input quantity.
+INPUT_UNITS = {"pad_z": "mm", "pad_fx": "N", "pad_fy": "N", "pad_mz": "N·m", "rack": "mm"}
+_TAGS = tuple(CORNER_TAGS[c] for c in CORNERS)
+_MM, _DEG = units.per_si("mm"), units.per_si("deg")
+
+
+class SignalLayout:
+    """The recorded signals of a rig, and one sample's values in the same order."""
+
+    def __init__(self, x_quantity: str | None, bushings: Sequence[str] = (), springs: Sequence[str] = (),
+                 dampers: Sequence[str] = ()):
+        """Wheel, pad and input signals, then each named spring's and damper's force and each bushing
+        direction's (``"<bushing>.<direction>"``) deflection and force; a rig records none of those."""
+
+        def hint(tag: str) -> str | None:
+            return f"{x_quantity}_{tag}" if x_quantity else None
+
+        specs = [SignalSpec(f"wheel_travel_{t}", "mm", "wheel_travel") for t in _TAGS]
+        for quantity, unit in (("camber", "deg"), ("toe", "deg"), ("half_track", "mm")):
+            specs += [SignalSpec(f"{quantity}_{t}", unit, quantity, hint(t)) for t in _TAGS]
+        specs += [SignalSpec(f"steer_{t}", "deg", "steer") for t in _TAGS]
+        specs += [SignalSpec(f"wheel_centre_{a}_{t}", "mm", "wheel_centre") for t in _TAGS for a in "xyz"]
+        specs += [SignalSpec(f"pad_height_{t}", "mm", "pads") for t in _TAGS]
+        specs += [SignalSpec(f"pad_fz_{t}", "N", "pads") for t in _TAGS]
+        self.input_scale = np.array([units.per_si(INPUT_UNITS[input_quantity(ch)]) for ch in INPUT_CHANNELS])
+        specs += [SignalSpec(ch, INPUT_UNITS[input_quantity(ch)], "inputs") for ch in INPUT_CHANNELS]
+        self.springs = list(springs)
+        self.dampers = list(dampers)
+        specs += [SignalSpec(f"{n}_force", "N", "springs") for n in self.springs]
+        specs += [SignalSpec(f"{n}_force", "N", "dampers") for n in self.dampers]
+        self.bushings = list(bushings)
+        rotation = np.array([is_rotation(n) for n in self.bushings])
+        self.deflection_scale = np.where(rotation, _DEG, _MM)
+        for name, rot in zip(self.bushings, rotation):
+            bushing, direction = name.split(".")
+            stem = f"{bushing}_{direction}"
+            specs += [SignalSpec(f"{stem}_deflection", "deg" if rot else "mm", f"bushing_{bushing}"),
+                      SignalSpec(f"{stem}_force", "N·m" if rot else "N", f"bushing_{bushing}")]
+        specs += [SignalSpec("case", "-", "run"), SignalSpec("phase", "-", "run"),
+                  SignalSpec("input_time", "s", "run"), SignalSpec("closure_error", "mm", "run")]
+        self.specs = specs
+
+    def values(self, s: Sample) -> np.ndarray:
+        """One sample's values, in the recorded units and the order of :attr:`specs`."""
+        o = s.outputs
+        w = [o.wheels[c] for c in CORNERS]
+        centre = np.array([x.wheel_centre for x in w])
+        bushing = np.column_stack([o.bushing_deflection * self.deflection_scale, o.bushing_force]).ravel()
+        return np.concatenate([
+            (centre[:, 2] - s.design_centre_z) * _MM,
+            [x.camber * _DEG for x in w], [x.toe * _DEG for x in w], [x.half_track * _MM for x in w],
+            [x.steer * _DEG for x in w],
+            centre.ravel() * _MM,
+            [x.pad_height * _MM for x in w], [x.pad_force[2] for x in w],
+            s.inputs * self.input_scale,
+            [o.spring_force[n] for n in self.springs], [o.damper_force[n] for n in self.dampers],
+            bushing,
+            [s.case, s.phase, s.input_time_s, o.closure_error * _MM],
+        ])
+
+
+def run_metadata(scenario: Scenario, plan: list[CaseSchedule], duration_scale: float, dt: float,
+                 channels: Sequence[Channel] | None = None) -> RunMetadata:
+    """The metadata of a run of ``scenario``: the scenario, the schedule of its cases, and (for a
+    simulated run, its bushing ``channels`` given) the vehicle and bushing parameters; software
+    version and revision."""
+    cases = []
+    for k, (case, s) in enumerate(zip(scenario.cases, plan), start=1):
+        entry = {"case": k, "label": case.label, "parameters": dict(case.parameters), "cycles": case.cycles,
+                 "start_s": s.start_s, "bushings_on_s": s.phase_start_s(1, dt),
+                 "input_start_s": s.phase_start_s(2, dt), "end_s": s.end_s(dt)}
+        w = case.waveform
+        if w is not None and not w.sines and len(w.values) > 2 and w.values[-1] == w.values[-2]:
+            entry["hold_from_s"] = entry["input_start_s"] + w.times_s[-2] * duration_scale  # the final hold
+        cases.append(entry)
+    simulated = channels is not None
+    model = {"vehicle_file": str(scenario.vehicle),
+             "bushing_model": scenario.bushing_model or "as in the vehicle file"} if simulated else {}
+    return RunMetadata(
+        scenario_yaml=scenario.text,
+        vehicle_yaml=scenario.vehicle.read_text() if simulated else "",
+        bushing_parameters={ch.name: {**asdict(ch.params), "effects": asdict(ch.effects)}
+                            for ch in channels} if simulated else {},
+        software_version=software_version(),
+        git_revision=git_revision(),
+        extra={"scenario": scenario.name, "type": scenario.type, "description": scenario.description,
+               "scenario_file": str(scenario.path), **model, "axles": list(scenario.axles),
+               "x_quantity": scenario.x_quantity, "duration_scale": duration_scale,
+               "output_rate_hz": scenario.output_rate_hz, "timestep_s": dt,
+               "limits": asdict(scenario.limits), "settle": asdict(scenario.settle), "cases": cases},
+        source="simulation" if simulated else "rig",
+    )
