@@ -43,8 +43,9 @@ METRICS = (
 
 
 #: One leg of a triangle: ``leg(quantity, corner)`` is that quantity's samples on the leg (SI;
-#: quantities of :data:`WHEEL_QUANTITIES`, corners of ``vehicle.model.definition.CORNERS``). Rig samples and
-#: recorded runs both provide legs, so that both use the definitions below.
+#: quantities of :data:`vsim_analysis.kc_test.WHEEL_QUANTITIES`, corners of
+#: ``vehicle.model.definition.CORNERS``). Rig samples and recorded runs both provide legs, so that
+#: both use the definitions below.
 Leg = Callable[[str, str], np.ndarray]
 
 

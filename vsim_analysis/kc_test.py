@@ -36,7 +36,7 @@ def branches(down: list[RigOutputs], up: list[RigOutputs], x, y) -> Branches:
 
 
 def kc_metrics(rig: KCRig) -> dict[str, dict[str, float]]:
-    """Run the K&C sequence (:data:`TESTS`) on ``rig``; metrics per axle (keys of :data:`METRICS`)."""
+    """Run the K&C sequence (:data:`TESTS`) on ``rig``; metrics per axle (keys of :data:`vsim_analysis.kc_metrics.METRICS`)."""
     base = design_contact_base(rig)
     legs = {t.name: [rig_leg(samples) for samples in run_triangle(rig, t)] for t in TESTS}
     out: dict[str, dict[str, float]] = {}

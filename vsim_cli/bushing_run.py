@@ -26,7 +26,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     run = subparsers.add_parser(
         "run", help="run a bench file (programme on one bushing) and write a CSV",
         description="Impose a bench programme (triangle, sine, bisine, step, firtree, csv, sweep) on one "
-        "bushing model. Time series write t_s,e_mm,F_N; a sweep writes amplitude_mm,frequency_hz,"
+        "bushing model; a sine with static_mm is played about that static offset. Time series write t_s,e_mm,F_N; a sweep writes amplitude_mm,frequency_hz,"
         "k_dyn_n_per_mm,tan_delta (first harmonic of the last, stabilised cycle). --plot draws the "
         "force-deflection loop and the time histories (log time for a step), or for a sweep |K*| and "
         "tan delta against amplitude and frequency, with the equivalent-damping approximation (spec "

@@ -127,7 +127,7 @@ class Fields:
     def of(cls, doc: Document, path: KeyPath, data: Any, allowed: tuple[str, ...]) -> "Fields":
         """The mapping ``data`` at ``path``, checked against the ``allowed`` keys."""
         if not isinstance(data, Mapping):
-            raise doc.error(path, f"expected a mapping, got {data!r}")
+            raise doc.error(path, f"expected a mapping with keys {', '.join(allowed)}, got {data!r}")
         fields = cls(doc, {k: (v, path + (k,)) for k, v in data.items()}, path)
         fields.check_keys(allowed)
         return fields

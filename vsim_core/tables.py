@@ -14,6 +14,11 @@ from vsim_core.errors import InputError
 from vsim_core.files import atomic_output, read_text
 
 
+def read_csv_header(path: str | Path) -> list[str]:
+    """The column names of a CSV file's header line; InputError naming the file when it cannot be read."""
+    return [h.strip() for h in next(csv.reader(read_text(path).splitlines()), [])]
+
+
 def read_csv_columns(path: str | Path, columns: Sequence[str], min_rows: int) -> dict[str, np.ndarray]:
     """Read the named numeric columns of a CSV file with a header line (other columns ignored).
 

@@ -48,6 +48,6 @@ def per_si(unit: str) -> float:
     return factor(SI_UNIT[dimension(unit)], unit)
 
 
-#: Metres per millimetre and radians per degree, the thesis's units at the boundary.
-MM = si("mm")
-DEG = si("deg")
+#: Metres per millimetre and radians per degree (the thesis's units at the boundary), and their inverses.
+MM, DEG = si("mm"), si("deg")
+MM_PER_M, DEG_PER_RAD = per_si("mm"), per_si("deg")

@@ -26,6 +26,7 @@ from vehicle.model.definition import BushingDef, DirectionDef, VehicleDefinition
 from vehicle.model.vehicle_file import with_extensions
 from vsim_core.documents import Document
 from vsim_core.errors import InputError
+from vsim_core.units import DEG_PER_RAD, MM_PER_M
 from vsim_diagnosis.catalogue import CAUSES, Entry, Parameter, draw_parameters
 
 #: Bushing causes at the K&C level (see the module docstring for self_heating).
@@ -177,7 +178,7 @@ def locations(vehicle: VehicleDefinition, cause: str) -> list[tuple[str, ...]]:
 
 def _si_per_file_unit(direction: str) -> float:
     """SI per vehicle-file unit of a cross stiffness: N/m per N/mm, N·m/rad per N·m/deg."""
-    return math.degrees(1.0) if direction.startswith("r") else 1e3
+    return DEG_PER_RAD if direction.startswith("r") else MM_PER_M
 
 
 def extended_vehicle(vehicle: VehicleDefinition, hypotheses: list[Hypothesis]) -> VehicleDefinition:

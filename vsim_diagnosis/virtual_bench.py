@@ -32,6 +32,7 @@ from vsim_core.errors import InputError
 from vsim_diagnosis.catalogue import CAUSES, Parameter
 from vsim_diagnosis.measurement import parse_measurement, quantise, truth_number
 from vsim_recordings.bench_dataset import BenchTestRecord, write_bench_dataset
+from vsim_core.units import MM, MM_PER_M
 
 #: Effects the virtual rig can hide that the diagnosis's catalogue does not hold (to test that an
 #: unexplained mismatch is reported as such).
@@ -158,11 +159,11 @@ def measure_bench(truth: Truth, output: Path, *, overwrite: bool = False, tests:
         t_fine, e_fine = test.signal(test.dt_s / OVERSAMPLING)
         force = bank.run(e_fine, test.dt_s / OVERSAMPLING)[:, 0]
         t, e, F = t_fine[::OVERSAMPLING], e_fine[::OVERSAMPLING], force[::OVERSAMPLING]
-        e_mm = quantise(e * 1e3 + e_offset_mm + rng.normal(0.0, m["displacement_noise_mm"], len(e)),
+        e_mm = quantise(e * MM_PER_M + e_offset_mm + rng.normal(0.0, m["displacement_noise_mm"], len(e)),
                          m["displacement_resolution_mm"])
         F_n = quantise(F + force_offset + rng.normal(0.0, m["force_noise_n"], len(F)), m["force_resolution_n"])
         records.append(BenchTestRecord(test.name, test.programme, test.rest_before_s,
-                                       BenchRecord(test.name, t, e_mm * 1e-3, F_n)))
+                                       BenchRecord(test.name, t, e_mm * MM, F_n)))
     rig = {"name": "virtual bench", "sample_steps_s": sorted({t.dt_s for t in tests})}
     return write_bench_dataset(output, truth.part, records, rig, overwrite=overwrite)
 

@@ -13,7 +13,9 @@ from matplotlib.figure import Figure
 
 from bushings.parameter_sets import save_parameter_set
 from vsim_diagnosis.bench_diagnosis import BenchDiagnosis, aggregate
-from vsim_presentation.diagnosis_report import Report
+from vsim_diagnosis.verdict import MIN_GAIN
+from vsim_core.units import MM_PER_M
+from vsim_presentation.diagnosis_report import Report, ranking_chart
 from vsim_presentation.figures import save_figure
 
 #: Held-out records overlaid in the report (the largest baseline errors first).
@@ -26,7 +28,7 @@ def record_features(d: BenchDiagnosis) -> list[dict[str, float]]:
     out = []
     for k in range(len(d.replay.names)):
         on = d.replay.record == k
-        e = d.replay.e[on] * 1e3
+        e = d.replay.e[on] * MM_PER_M
         v = np.abs(np.diff(e) / d.replay.dts[on][1:])
         moving = v > 0.05 * v.max() if v.size else v.astype(bool)
         out.append({"amplitude_mm": float(np.ptp(e) / 2.0), "static_mm": float(np.median(e)),
@@ -65,7 +67,7 @@ def verdict_sentence(d: BenchDiagnosis) -> str:
     before, after = d.heldout_error_before, d.heldout_error_after
     if d.verdict == "none":
         return (f"Nothing significant is missing: the baseline's held-out error ({before:.2%} of the force range) "
-                f"is at the noise floor or no cause reduces it by {10:.0f} %.")
+                f"is at the noise floor or no cause reduces it by {MIN_GAIN:.0%}.")
     if d.verdict == "unexplained":
         best = d.ranking[0] if d.ranking else None
         partial = f"; the best catalogue cause, {best.cause.id}, only brings it to {best.heldout_error:.2%}" if best else ""
@@ -87,7 +89,7 @@ def _overlays(d: BenchDiagnosis, after: np.ndarray | None, out: Path) -> Path:
     for i, k in enumerate(held):
         ax = fig.add_subplot(1, len(held), i + 1)
         on = d.replay.record == k
-        e = d.replay.e[on] * 1e3
+        e = d.replay.e[on] * MM_PER_M
         step = "step" in d.replay.names[k]
         t = np.cumsum(d.replay.dts[on])
         x = t if step else e
@@ -125,16 +127,9 @@ def _residuals(d: BenchDiagnosis, features: list[dict[str, float]], out: Path) -
 
 
 def _ranking(d: BenchDiagnosis, out: Path) -> Path:
-    fig = Figure(figsize=(7, 0.5 + 0.4 * (len(d.ranking) + 1)))
-    ax = fig.add_subplot(1, 1, 1)
-    names = ["baseline"] + [c.cause.id for c in d.ranking]
-    values = [d.heldout_error_before] + [c.heldout_error for c in d.ranking]
-    ax.barh(names[::-1], [100 * v for v in values[::-1]], color=["C0"] * len(d.ranking) + ["C3"])
-    ax.axvline(100 * aggregate(d.noise, d.heldout), color="k", ls="--", lw=0.8, label="noise floor")
-    ax.set_xscale("log")
-    ax.set_xlabel("held-out RMS error [% of force range]")
-    ax.legend(fontsize=7)
-    return save_figure(fig, out)
+    return ranking_chart(100 * d.heldout_error_before, [(c.cause.id, 100 * c.heldout_error) for c in d.ranking],
+                         (100 * aggregate(d.noise, d.heldout), "noise floor"), "held-out RMS error [% of force range]",
+                         out, log=True)
 
 
 def write_report(d: BenchDiagnosis, out_dir: Path) -> list[Path]:

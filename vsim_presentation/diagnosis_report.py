@@ -1,6 +1,6 @@
 """The report both diagnosis levels write: a one-page ``report.md`` (the verdict, how it was reached,
 the ranking of the causes and the error per test, the pictures) beside ``diagnosis.json``, every file
-written atomically."""
+written atomically; and the ranking's chart."""
 
 from __future__ import annotations
 
@@ -8,7 +8,14 @@ import json
 from pathlib import Path
 from typing import Any, Iterable, Sequence
 
+from matplotlib.figure import Figure
+
 from vsim_core.files import atomic_output
+from vsim_presentation.figures import save_figure
+
+
+def _row(cells: Sequence[str]) -> str:
+    return "|" + "|".join(f" {c} " if c else " " for c in cells) + "|"
 
 
 class Report:
@@ -29,8 +36,8 @@ class Report:
 
     def table(self, header: Sequence[str], rows: Iterable[Sequence[str]]) -> None:
         """A table of text cells."""
-        self.lines += [f"| {' | '.join(header)} |", "|" + "---|" * len(header)]
-        self.lines += [f"| {' | '.join(row)} |" for row in rows]
+        self.lines += [_row(header), "|" + "---|" * len(header)]
+        self.lines += [_row(row) for row in rows]
         self.lines.append("")
 
     def picture(self, name: str) -> None:
@@ -45,3 +52,20 @@ class Report:
                 tmp.write_text(text)
             written.append(out_dir / name)
         return written
+
+
+def ranking_chart(baseline: float, causes: Sequence[tuple[str, float]], floor: tuple[float, str], xlabel: str,
+                  out: Path, *, log: bool = False) -> Path:
+    """Bars of the held-out error of the baseline (red, on top) and of each ranked ``(cause, error)``
+    (blue), the noise ``floor`` (value, label) dashed; written to ``out`` (PNG)."""
+    fig = Figure(figsize=(7, 0.5 + 0.4 * (len(causes) + 1)))
+    ax = fig.add_subplot(1, 1, 1)
+    names = ["baseline"] + [name for name, _ in causes]
+    values = [baseline] + [value for _, value in causes]
+    ax.barh(names[::-1], values[::-1], color=["C0"] * len(causes) + ["C3"])
+    ax.axvline(floor[0], color="k", ls="--", lw=0.8, label=floor[1])
+    if log:
+        ax.set_xscale("log")
+    ax.set_xlabel(xlabel)
+    ax.legend(fontsize=7)
+    return save_figure(fig, out)

@@ -14,7 +14,7 @@ from vehicle.model.definition import VehicleDefinition
 from vsim_core.files import atomic_output
 from vsim_diagnosis.kc_catalogue import extended_vehicle_yaml, parameters
 from vsim_diagnosis.kc_diagnosis import KCDiagnosis
-from vsim_presentation.diagnosis_report import Report
+from vsim_presentation.diagnosis_report import Report, ranking_chart
 from vsim_presentation.figures import save_figure
 
 #: Channels overlaid in the report (the largest baseline mismatch on held-out tests first).
@@ -122,16 +122,8 @@ def _residuals(d: KCDiagnosis, out: Path) -> Path:
 
 
 def _ranking(d: KCDiagnosis, out: Path) -> Path:
-    shown = [c for c in d.ranking if c.verified]
-    fig = Figure(figsize=(7, 0.5 + 0.4 * (len(shown) + 1)))
-    ax = fig.add_subplot(1, 1, 1)
-    names = ["baseline"] + [c.hypothesis.label for c in shown]
-    values = [d.heldout_error_before] + [c.heldout_error for c in shown]
-    ax.barh(names[::-1], values[::-1], color=["C0"] * len(shown) + ["C3"])
-    ax.axvline(1.0, color="k", ls="--", lw=0.8, label="noise")
-    ax.set_xlabel("held-out RMS error [× noise]")
-    ax.legend(fontsize=7)
-    return save_figure(fig, out)
+    return ranking_chart(d.heldout_error_before, [(c.hypothesis.label, c.heldout_error) for c in d.ranking if c.verified],
+                         (1.0, "noise"), "held-out RMS error [× noise]", out)
 
 
 def write_report(d: KCDiagnosis, baseline: VehicleDefinition, out_dir: Path, dataset: str) -> list[Path]:

@@ -28,6 +28,7 @@ from bushings.bench.records import BenchRecord, read_bench_csv
 from vsim_core.errors import InputError
 from vsim_core.files import atomic_directory
 from vsim_recordings.datasets import read_manifest, write_manifest
+from vsim_core.units import MM_PER_M
 
 _KEYS = ("level", "part", "quantity", "rig", "records")
 _RECORD_KEYS = {"file", "programme", "rest_before_s"}
@@ -96,7 +97,7 @@ def write_bench_dataset(directory: str | os.PathLike[str], part: str, records: S
         for i, r in enumerate(records, start=1):
             name = f"{i:0{width}d}_{r.name}.csv"
             rec = r.record
-            np.savetxt(tmp / name, np.column_stack([rec.t, rec.e * 1e3, rec.F]), delimiter=",",
+            np.savetxt(tmp / name, np.column_stack([rec.t, rec.e * MM_PER_M, rec.F]), delimiter=",",
                        fmt=("%.6f", "%.7f", "%.3f"), header="t_s,e_mm,F_N", comments="")
             entries.append({"file": name, "programme": r.programme, "rest_before_s": r.rest_before_s})
         manifest = {"level": "bench", "part": part, "quantity": "translation", "rig": rig, "records": entries}

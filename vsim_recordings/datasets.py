@@ -25,7 +25,10 @@ def _manifest(directory: str | os.PathLike[str]) -> tuple[Path, Any]:
 def dataset_level(directory: str | os.PathLike[str]) -> str:
     """``bench`` or ``kc``: the level a measured directory declares in its rig.yaml."""
     path, data = _manifest(directory)
-    level = data.get("level") if isinstance(data, Mapping) else None
+    if not isinstance(data, Mapping):
+        raise InputError(f"expected a mapping with a level key (bench or kc), got {type(data).__name__}",
+                         source=str(path))
+    level = data.get("level")
     if level not in LEVELS:
         raise InputError(f"expected level bench or kc, got {level!r}", source=str(path), key="level")
     return level

@@ -9,6 +9,7 @@ exception (:class:`vsim_recordings.run_writer.RunWriter`).
 from __future__ import annotations
 
 import time
+from contextlib import closing
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Callable
@@ -70,8 +71,9 @@ def run_scenario(scenario: Scenario, output: Path, *, bushing_model: str | None 
     bodies = play.bodies()
     with RunWriter(output, signals=layout.specs, bodies=bodies, geometry=geometry_from_model(play.rig.model, bodies),
                    metadata=_metadata(play), overwrite=overwrite) as writer:
-        for s in play.samples():
-            writer.write(s.time_s, layout.values(s), s.body_pos, s.body_quat_wxyz)
+        with closing(play.samples()) as samples:  # leaves the rig's context at once if writing fails
+            for s in samples:
+                writer.write(s.time_s, layout.values(s), s.body_pos, s.body_quat_wxyz)
     return RunResult(output, play.total_s, time.perf_counter() - started)
 
 
@@ -87,9 +89,10 @@ def simulate(scenario: Scenario, vehicle: VehicleDefinition | None = None, *, du
                        progress)
     layout = layout_of(play.rig, scenario.x_quantity)
     times, rows = [], []
-    for s in play.samples():
-        times.append(s.time_s)
-        rows.append(layout.values(s))
+    with closing(play.samples()) as samples:
+        for s in samples:
+            times.append(s.time_s)
+            rows.append(layout.values(s))
     specs = layout.specs
     values = np.array(rows).reshape(len(rows), len(specs))
     metadata = _metadata(play)

@@ -22,7 +22,7 @@ metadata record ``vsim.run``
     hint), the body list and the geometry (JSON). A ``rig`` record has no vehicle YAML and no
     bushing parameters: measured data carries nothing about a model.
 metadata record ``vsim.status``
-    written by :meth:`RunWriter.close`: ``complete`` (``"true"``/``"false"``) and ``reason``.
+    written by :meth:`vsim_recordings.run_writer.RunWriter.close`: ``complete`` (``"true"``/``"false"``) and ``reason``.
 
 Every time in the file is simulation time (``log_time`` = ``publish_time`` = stamp = t in ns), so
 equal inputs give bit-identical data. The file is written as ``<path>.partial`` and renamed to

@@ -24,13 +24,13 @@ from vehicle.scenarios.scenario import Scenario
 from vehicle.scenarios.schedule import CaseSchedule
 from vehicle.simulation.outputs import Sample
 from vsim_core import units
+from vsim_core.units import DEG_PER_RAD, MM_PER_M
 from vsim_core.provenance import git_revision, software_version
 from vsim_recordings.run_format import RunMetadata, SignalSpec
 
 #: Recorded unit of each input quantity.
 INPUT_UNITS = {"pad_z": "mm", "pad_fx": "N", "pad_fy": "N", "pad_mz": "N·m", "rack": "mm"}
 _TAGS = tuple(CORNER_TAGS[c] for c in CORNERS)
-_MM, _DEG = units.per_si("mm"), units.per_si("deg")
 
 
 class SignalLayout:
@@ -59,7 +59,7 @@ class SignalLayout:
         specs += [SignalSpec(f"{n}_force", "N", "dampers") for n in self.dampers]
         self.bushings = list(bushings)
         rotation = np.array([is_rotation(n) for n in self.bushings])
-        self.deflection_scale = np.where(rotation, _DEG, _MM)
+        self.deflection_scale = np.where(rotation, DEG_PER_RAD, MM_PER_M)
         for name, rot in zip(self.bushings, rotation):
             bushing, direction = name.split(".")
             stem = f"{bushing}_{direction}"
@@ -76,15 +76,15 @@ class SignalLayout:
         centre = np.array([x.wheel_centre for x in w])
         bushing = np.column_stack([o.bushing_deflection * self.deflection_scale, o.bushing_force]).ravel()
         return np.concatenate([
-            (centre[:, 2] - s.design_centre_z) * _MM,
-            [x.camber * _DEG for x in w], [x.toe * _DEG for x in w], [x.half_track * _MM for x in w],
-            [x.steer * _DEG for x in w],
-            centre.ravel() * _MM,
-            [x.pad_height * _MM for x in w], [x.pad_force[2] for x in w],
+            (centre[:, 2] - s.design_centre_z) * MM_PER_M,
+            [x.camber * DEG_PER_RAD for x in w], [x.toe * DEG_PER_RAD for x in w],
+            [x.half_track * MM_PER_M for x in w], [x.steer * DEG_PER_RAD for x in w],
+            centre.ravel() * MM_PER_M,
+            [x.pad_height * MM_PER_M for x in w], [x.pad_force[2] for x in w],
             s.inputs * self.input_scale,
             [o.spring_force[n] for n in self.springs], [o.damper_force[n] for n in self.dampers],
             bushing,
-            [s.case, s.phase, s.input_time_s, o.closure_error * _MM],
+            [s.case, s.phase, s.input_time_s, o.closure_error * MM_PER_M],
         ])
 
 

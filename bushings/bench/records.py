@@ -16,6 +16,7 @@ import numpy as np
 from bushings.bank import BushingBank
 from bushings.parameters import ChannelParams
 from vsim_core.tables import read_csv_columns
+from vsim_core.units import MM
 
 #: Columns a bench record must have (extra columns are ignored).
 RECORD_COLUMNS = ("t_s", "e_mm", "F_N")
@@ -47,7 +48,7 @@ class BenchRecord:
 def read_bench_csv(path: str | Path) -> BenchRecord:
     """Read a ``t_s,e_mm,F_N`` bench record; errors name the file, line and column."""
     cols = read_csv_columns(path, RECORD_COLUMNS, MIN_SAMPLES)
-    return BenchRecord(source=Path(path).name, t=cols["t_s"], e=cols["e_mm"] * 1e-3, F=cols["F_N"])
+    return BenchRecord(source=Path(path).name, t=cols["t_s"], e=cols["e_mm"] * MM, F=cols["F_N"])
 
 
 def simulate_record(channels: Sequence[ChannelParams], t: np.ndarray, e: np.ndarray) -> np.ndarray:

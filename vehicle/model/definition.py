@@ -138,7 +138,8 @@ class DirectionDef:
         ``override_model`` (run-time ``--bushings``) reads the direction's own set or inline
         parameters as that model when they hold its parameters (an STVS set read as ``sts``
         drops Co and pw; anything read as ``linear`` keeps K0); otherwise the vehicle's family
-        set of that model is scaled to the direction's own K0 (:class:`Families`).
+        set of that model is scaled to the direction's own K0 (:class:`Families`). Read as its own
+        model, a direction's law always comes from its own parameters (a missing one is an error).
         """
         pset = load_parameter_set(self.set_name) if self.set_name is not None else None
         if pset is not None and pset.quantity != self.quantity:
@@ -149,7 +150,7 @@ class DirectionDef:
         if target is not None and target not in MODELS:
             raise InputError(f"unknown model {target!r}; expected one of {', '.join(MODELS)}",
                              source=self.source, key="model")
-        if target is None or set(MODELS[target][0]) <= set(own):
+        if target is None or target == self.model or set(MODELS[target][0]) <= set(own):
             if pset is not None:
                 return pset.channel(target)
             values = dict(own)

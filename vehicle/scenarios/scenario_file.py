@@ -8,7 +8,6 @@ Values in the file carry their unit in the key name (``amplitude_mm``, ``amplitu
 
 from __future__ import annotations
 
-import csv
 import math
 from pathlib import Path
 
@@ -23,7 +22,8 @@ from vsim_core.documents import Document, Fields
 from vsim_core.errors import InputError
 from vsim_core.files import read_text
 from vsim_core.shipped import DEFAULT_VEHICLE
-from vsim_core.tables import read_csv_columns
+from vsim_core.tables import read_csv_columns, read_csv_header
+from vsim_core.units import MM, MM_PER_M
 
 # -- cases ------------------------------------------------------------------------------------------
 #: Keys a case (merged over ``defaults``) may have, per type; ``label`` is always allowed.
@@ -128,11 +128,11 @@ def _case(f: Fields, kind: str, axles: tuple[str, ...], base_dir: Path) -> Case:
         waveform, cycles = _periodic(f, kind)
         return Case(label, params, cycles, waveform, _pattern(kind, axles))
     if kind == "rack_step":
-        levels = [(f.number("rack_mm", nonzero=True) * 1e-3, f.number("hold_s", positive=True))]
+        levels = [(f.number("rack_mm", nonzero=True) * MM, f.number("hold_s", positive=True))]
         return Case(label, params, 1, _ramps(f, levels), _pattern("rack", axles))
     if kind == "double_rack_step":
-        first = f.number("first_mm", nonzero=True) * 1e-3
-        second = first + f.number("second_mm", nonzero=True) * 1e-3
+        first = f.number("first_mm", nonzero=True) * MM
+        second = first + f.number("second_mm", nonzero=True) * MM
         levels = [(first, f.number("rest_s", positive=True)), (second, f.number("hold_s", positive=True))]
         return Case(label, params, 1, _ramps(f, levels), _pattern("rack", axles))
     if kind == "bisine":
@@ -149,10 +149,9 @@ def read_input_csv(path: Path) -> InputTable:
     """Read a scenario time series: a header ``t_s`` plus any of :func:`csv_columns` (absent
     channels stay at 0), then one line per time, from 0. Raises InputError naming the file, the
     line and the column for an unknown or missing column, a non-number, or a time that does not
-    start at 0 or does not increase (the numbers are read by :func:`bushings.bench.records.read_csv_columns`)."""
+    start at 0 or does not increase (the numbers are read by :func:`vsim_core.tables.read_csv_columns`)."""
     columns = csv_columns()
-    with path.open(newline="") as handle:
-        header = [c.strip() for c in next(csv.reader(handle), [])]
+    header = read_csv_header(path)
     unknown = [c for c in header if c != "t_s" and c not in columns]
     if unknown:
         raise InputError(f"unknown column {unknown[0]!r}; expected t_s and any of {', '.join(columns)}",
@@ -225,9 +224,9 @@ def parse_scenario(text: str, path: Path, source: str | None = None) -> Scenario
     settle = Settle(s.number("before_bushings_s", Settle.before_bushings_s, nonneg=True),
                     s.number("before_input_s", Settle.before_input_s, nonneg=True))
     lim = Fields.of(doc, ("limits",), top.raw("limits", {}), ("translation_mm", "rotation_deg", "closure_error_mm"))
-    limits = Limits(lim.number("translation_mm", Limits.translation_m * 1e3, positive=True) * 1e-3,
+    limits = Limits(lim.number("translation_mm", Limits.translation_m * MM_PER_M, positive=True) * MM,
                     math.radians(lim.number("rotation_deg", math.degrees(Limits.rotation_rad), positive=True)),
-                    lim.number("closure_error_mm", Limits.closure_error_m * 1e3, positive=True) * 1e-3)
+                    lim.number("closure_error_mm", Limits.closure_error_m * MM_PER_M, positive=True) * MM)
 
     allowed = _case_keys(kind)
     defaults = Fields.of(doc, ("defaults",), top.raw("defaults", {}), allowed)

@@ -62,11 +62,11 @@ class BushingForces:
     """The bushing directions of a model: one bank call per step, remainder into ``qfrc_applied``.
 
     Each channel's joint must carry its reference stiffness (K0 for linear laws, K0 + Kpa
-    otherwise, see :func:`vehicle.model.builder.joint_stiffness`). The parallel damping C is taken where
+    otherwise, see :func:`vehicle.model.elements.joint_stiffness`). The parallel damping C is taken where
     the model put it: in the joint if the joint has damping (implicit), else in the bank (explicit).
     The bank is an :class:`bushings.extended_bank.ExtendedBank`: a channel with a preload is mounted at
     the design position (deflection 0) on every reset, with zero force there. ``cross`` are the
-    bushings' cross stiffnesses between channels (:class:`vehicle.model.builder.CrossTerm`).
+    bushings' cross stiffnesses between channels (:class:`vehicle.model.elements.CrossTerm`).
     """
 
     def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, channels, cross: Sequence[CrossTerm] = ()):

@@ -27,7 +27,7 @@ from vehicle.scenarios.scenario import Case, Scenario
 from vehicle.scenarios.schedule import CaseSchedule, Progress, output_interval, schedule
 from vehicle.simulation.outputs import RigOutputs, Sample
 from vehicle.simulation.rig import KCRig
-from vsim_core import units
+from vsim_core.units import DEG_PER_RAD, MM_PER_M
 from vsim_core.errors import InputError
 
 
@@ -59,14 +59,13 @@ def check_divergence(rig: KCRig, o: RigOutputs, scenario: Scenario, time_s: floa
     i = int(np.argmax(ratio))
     if ratio[i] > 1.0:
         bushing, direction = names[i].split(".")
-        scale, unit = (units.per_si("deg"), "deg") if rotation[i] else (units.per_si("mm"), "mm")
+        scale, unit = (DEG_PER_RAD, "deg") if rotation[i] else (MM_PER_M, "mm")
         raise DivergenceError(time_s, case, f"bushing {bushing}, direction {direction}: deflection "
                                             f"{o.bushing_deflection[i] * scale:.3f} {unit} beyond the limit "
                                             f"{limit[i] * scale:g} {unit}")
     if o.closure_error > scenario.limits.closure_error_m:
-        mm = units.per_si("mm")
-        raise DivergenceError(time_s, case, f"loop-closure error {o.closure_error * mm:.3f} mm beyond the limit "
-                                            f"{scenario.limits.closure_error_m * mm:g} mm")
+        raise DivergenceError(time_s, case, f"loop-closure error {o.closure_error * MM_PER_M:.3f} mm beyond the "
+                                            f"limit {scenario.limits.closure_error_m * MM_PER_M:g} mm")
 
 
 class ScenarioRun:
