@@ -144,7 +144,7 @@ def test_rack_step_compares_relaxation_over_the_hold(rack_step: Run) -> None:
 
 
 def write_resampled(run: Run, path: Path, rate_hz: float, offset_s: float) -> Path:
-    """``run`` as a rig would record it: no bodies, no bushing, spring or damper channels, sampled
+    """``run`` as a rig would record it: source ``rig`` and no model, no bodies, no bushing, spring or damper channels, sampled
     at ``rate_hz`` from ``offset_s``, between samples of the same case and phase (the runner's
     cases follow each other without a transition); signals interpolated, the schedule's steps held."""
     t = np.arange(offset_s, run.t_s[-1], 1.0 / rate_hz)
@@ -155,7 +155,8 @@ def write_resampled(run: Run, path: Path, rate_hz: float, offset_s: float) -> Pa
     specs = [s for s in run.specs if not s.group.startswith(("bushing_", "springs", "dampers"))]
     values = np.column_stack([run.signals[s.name][previous] if s.name in ("case", "phase")
                               else np.interp(t, run.t_s, run.signals[s.name]) for s in specs])
-    with RunWriter(path, signals=specs, bodies=[], geometry=[], metadata=run.metadata) as writer:
+    measured = dataclasses.replace(run.metadata, source="rig", vehicle_yaml="", bushing_parameters={})
+    with RunWriter(path, signals=specs, bodies=[], geometry=[], metadata=measured) as writer:
         for time_s, row in zip(t, values):
             writer.write(time_s, row, np.empty((0, 3)), np.empty((0, 4)))
     return path
@@ -219,3 +220,15 @@ def test_mismatched_rig_files_are_refused_with_the_file_named(pumping: Run, chan
     assert message.startswith(f"{pumping.path.with_name('rig.mcap')}: "), message
     for word in words:
         assert word in message, message
+
+
+def test_swapped_files_are_refused_before_any_difference_is_taken(pumping: Run, tmp_path: Path, capsys) -> None:
+    """Differences are simulation minus rig: a rig recording first and a simulated run second would flip
+    their sign, so the command names the rig file and says which goes first."""
+    rig = write_resampled(pumping, tmp_path / "rig.mcap", rate_hz=40.0, offset_s=0.0)
+    assert load_run(rig).metadata.source == "rig" and pumping.metadata.source == "simulation"
+    assert cli.main(["compare", str(rig), str(pumping.path)]) == 2
+    err = capsys.readouterr().err
+    assert f"{rig}: the files are swapped" in err and "expected the simulated run first" in err
+    camber = {ch.channel: ch for ch in compare_runs(pumping, load_run(rig)).cases[0].channels}["camber_fl"]
+    assert camber.rms_error < 1e-9  # in the right order the same files compare

@@ -119,6 +119,13 @@ def _check_run(run: Run) -> None:
                          f"{', '.join(_SCHEDULE)}", source=str(run.path))
 
 
+def _check_order(sim: Run, rig: Run) -> None:
+    """Differences are simulation minus rig: swapped files would change their sign unnoticed."""
+    if sim.metadata.source == "rig" and rig.metadata.source == "simulation":
+        raise InputError(f"the files are swapped: this is a measured rig recording and {rig.path} a simulated run; "
+                         "expected the simulated run first, the rig recording second", source=str(sim.path))
+
+
 def _check_cases(sim: Run, rig: Run) -> None:
     """The rig file plays the simulation's scenario: same type, duration scale and cases."""
     for key in ("type", "duration_scale"):
@@ -213,9 +220,12 @@ def _not_applicable(sim: Run, case: Mapping[str, Any]) -> dict[str, str]:
 
 def compare_runs(sim: Run, rig: Run) -> Comparison:
     """Compare ``sim`` with ``rig`` (see the module); InputError (naming the file) if either is not
-    a run of a scenario, the rig plays other cases, or they share no channel."""
+    a run of a scenario, the files are swapped (a rig recording first, a simulated run second), the rig
+    plays other cases, or they share no channel. Two runs of the same source compare too (two variants of
+    the car, two rig sessions)."""
     for run in (sim, rig):
         _check_run(run)
+    _check_order(sim, rig)
     _check_cases(sim, rig)
     names = common_channels(sim, rig)
     out = []

@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from vsim_cli.arguments import output_file, output_folder
+
 
 def _run(args: argparse.Namespace) -> int:
     from bushings.bench.bench_file import load_bench, run_bench
@@ -32,6 +34,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "tan delta against amplitude and frequency, with the equivalent-damping approximation (spec "
         "5.16/5.17) dashed over the time-domain result.")
     run.add_argument("bench", type=Path, metavar="BENCH.yaml")
-    run.add_argument("-o", "--output", type=Path, required=True, metavar="OUT.csv")
-    run.add_argument("--plot", type=Path, metavar="DIR", help="also write PNG plots into this directory")
+    run.add_argument("-o", "--output", type=output_file, required=True, metavar="OUT.csv")
+    run.add_argument("--plot", type=output_folder, metavar="DIR", help="also write PNG plots into this directory")
     run.set_defaults(func=_run)

@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from vsim_cli.arguments import output_folder
+
 
 def _compare(args: argparse.Namespace) -> int:
     from vsim_analysis.compare import compare_runs
@@ -30,6 +32,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     "simulation, rig and their difference (vsim_analysis/compare.py).")
     compare.add_argument("sim", type=Path, metavar="SIM.mcap", help="simulated run (vsim run)")
     compare.add_argument("rig", type=Path, metavar="RIG.mcap", help="measured rig recording of the same scenario")
-    compare.add_argument("-o", "--output", type=Path, metavar="DIR",
+    compare.add_argument("-o", "--output", type=output_folder, metavar="DIR",
                          help="also write DIR/comparison.json and loop and time-history overlays (PNG)")
     compare.set_defaults(func=_compare)

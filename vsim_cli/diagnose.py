@@ -7,6 +7,7 @@ import json
 import sys
 from pathlib import Path
 
+from vsim_cli.arguments import output_folder
 from vsim_core.errors import InputError
 
 
@@ -71,7 +72,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     group.add_argument("--vehicle", type=Path, metavar="V.yaml",
                        help="baseline vehicle (K&C datasets; default: the built-in car)")
     group.add_argument("--bushing-model", metavar="SET", help="baseline parameter set (bench datasets)")
-    p.add_argument("-o", "--output", type=Path, metavar="REPORT_DIR",
+    p.add_argument("-o", "--output", type=output_folder, metavar="REPORT_DIR",
                    help="write report.md, PNGs, diagnosis.json and extended_model.yaml here")
     p.add_argument("--json", action="store_true", help="print the verdict as one JSON object")
     p.set_defaults(func=_diagnose)

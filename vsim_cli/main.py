@@ -13,6 +13,7 @@ from types import ModuleType
 
 from vsim_cli import (bushing_fit, bushing_run, compare, diagnose, kc, model_export, plot, rig_import, rig_measure, run,
                       view)
+from vsim_cli.interrupts import handle_sigterm, status
 from vsim_core.errors import InputError
 
 #: Command groups: name -> (help, description, their commands' modules).
@@ -45,13 +46,19 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run ``vsim`` with ``argv``; input errors print one clear line and exit with status 2."""
+    """Run ``vsim`` with ``argv``; input errors print one clear line and exit with status 2, Ctrl-C
+    and SIGTERM one line and 128 + the signal's number."""
     args = build_parser().parse_args(argv)
+    handle_sigterm()
     try:
         return int(args.func(args) or 0)
     except InputError as exc:
         print(f"vsim: error: {exc}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt as exc:
+        print(f"vsim: interrupted ({exc or 'SIGINT'}); outputs are as they were, a run's recording is kept incomplete",
+              file=sys.stderr)
+        return status(exc)
 
 
 if __name__ == "__main__":

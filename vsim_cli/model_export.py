@@ -3,9 +3,9 @@
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
 from vehicle.model.definition import BUSHING_MODELS
+from vsim_cli.arguments import output_file
 
 
 def _export(args: argparse.Namespace) -> int:
@@ -17,7 +17,7 @@ def _export(args: argparse.Namespace) -> int:
 
     vehicle = resolve_preloads(load_vehicle(args.vehicle))
     car = build(vehicle, BuildOptions(rig=not args.road, clamped=not args.free, bushing_model=args.bushings))
-    with atomic_output(Path(args.output)) as tmp:
+    with atomic_output(args.output) as tmp:
         tmp.write_text(car.xml())
     print(f"wrote {args.output}: {car.model.nbody - 1} bodies, {car.model.nv} DOF, "
           f"{len(car.channels)} bushing directions, {car.model.neq} equality constraints")
@@ -28,7 +28,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``export`` (of the ``model`` group)."""
     export = subparsers.add_parser("export", help="write the MJCF of a vehicle definition")
     export.add_argument("vehicle", help="vehicle YAML file (models/vehicles/)")
-    export.add_argument("-o", "--output", required=True, help="MJCF file to write")
+    export.add_argument("-o", "--output", type=output_file, required=True, help="MJCF file to write")
     export.add_argument("--bushings", choices=BUSHING_MODELS, default=None,
                         help="read every bushing parameter set as this model")
     export.add_argument("--road", action="store_true", help="without the K&C rig")

@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from vsim_cli.arguments import output_folder
+
 
 def _plot(args: argparse.Namespace) -> int:
     from vsim_presentation.run_plots import plot_run
@@ -25,7 +27,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "one per signal group against time.",
     )
     plot.add_argument("run", type=Path, metavar="RUN.mcap")
-    plot.add_argument("-o", "--output", type=Path, required=True, metavar="DIR", help="directory for the PNGs")
+    plot.add_argument("-o", "--output", type=output_folder, required=True, metavar="DIR", help="directory for the PNGs")
     plot.add_argument("--log-time", action="store_true", help="time axis in log scale (relaxations), from --t0 on")
     plot.add_argument("--t0", type=float, default=0.0, metavar="SECONDS", help="time origin (e.g. of the step)")
     plot.set_defaults(func=_plot)

@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from vsim_cli.arguments import output_file
+
 
 def _import(args: argparse.Namespace) -> int:
     from vsim_recordings.csv_import import import_csv
@@ -27,6 +29,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     "vsim view like a simulated run. Nothing is written on error.")
     p.add_argument("data", type=Path, metavar="DATA.csv")
     p.add_argument("--meta", type=Path, required=True, metavar="META.yaml", help="how to read DATA.csv")
-    p.add_argument("-o", "--output", type=Path, required=True, metavar="RIG.mcap", help="rig recording to write")
+    p.add_argument("-o", "--output", type=output_file, required=True, metavar="RIG.mcap", help="rig recording to write")
     p.add_argument("--overwrite", action="store_true", help="replace an existing output file")
     p.set_defaults(func=_import)

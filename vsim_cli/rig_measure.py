@@ -6,6 +6,8 @@ import argparse
 import sys
 from pathlib import Path
 
+from vsim_cli.arguments import output_folder
+
 
 def _measure(args: argparse.Namespace) -> int:
     from vsim_diagnosis.truths import load_truth, measure
@@ -33,6 +35,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     "vehicle on the K&C rig, the scenarios of scenarios/kc; format in "
                     "vsim_diagnosis/virtual_kc_rig.py) writes rig.yaml + MCAP rig recordings (data/README.md).")
     p.add_argument("truth", type=Path, metavar="TRUTH.yaml")
-    p.add_argument("-o", "--output", type=Path, required=True, metavar="DIR", help="measured dataset to write")
+    p.add_argument("-o", "--output", type=output_folder, required=True, metavar="DIR", help="measured dataset to write")
     p.add_argument("--overwrite", action="store_true", help="replace an existing output directory")
     p.set_defaults(func=_measure)

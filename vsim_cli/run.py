@@ -8,18 +8,21 @@ import time
 from pathlib import Path
 
 from vehicle.model.definition import BUSHING_MODELS
+from vsim_cli.arguments import output_file, positive_scale
+from vsim_cli.interrupts import status as interrupt_status
 
 
 def _run(args: argparse.Namespace) -> int:
     from vehicle.scenarios.scenario_file import load_scenario
     from vehicle.simulation.runner import DivergenceError
     from vsim_cli.progress import ProgressBar
+    from vsim_core.files import check_output
     from vsim_presentation.run_summary import summary
     from vsim_recordings.recorder import default_output, run_scenario
     from vsim_recordings.run_reader import load_run
 
     scenario = load_scenario(args.scenario)
-    output = args.output or default_output(scenario)
+    output = args.output or check_output(default_output(scenario))
     bar = ProgressBar()
     status, note = 0, ""
     started = time.perf_counter()
@@ -30,8 +33,8 @@ def _run(args: argparse.Namespace) -> int:
                f"{result.simulated_s / result.wall_s:.1f}x real time)"
     except DivergenceError as exc:
         status, note = 1, f"stopped: {exc}"
-    except KeyboardInterrupt:
-        status, note = 130, f"interrupted after {time.perf_counter() - started:.0f} s"
+    except KeyboardInterrupt as exc:
+        status, note = interrupt_status(exc), f"interrupted ({exc or 'SIGINT'}) after {time.perf_counter() - started:.0f} s"
     finally:
         bar.close()
     if status:
@@ -51,10 +54,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     "MCAP file; print a summary (gradients and loop widths, K&C metrics, relaxation, peak bushing "
                     "deflections).")
     run.add_argument("scenario", type=Path, metavar="SCENARIO.yaml")
-    run.add_argument("-o", "--output", type=Path, metavar="OUT.mcap", help="run file (default: out/<scenario>.mcap)")
+    run.add_argument("-o", "--output", type=output_file, metavar="OUT.mcap", help="run file (default: out/<scenario>.mcap)")
     run.add_argument("--bushings", choices=BUSHING_MODELS, default=None,
                      help="this bushing model on every bushing direction (overrides the scenario's `bushings`)")
     run.add_argument("--overwrite", action="store_true", help="replace an existing output file")
-    run.add_argument("--duration-scale", type=float, default=1.0, metavar="X",
+    run.add_argument("--duration-scale", type=positive_scale, default=1.0, metavar="X",
                      help="multiply every duration (settle phases, periods, holds) by X, e.g. 0.1 for a quick run")
     run.set_defaults(func=_run)

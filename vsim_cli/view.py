@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from vsim_cli.arguments import output_file
 from vsim_core.errors import InputError
 
 
@@ -29,7 +30,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description="Build a Rerun recording from a run file alone. Without --save a viewer is spawned.",
     )
     view.add_argument("run", type=Path, metavar="RUN.mcap")
-    view.add_argument("--save", type=Path, metavar="RUN.rrd", help="write the recording (with its layout) to this file")
+    view.add_argument("--save", type=output_file, metavar="RUN.rrd", help="write the recording (with its layout) to this file")
     view.add_argument("--spawn", action="store_true", help="also show it in a Rerun viewer when saving")
     view.add_argument("--overwrite", action="store_true", help="replace an existing --save file")
     view.set_defaults(func=_view)

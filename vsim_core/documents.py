@@ -30,23 +30,47 @@ def dotted(path: KeyPath) -> str:
     return out
 
 
+class _Refused(Exception):
+    """What the loader refuses in a document that YAML itself accepts, at a line."""
+
+    def __init__(self, message: str, line: int):
+        super().__init__(message)
+        self.line = line
+
+
+class _Loader(yaml.SafeLoader):
+    """YAML's safe loader without aliases: a few lines of anchors and aliases can expand to any size."""
+
+    def compose_node(self, parent: yaml.Node | None, index: Any) -> yaml.Node:
+        if self.check_event(yaml.AliasEvent):
+            event = self.peek_event()
+            raise _Refused(f"YAML aliases (*{event.anchor}) are not accepted; write the value out",
+                           event.start_mark.line + 1)
+        return super().compose_node(parent, index)
+
+
 class Document:
     """A YAML document as plain data plus the line of every key path (from the composed nodes)."""
 
     def __init__(self, text: str, source: str):
-        """Parse ``text``; InputError naming ``source`` when it is not valid YAML or repeats a key."""
+        """Parse ``text``; InputError naming ``source`` when it is not valid YAML, repeats a key, uses
+        an alias or a key that is not a plain scalar, or nests beyond Python's recursion limit."""
         self.source, self.text = source, text
-        loader = yaml.SafeLoader(text)
+        self.lines: dict[KeyPath, int] = {}
+        loader = _Loader(text)
         try:
             node = loader.get_single_node()
             self.data = loader.construct_document(node) if node is not None else None
+            if node is not None:
+                self._index(node, ())
         except yaml.YAMLError as exc:
-            raise InputError(f"not valid YAML: {exc}", source=source) from exc
+            raise InputError(f"not valid YAML: {exc}", source=source) from None
+        except _Refused as exc:
+            raise InputError(str(exc), source=f"{source}:{exc.line}") from None
+        except RecursionError:
+            raise InputError("not valid here: nested too deeply", source=source) from None
         finally:
             loader.dispose()
-        self.lines: dict[KeyPath, int] = {}
-        if node is not None:
-            self._index(node, ())
 
     @classmethod
     def read(cls, path: str | Path, missing: str = "no such file") -> "Document":
@@ -68,6 +92,8 @@ class Document:
         if isinstance(node, yaml.MappingNode):
             seen = set()
             for key, value in node.value:
+                if not isinstance(key, yaml.ScalarNode):
+                    raise _Refused(f"keys must be plain names (at {dotted(path) or 'the top'})", key.start_mark.line + 1)
                 if key.value in seen:
                     raise InputError(f"duplicate key {key.value!r}", source=f"{self.source}:{key.start_mark.line + 1}",
                                      key=dotted(path + (key.value,)))
@@ -95,9 +121,10 @@ class Document:
 
 
 def check_number(doc: Document, path: KeyPath, value: Any, *, positive: bool = False, nonneg: bool = False,
-                 nonzero: bool = False, integer: bool = False) -> float:
-    """``value`` (found at ``path`` of ``doc``) as a finite float with the properties asked for;
-    InputError at ``path`` otherwise."""
+                 nonzero: bool = False, integer: bool = False, at_most: float = math.inf, unit: str = "") -> float:
+    """``value`` (found at ``path`` of ``doc``) as a finite float with the properties asked for, and
+    at most ``at_most`` in magnitude (a physical range; ``unit`` for the message); InputError at
+    ``path`` otherwise."""
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
         raise doc.error(path, f"expected a finite number, got {value!r}")
     if integer and value != int(value):
@@ -106,14 +133,18 @@ def check_number(doc: Document, path: KeyPath, value: Any, *, positive: bool = F
                       (nonzero and value == 0, "non-zero")):
         if bad:
             raise doc.error(path, f"expected a {what} number, got {value!r}")
+    if abs(value) > at_most:
+        raise doc.error(path, f"expected at most {at_most:g}{f' {unit}' if unit else ''} in magnitude, got {value!r}")
     return float(value)
 
 
-def check_vector(doc: Document, path: KeyPath, value: Any, n: int) -> tuple[float, ...]:
-    """``value`` (found at ``path``) as a list of ``n`` finite numbers; InputError at ``path`` otherwise."""
+def check_vector(doc: Document, path: KeyPath, value: Any, n: int, *, at_most: float = math.inf,
+                 unit: str = "") -> tuple[float, ...]:
+    """``value`` (found at ``path``) as a list of ``n`` finite numbers, each at most ``at_most`` in
+    magnitude; InputError at ``path`` otherwise."""
     if not isinstance(value, (list, tuple)) or len(value) != n:
         raise doc.error(path, f"expected a list of {n} numbers, got {value!r}")
-    return tuple(check_number(doc, path + (i,), v) for i, v in enumerate(value))
+    return tuple(check_number(doc, path + (i,), v, at_most=at_most, unit=unit) for i, v in enumerate(value))
 
 
 class Fields:
@@ -159,14 +190,14 @@ class Fields:
         return self.doc.error(self.path(key), message)
 
     def number(self, key: str, default: Any = ..., *, positive: bool = False, nonneg: bool = False,
-               nonzero: bool = False, integer: bool = False) -> float:
+               nonzero: bool = False, integer: bool = False, at_most: float = math.inf, unit: str = "") -> float:
         """A finite number (:func:`check_number`)."""
         return check_number(self.doc, self.path(key), self.raw(key, default), positive=positive, nonneg=nonneg,
-                            nonzero=nonzero, integer=integer)
+                            nonzero=nonzero, integer=integer, at_most=at_most, unit=unit)
 
-    def vector(self, key: str, n: int = 3) -> tuple[float, ...]:
-        """A list of ``n`` finite numbers."""
-        return check_vector(self.doc, self.path(key), self.raw(key), n)
+    def vector(self, key: str, n: int = 3, *, at_most: float = math.inf, unit: str = "") -> tuple[float, ...]:
+        """A list of ``n`` finite numbers, each at most ``at_most`` in magnitude."""
+        return check_vector(self.doc, self.path(key), self.raw(key), n, at_most=at_most, unit=unit)
 
     def choice(self, key: str, options: tuple[str, ...], default: Any = ...) -> Any:
         """One of ``options`` (or ``default`` when absent)."""

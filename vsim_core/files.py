@@ -23,6 +23,24 @@ def read_text(path: str | Path) -> str:
         raise InputError(f"cannot read: {exc.strerror}", source=str(path)) from exc
 
 
+def check_output(path: str | os.PathLike[str], *, folder: bool = False) -> Path:
+    """``path`` as a Path if an output can be written there (a file, or a ``folder``), else an
+    InputError naming it: a folder where a file is expected or the reverse, an ancestor that is a
+    file, a folder that cannot be written into. For commands to call before any work starts."""
+    path = Path(path)
+    if path.exists() and path.is_dir() != folder:
+        raise InputError(f"is a {'file' if folder else 'folder'}; expected a {'folder' if folder else 'file'} to write",
+                         source=str(path))
+    ancestor = path.parent
+    while not ancestor.exists() and ancestor != ancestor.parent:
+        ancestor = ancestor.parent
+    if not ancestor.is_dir():
+        raise InputError(f"is a file; it cannot hold {path}", source=str(ancestor))
+    if not os.access(ancestor, os.W_OK | os.X_OK):
+        raise InputError(f"cannot write here (permission denied), so not {path}", source=str(ancestor))
+    return path
+
+
 def _usual_permissions(path: str | Path, mode: int) -> None:
     """mkstemp and mkdtemp create private files (0600, 0700): give ``path`` the umask's permissions."""
     umask = os.umask(0)

@@ -19,16 +19,22 @@ def read_csv_header(path: str | Path) -> list[str]:
     return [h.strip() for h in next(csv.reader(read_text(path).splitlines()), [])]
 
 
-def read_csv_columns(path: str | Path, columns: Sequence[str], min_rows: int) -> dict[str, np.ndarray]:
+def read_csv_columns(path: str | Path, columns: Sequence[str], min_rows: int,
+                     limits: Mapping[str, float] | None = None) -> dict[str, np.ndarray]:
     """Read the named numeric columns of a CSV file with a header line (other columns ignored).
 
     Values stay in the file's units. Raises InputError naming the file, line and column for a
-    missing column, a non-number, a NaN, a time (first column) that does not increase strictly,
-    or fewer than ``min_rows`` data lines.
+    missing or repeated column, a line with more fields than the header, a non-number, a NaN, a time
+    (first column) that does not increase strictly, a value larger in magnitude than its column's
+    ``limits`` (in the file's unit), or fewer than ``min_rows`` data lines.
     """
     source = str(path)
     rows = csv.reader(read_text(path).splitlines())
     header = [h.strip() for h in next(rows, [])]
+    repeated = sorted({h for h in header if header.count(h) > 1})
+    if repeated:
+        raise InputError(f"column {repeated[0]!r} appears {header.count(repeated[0])} times; expected each name once",
+                         source=source, key="line 1")
     missing = [c for c in columns if c not in header]
     if missing:
         raise InputError(f"missing column(s) {', '.join(missing)}; expected a header with {','.join(columns)}, "
@@ -38,6 +44,9 @@ def read_csv_columns(path: str | Path, columns: Sequence[str], min_rows: int) ->
     for line, row in enumerate(rows, start=2):
         if not row or not "".join(row).strip():
             continue
+        if len(row) > len(header):
+            raise InputError(f"{len(row)} fields; expected {len(header)}, as the header has", source=source,
+                             key=f"line {line}")
         values = []
         for name, col in zip(columns, cols):
             where = f"line {line}, column {name}"
@@ -49,6 +58,9 @@ def read_csv_columns(path: str | Path, columns: Sequence[str], min_rows: int) ->
                 raise InputError(f"expected a number, got {row[col]!r}", source=source, key=where) from None
             if not math.isfinite(value):
                 raise InputError(f"expected a finite number, got {row[col]!r}", source=source, key=where)
+            if limits and name in limits and not abs(value) <= limits[name]:
+                raise InputError(f"{row[col]!r} is beyond any plausible value; expected at most {limits[name]:g} in "
+                                 f"magnitude", source=source, key=where)
             values.append(value)
         if data and not values[0] > data[-1][0]:
             raise InputError(f"time must increase strictly: {values[0]!r} s follows {data[-1][0]!r} s",

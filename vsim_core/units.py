@@ -18,6 +18,9 @@ _SIZES: dict[str, tuple[str, float]] = {
        for dot in ("·", ".", "")},
     "s": ("time", 1.0), "ms": ("time", 1e-3),
 }
+#: The largest magnitude a measured or commanded value may take, per dimension, in SI: far beyond a
+#: car on a K&C rig or a part on a bushing bench, far below what a unit or typing error gives.
+_PLAUSIBLE_SI = {"length": 10.0, "angle": 2.0 * math.pi, "force": 1e7, "torque": 1e6, "time": 1e6}
 #: The SI unit of each dimension.
 SI_UNIT = {"length": "m", "angle": "rad", "force": "N", "torque": "N·m", "time": "s"}
 #: Every unit known, in the table's order.
@@ -46,6 +49,11 @@ def si(unit: str) -> float:
 def per_si(unit: str) -> float:
     """``unit`` per SI: 1000 for mm, 180/π for deg."""
     return factor(SI_UNIT[dimension(unit)], unit)
+
+
+def plausible(unit: str) -> float:
+    """The largest magnitude plausible for a value in ``unit`` (10 m, 360°, 10 MN, 1 MN·m, 1e6 s)."""
+    return _PLAUSIBLE_SI[dimension(unit)] * per_si(unit)
 
 
 #: Metres per millimetre and radians per degree (the thesis's units at the boundary), and their inverses.

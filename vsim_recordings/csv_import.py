@@ -40,6 +40,7 @@ class _Column:
     channel: str       #: run channel (``vsim_recordings.rig_recordings.TIME_NAME`` for the time)
     factor: float      #: run units per column unit, times the sign
     offset: float      #: added to the column's values [column unit]
+    limit: float       #: largest plausible magnitude [column unit]
 
     def convert(self, values: np.ndarray) -> np.ndarray:
         """The column's values in the run's unit and sign."""
@@ -74,7 +75,7 @@ def _column(doc: Document, name: str, item: Any, known: Mapping[str, str]) -> _C
     sign = f.number("sign", 1.0)
     if sign not in (1.0, -1.0):
         raise f.fail("sign", f"expected +1 or -1, got {sign!r}")
-    return _Column(str(name), channel, sign * factor, f.number("offset", 0.0))
+    return _Column(str(name), channel, sign * factor, f.number("offset", 0.0), units.plausible(f.text("unit")))
 
 
 def _scenario(top: Fields, meta: Path) -> Scenario:
@@ -114,7 +115,7 @@ def import_csv(data: str | os.PathLike[str], meta: str | os.PathLike[str], outpu
            "imported_from": {"csv": Path(data).name, "meta_yaml": doc.text}}
     time_fields = Fields.of(doc, ("time",), top.raw("time"), _TIME_KEYS)
     time = _Column(time_fields.text("column"), TIME_NAME, _factor(time_fields, "the time", "s"),
-                   time_fields.number("offset", 0.0))
+                   time_fields.number("offset", 0.0), units.plausible(time_fields.text("unit")))
     raw = top.raw("columns")
     if not isinstance(raw, Mapping) or not raw:
         raise top.fail("columns", f"expected a mapping of CSV columns to {{{', '.join(_COLUMN_KEYS)}}}, got {raw!r}")
@@ -128,7 +129,8 @@ def import_csv(data: str | os.PathLike[str], meta: str | os.PathLike[str], outpu
             raise doc.error(("columns", c.name, "channel"), f"channel {c.channel} is already given by column "
                                                             f"{header[c.channel]!r}")
         header[c.channel] = c.name
-    values = read_csv_columns(data, list(header.values()), min_rows=2)
+    limits = {c.name: c.limit for c in (time, *columns)}
+    values = read_csv_columns(data, list(header.values()), min_rows=2, limits=limits)
     return write_rig_recording(
         output, scenario, time.convert(values[time.name]), {c.channel: c.convert(values[c.name]) for c in columns},
         {c.channel: known[c.channel] for c in columns}, rig=rig, duration_scale=duration_scale, overwrite=overwrite,

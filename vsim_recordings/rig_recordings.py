@@ -18,6 +18,7 @@ import numpy as np
 from vehicle.scenarios.channels import INPUT_CHANNELS
 from vehicle.scenarios.scenario import RIG_TIMESTEP_S, Scenario
 from vehicle.scenarios.schedule import CaseSchedule, schedule
+from vsim_core.units import plausible
 from vsim_core.errors import InputError
 from vsim_core.files import atomic_output
 from vsim_recordings.run_format import SignalSpec
@@ -119,6 +120,12 @@ def _check_signals(t: np.ndarray, signals: Mapping[str, np.ndarray], units: Mapp
         if bad.size:
             raise InputError(f"value {array[bad[0]]} at t = {t[bad[0]]:.9g} s; expected a finite number",
                              source=source, key=where(bad[0], name))
+        limit = plausible(known[name])
+        bad = np.flatnonzero(np.abs(array) > limit)
+        if bad.size:
+            raise InputError(f"value {array[bad[0]]:.6g} {known[name]} at t = {t[bad[0]]:.9g} s is beyond any plausible "
+                             f"value; expected at most {limit:g} {known[name]} in magnitude", source=source,
+                             key=where(bad[0], name))
         out[name] = array
     return out
 
@@ -160,8 +167,6 @@ def write_rig_recording(path: str | os.PathLike[str], scenario: Scenario, t_s: n
     path = Path(path)
     if path.exists() and not overwrite:
         raise InputError("the output exists; pass --overwrite (overwrite=True) to replace it", source=str(path))
-    if not duration_scale > 0:
-        raise InputError(f"expected a positive duration scale, got {duration_scale}", key="duration_scale")
     t = np.asarray(t_s, dtype=float)
     if t.ndim != 1 or t.size < 2:
         raise InputError(f"expected at least two samples in one time vector, got shape {t.shape}", source=source)

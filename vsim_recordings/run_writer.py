@@ -24,6 +24,11 @@ from vsim_recordings.run_format import (FORMAT_VERSION, GEOM_KINDS, GEOMETRY_TOP
                                         RunMetadata, SignalSpec, rotation_matrix, signal_label, to_json)
 
 
+#: Uncompressed size of a chunk [bytes]: the writer writes each chunk when it is full, so a killed
+#: run's file holds all but its last chunk (read back by :func:`vsim_recordings.run_reader.load_run`).
+CHUNK_BYTES = 1 << 20
+
+
 def _check_specs(signals: list[SignalSpec], bodies: list[str], geometry: list[GeomSpec]) -> None:
     names = [s.name for s in signals]
     for name in [*names, *(s.group for s in signals), *bodies]:
@@ -137,7 +142,7 @@ class RunWriter:
             self.partial_path,
             allow_overwrite=True,
             context=self._context,
-            writer_options=MCAPWriteOptions(compression=MCAPCompression.Zstd, profile=""),
+            writer_options=MCAPWriteOptions(compression=MCAPCompression.Zstd, profile="", chunk_size=CHUNK_BYTES),
         )
         self._writer.write_metadata(RUN_RECORD, run_record)
         if self.bodies:  # no empty /tf channel in a recording without bodies

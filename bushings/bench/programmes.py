@@ -18,11 +18,14 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from vsim_core.documents import Document, Fields, KeyPath, check_number
+from vsim_core import units
 from vsim_core.tables import read_csv_columns
 from vsim_core.units import MM
 
 #: Fewest samples per period of the fastest sine component that a bench accepts.
 MIN_SAMPLES_PER_PERIOD = 20
+#: Most samples a programme may take (each an 8-byte number per channel): beyond, it is a typing error.
+MAX_SAMPLES = 10_000_000
 #: Speed of the ramps to and from a sine's static offset [mm/s], and the rest before the sine [s].
 STATIC_RAMP_MM_S, STATIC_REST_S = 1.0, 1.0
 
@@ -129,7 +132,8 @@ def read_csv_record(path: Path) -> tuple[np.ndarray, np.ndarray]:
     Raises InputError naming the file, line and column for a missing column, a non-number, a
     NaN, or a time that does not increase strictly.
     """
-    cols = read_csv_columns(path, ("t_s", "e_mm"), min_rows=2)
+    cols = read_csv_columns(path, ("t_s", "e_mm"), min_rows=2,
+                            limits={"t_s": units.plausible("s"), "e_mm": units.plausible("mm")})
     return cols["t_s"], cols["e_mm"] * MM
 
 
@@ -157,7 +161,7 @@ def read_programme(doc: Document, path: KeyPath, dt_s: float, base_dir: Path | N
 
     ``base_dir`` resolves a relative csv ``path`` (the bench file's folder). Raises InputError
     naming the file and the offending key for an unknown type or key, a missing key, a value of the
-    wrong sign or kind, or a sine too coarsely sampled by dt_s.
+    wrong sign or kind, a sine too coarsely sampled by dt_s, or more than :data:`MAX_SAMPLES`.
     """
     data = doc.data
     for part in path:
@@ -177,25 +181,37 @@ def read_programme(doc: Document, path: KeyPath, dt_s: float, base_dir: Path | N
     def number(key: str, **kind_of: bool) -> float:
         return f.number(key, allowed[key], **(kind_of or {"positive": True}))
 
+    def affordable(samples: float) -> None:
+        if not samples <= MAX_SAMPLES:
+            raise doc.error(path, f"{samples:.3g} samples at dt_s = {dt_s:g} s; expected at most {MAX_SAMPLES:g} "
+                                  f"(shorten the programme or raise dt_s)")
+
     if kind == "sweep":
-        return Sweep(np.unique(_numbers(f, "amplitudes_mm")) * MM, np.unique(_numbers(f, "frequencies_hz")),
-                     int(number("cycles", positive=True, integer=True)),
-                     int(number("points_per_cycle", positive=True, integer=True)))
+        sweep = Sweep(np.unique(_numbers(f, "amplitudes_mm")) * MM, np.unique(_numbers(f, "frequencies_hz")),
+                      int(number("cycles", positive=True, integer=True)),
+                      int(number("points_per_cycle", positive=True, integer=True)))
+        per_cycle = max(sweep.points_per_cycle, 1.0 / (sweep.frequencies_hz.min() * dt_s))
+        affordable(per_cycle * sweep.cycles * sweep.amplitudes_m.size * sweep.frequencies_hz.size)
+        return sweep
     if kind == "csv":
         if not isinstance(data["path"], str):
             raise f.fail("path", f"expected a file path, got {data['path']!r}")
         csv = Path(data["path"])
         t, e = read_csv_record(csv if csv.is_absolute() or base_dir is None else base_dir / csv)
+        affordable((t[-1] - t[0]) / dt_s)
         return TimeSeries(kind, *piecewise_linear(t, e, dt_s))
     if kind == "triangle":
-        t, e = triangle(number("amplitude_mm") * MM, number("speed_mm_s") * MM,
-                        int(number("cycles", positive=True, integer=True)), dt_s)
+        amplitude, speed = number("amplitude_mm"), number("speed_mm_s")
+        cycles = number("cycles", positive=True, integer=True)
+        affordable(4.0 * amplitude / speed * cycles / dt_s)
+        t, e = triangle(amplitude * MM, speed * MM, int(cycles), dt_s)
     elif kind == "sine":
         frequency = number("frequency_hz")
         _check_sampling(f, "frequency_hz", frequency, dt_s)
         amplitude, cycles = number("amplitude_mm") * MM, int(number("cycles", positive=True, integer=True))
+        static_mm = f.number("static_mm") if f.has("static_mm") else 0.0
+        affordable((cycles / frequency + 2.0 * abs(static_mm) / STATIC_RAMP_MM_S + STATIC_REST_S) / dt_s)
         if f.has("static_mm"):
-            static_mm = f.number("static_mm")
             t, e = sine_about(static_mm * MM, abs(static_mm) / STATIC_RAMP_MM_S, amplitude, frequency, cycles, dt_s)
         else:
             t, e = sine(amplitude, frequency, cycles, dt_s)
@@ -206,16 +222,20 @@ def read_programme(doc: Document, path: KeyPath, dt_s: float, base_dir: Path | N
             raise f.fail("duration_s", "give either cycles (of the slowest component) or duration_s, not both")
         duration = (number("duration_s") if f.has("duration_s")
                     else number("cycles", positive=True, integer=True) / min(frequencies))
+        affordable(duration / dt_s)
         t, e = multisine(amplitudes, frequencies, duration, dt_s)
     elif kind == "step":
-        t, e = step(number("amplitude_mm", nonzero=True) * MM, number("rise_time_s", nonneg=True),
-                    number("hold_s"), dt_s)
+        rise, hold = number("rise_time_s", nonneg=True), number("hold_s")
+        affordable((rise + hold) / dt_s)
+        t, e = step(number("amplitude_mm", nonzero=True) * MM, rise, hold, dt_s)
     else:
         amplitude, level = number("amplitude_mm"), number("step_mm")
         if abs(amplitude / level - round(amplitude / level)) > 1e-9:
             raise f.fail("step_mm", f"expected amplitude_mm ({amplitude}) to be a whole multiple of step_mm ({level})")
-        t, e = firtree(amplitude * MM, number("speed_mm_s") * MM, level * MM, number("hold_s", nonneg=True),
-                       int(number("cycles", positive=True, integer=True)), dt_s)
+        speed, hold = number("speed_mm_s"), number("hold_s", nonneg=True)
+        cycles = number("cycles", positive=True, integer=True)
+        affordable(cycles * 4.0 * amplitude / level * (level / speed + hold) / dt_s)
+        t, e = firtree(amplitude * MM, speed * MM, level * MM, hold, int(cycles), dt_s)
     return TimeSeries(kind, t, e)
 
 

@@ -36,6 +36,7 @@ from bushings.effects import NO_EFFECTS
 from vehicle.model.definition import DIRECTIONS, SIDES, BushingDef, Spring, VehicleDefinition
 from vehicle.model.elements import BuildOptions, Channel, CrossTerm, Element, joint_stiffness
 from vehicle.model.geometry import frame_from, mirror, mirror_axes, mirror_signs, mirrored_law, wheel_axis
+from vsim_core.errors import InputError
 
 #: Stiffness of a "rigid" bushing translation [N/m] (kinematics mode).
 RIGID_TRANSLATION = 1e9
@@ -189,7 +190,10 @@ class _Builder:
             self.rear_corner(side, sign)
         self.beam()
         self.anti_roll_bar()
-        model = self.spec.compile()
+        try:
+            model = self.spec.compile()
+        except ValueError as exc:  # what the file's checks let through and MuJoCo refuses
+            raise InputError(f"MuJoCo cannot build this vehicle: {exc}", source=str(v.path)) from None
         return CarModel(v, self.o, self.spec, model, self.channels, self.elements, self.closures, self.corners,
                         self.cross)
 
@@ -212,7 +216,8 @@ class _Builder:
         closing = len(bushings) - 1
         m = f.masses["wishbone"] - SLEEVE_MASS * closing
         if m <= 0:
-            raise ValueError("wishbone mass smaller than its bushing sleeves")
+            raise InputError(f"{f.masses['wishbone']} kg, less than the {closing} bushing sleeve(s) it carries "
+                             f"({SLEEVE_MASS} kg each); expected more", source=str(v.path), key="front.masses.wishbone")
         self._hang("chassis", wishbone, bushings, side, sign, m, com, [0.05, 0.05, 0.09])
         self.capsule(wishbone, hp["wishbone_front_pivot"], hp["lower_ball_joint"])
         self.capsule(wishbone, hp["wishbone_rear_pivot"], hp["lower_ball_joint"])
@@ -261,6 +266,10 @@ class _Builder:
         closing = len(bushings) - 1
         com = (hp["arm_pivot"] + wc + beam_end) / 3.0
         mass = r.masses["arm"] - SLEEVE_MASS * closing - BEAM_CENTRE_MASS
+        if mass <= 0:
+            raise InputError(f"{r.masses['arm']} kg, less than the arm's share of the beam ({BEAM_CENTRE_MASS} kg) and "
+                             f"its {closing} bushing sleeve(s) ({SLEEVE_MASS} kg each); expected more",
+                             source=str(v.path), key="rear.masses.arm")
         self._hang("chassis", arm, bushings, side, sign, mass, com,
                    [0.15, 0.1, 0.2])
         self.capsule(arm, hp["arm_pivot"], wc, 0.025)

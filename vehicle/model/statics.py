@@ -9,6 +9,8 @@ the spring's motion ratio and the sum runs over the corner's moving parts.
 from __future__ import annotations
 
 import dataclasses
+import math
+from typing import Callable
 
 import mujoco
 import numpy as np
@@ -16,7 +18,9 @@ import numpy as np
 from vehicle.model.builder import build
 from vehicle.model.definition import VehicleDefinition
 from vehicle.model.elements import BuildOptions
-from vehicle.model.kinematics import front_corner, rear_heave
+from vehicle.model.kinematics import CornerState, front_corner, rear_heave
+from vehicle.model.plausibility import MAX_PRELOAD_N
+from vsim_core.errors import InputError
 
 GRAVITY = 9.81
 _STEP = 5e-4  # finite-difference travel [m]
@@ -58,17 +62,16 @@ def resolve_preloads(v: VehicleDefinition) -> VehicleDefinition:
 
     front, rear = v.front, v.rear
     if front.spring.preload is None:
-        plus, _ = front_corner(v, _STEP)
-        minus, _ = front_corner(v, -_STEP)
+        plus, minus = _solved(v, "front", lambda: (front_corner(v, _STEP)[0], front_corner(v, -_STEP)[0]))
         parts = {"wishbone_left": "wishbone", "knuckle_left": "knuckle", "strut_rod_left": "rod",
                  "wheel_front_left": "knuckle"}
         parts |= {f"{b.name}_left_sleeve": "wishbone" for b in v.bushings if b.child == "front.wishbone"}
         parts = {k: p for k, p in parts.items() if k in bodies}
         ratio = -(plus.strut_extension - minus.strut_extension) / (2 * _STEP)
-        preload = (front_load - _gravity_term(bodies, parts, plus, minus)) / ratio
-        front = dataclasses.replace(front, spring=dataclasses.replace(front.spring, preload=float(preload)))
+        preload = _checked(v, "front", (front_load - _gravity_term(bodies, parts, plus, minus)) / ratio)
+        front = dataclasses.replace(front, spring=dataclasses.replace(front.spring, preload=preload))
     if rear.spring.preload is None:
-        plus, minus = rear_heave(v, _STEP), rear_heave(v, -_STEP)
+        plus, minus = _solved(v, "rear", lambda: (rear_heave(v, _STEP), rear_heave(v, -_STEP)))
         parts = {"arm_left": "arm", "hub_left": "arm", "wheel_rear_left": "arm"}
         parts |= {f"{b.name}_left_sleeve": "arm" for b in v.bushings if b.child == "rear.arm"}
         parts = {k: p for k, p in parts.items() if k in bodies}
@@ -78,9 +81,29 @@ def resolve_preloads(v: VehicleDefinition) -> VehicleDefinition:
         hp = {k: np.array(p) for k, p in v.rear.hardpoints.items()}
         length = lambda s: np.linalg.norm(hp["spring_upper"] - s.parts["arm"](hp["spring_lower"]))
         ratio = -(length(plus) - length(minus)) / (2 * _STEP)
-        preload = (rear_load - _gravity_term(bodies_half, parts, plus, minus)) / ratio
-        rear = dataclasses.replace(rear, spring=dataclasses.replace(rear.spring, preload=float(preload)))
+        preload = _checked(v, "rear", (rear_load - _gravity_term(bodies_half, parts, plus, minus)) / ratio)
+        rear = dataclasses.replace(rear, spring=dataclasses.replace(rear.spring, preload=preload))
     return dataclasses.replace(v, front=front, rear=rear)
+
+
+def _solved(v: VehicleDefinition, axle: str, solve: Callable[[], tuple[CornerState, CornerState]]
+            ) -> tuple[CornerState, CornerState]:
+    """The corner states ``solve`` gives; InputError naming the axle's hardpoints if the kinematics
+    fail to close about the design position."""
+    try:
+        return solve()
+    except (RuntimeError, ValueError) as exc:  # fsolve finds no pose, brentq no bracket
+        raise InputError(f"the suspension does not move about its design position ({exc}); check the hardpoints",
+                         source=str(v.path), key=f"{axle}.hardpoints") from None
+
+
+def _checked(v: VehicleDefinition, axle: str, preload: float) -> float:
+    """``preload`` [N], or InputError if it is not a finite compression the spring can hold."""
+    if not (math.isfinite(preload) and 0.0 <= preload <= MAX_PRELOAD_N):
+        raise InputError(f"carrying the car at design height would need a spring preload of {preload:.6g} N; expected "
+                         f"0 to {MAX_PRELOAD_N:g} N: check the masses, the CG and the spring's hardpoints",
+                         source=str(v.path), key=f"{axle}.spring.preload")
+    return float(preload)
 
 
 def axle_loads(v: VehicleDefinition) -> tuple[float, float, float]:

@@ -21,6 +21,10 @@ from bushings.parameters import LENGTH_UNIT_SI, MODELS, UNIT_LABELS
 from vehicle.model.definition import (BUSHING_PARTS, DIRECTIONS, FRONT_MASSES, FRONT_POINTS, NO_FAMILIES, REAR_MASSES,
                                       REAR_POINTS, Body, BushingDef, CrossStiffness, Curve, Damper, DirectionDef,
                                       Families, FrontAxle, RearAxle, Spring, Tyre, Vec3, VehicleDefinition)
+from vehicle.model.plausibility import (MAX_BODY_MASS_KG, MAX_CAMBER_DEG, MAX_COORDINATE_M, MAX_FRICTION_N,
+                                        MAX_INERTIA_KGM2, MAX_PART_MASS_KG, MAX_PRELOAD_N, MAX_RACK_TRAVEL_M,
+                                        MAX_RADIUS_M, MAX_SCALE, MAX_STIFFNESS_N_PER_M, MAX_TOE_DEG,
+                                        MAX_TORSION_NM_PER_RAD, check_geometry)
 from vsim_core.documents import Document, Fields, KeyPath, check_number, check_vector, dotted
 from vsim_core.errors import InputError
 from vsim_core.shipped import DEFAULT_VEHICLE
@@ -36,37 +40,38 @@ def load_vehicle(path: str | Path = DEFAULT_VEHICLE) -> VehicleDefinition:
     doc = Document.read(path, "no such vehicle file")
     top = doc.top(_TOP)
     t = top.fields("tyre", ("radius", "wheel_mass", "wheel_inertia"))
-    inertia = t.vector("wheel_inertia", 2)
-    if min(inertia) <= 0:
-        raise t.fail("wheel_inertia", f"expected positive inertias, got {list(inertia)}")
-    tyre = Tyre(t.number("radius", positive=True), t.number("wheel_mass", positive=True), inertia)
-
+    tyre = Tyre(t.number("radius", positive=True, at_most=MAX_RADIUS_M, unit="m"),
+                t.number("wheel_mass", positive=True, at_most=MAX_PART_MASS_KG, unit="kg"),
+                _inertias(t, "wheel_inertia", 2))
     b = top.fields("body", ("mass", "cg", "inertia", "ride_height_point", "design_ride_height"))
-    body = Body(b.number("mass", positive=True), b.vector("cg"), b.vector("inertia"),
-                b.vector("ride_height_point"), b.number("design_ride_height"))
+    body = Body(b.number("mass", positive=True, at_most=MAX_BODY_MASS_KG, unit="kg"), _point(b, "cg"),
+                _inertias(b, "inertia", 3), _point(b, "ride_height_point"),
+                b.number("design_ride_height", positive=True, at_most=MAX_COORDINATE_M, unit="m"))
 
     f = top.fields("front", ("hardpoints", "static_toe", "static_camber", "masses", "spring", "damper",
                              "anti_roll_bar", "steering", "strut_friction"))
     front = FrontAxle(
         hardpoints=_points(f.fields("hardpoints", FRONT_POINTS), FRONT_POINTS),
-        static_toe=math.radians(f.number("static_toe")), static_camber=math.radians(f.number("static_camber")),
+        static_toe=_angle(f, "static_toe", MAX_TOE_DEG), static_camber=_angle(f, "static_camber", MAX_CAMBER_DEG),
         masses=_masses(f.fields("masses", FRONT_MASSES), FRONT_MASSES),
         spring=_spring(f.fields("spring", ("rate", "curve", "preload"))),
         damper=Damper(_curve(f.fields("damper", ("curve",)), "curve")),
-        anti_roll_rate=f.fields("anti_roll_bar", ("rate",)).number("rate", nonneg=True),
-        rack_travel_per_rev=f.fields("steering", ("rack_travel_per_rev",)).number("rack_travel_per_rev",
-                                                                                  positive=True),
+        anti_roll_rate=f.fields("anti_roll_bar", ("rate",)).number("rate", nonneg=True, at_most=MAX_STIFFNESS_N_PER_M,
+                                                                    unit="N/m"),
+        rack_travel_per_rev=f.fields("steering", ("rack_travel_per_rev",)).number(
+            "rack_travel_per_rev", positive=True, at_most=MAX_RACK_TRAVEL_M, unit="m"),
         strut_friction=_per_side(f, "strut_friction", 0.0))
     rr = top.fields("rear", ("hardpoints", "static_toe", "static_camber", "masses", "beam_torsional_stiffness",
                              "beam_torsion_scale", "spring", "damper"))
     rear = RearAxle(
         hardpoints=_points(rr.fields("hardpoints", REAR_POINTS), REAR_POINTS),
-        static_toe=math.radians(rr.number("static_toe")), static_camber=math.radians(rr.number("static_camber")),
+        static_toe=_angle(rr, "static_toe", MAX_TOE_DEG), static_camber=_angle(rr, "static_camber", MAX_CAMBER_DEG),
         masses=_masses(rr.fields("masses", REAR_MASSES), REAR_MASSES),
-        beam_torsional_stiffness=rr.number("beam_torsional_stiffness", positive=True),
+        beam_torsional_stiffness=rr.number("beam_torsional_stiffness", positive=True, at_most=MAX_TORSION_NM_PER_RAD,
+                                           unit="N·m/rad"),
         spring=_spring(rr.fields("spring", ("rate", "curve", "preload"))),
         damper=Damper(_curve(rr.fields("damper", ("curve",)), "curve")),
-        beam_torsion_scale=rr.number("beam_torsion_scale", 1.0, positive=True))
+        beam_torsion_scale=rr.number("beam_torsion_scale", 1.0, positive=True, at_most=MAX_SCALE))
 
     points = {f"front.{k}": np.array(v) for k, v in front.hardpoints.items()}
     points |= {f"rear.{k}": np.array(v) for k, v in rear.hardpoints.items()}
@@ -84,7 +89,9 @@ def load_vehicle(path: str | Path = DEFAULT_VEHICLE) -> VehicleDefinition:
     name = top.raw("name")
     if not isinstance(name, str):
         raise top.fail("name", f"expected a name, got {name!r}")
-    return VehicleDefinition(name, str(top.raw("description", "")), path, tyre, body, front, rear, bushings)
+    vehicle = VehicleDefinition(name, str(top.raw("description", "")), path, tyre, body, front, rear, bushings)
+    check_geometry(vehicle, doc)
+    return vehicle
 
 
 def with_extensions(v: VehicleDefinition, *, strut_friction: float | Mapping[str, float] | None = None,
@@ -112,7 +119,7 @@ def with_extensions(v: VehicleDefinition, *, strut_friction: float | Mapping[str
     if strut_friction is not None:
         front = replace(front, strut_friction=_per_side(ext, "strut_friction"))
     if beam_torsion_scale is not None:
-        rear = replace(rear, beam_torsion_scale=ext.number("beam_torsion_scale", positive=True))
+        rear = replace(rear, beam_torsion_scale=ext.number("beam_torsion_scale", positive=True, at_most=MAX_SCALE))
     bushings = {b.name: b for b in v.bushings}
 
     def bushing(name: str, path: KeyPath) -> BushingDef:
@@ -165,17 +172,34 @@ def _spring(f: Fields) -> Spring:
     if f.has("rate") == f.has("curve"):
         raise f.doc.error(f.where, "give exactly one of `rate` [N/m] or `curve` [[compression m, force N], ...]")
     if f.has("rate"):
-        k = f.number("rate", positive=True)
+        k = f.number("rate", positive=True, at_most=MAX_STIFFNESS_N_PER_M, unit="N/m")
         curve = Curve((-1.0, 1.0), (-k, k))
     else:
         curve = _curve(f, "curve")
     if f.raw("preload", "auto") == "auto":
         return Spring(curve, None)
-    return Spring(curve, f.number("preload"))
+    return Spring(curve, f.number("preload", nonneg=True, at_most=MAX_PRELOAD_N, unit="N"))
+
+
+def _point(f: Fields, key: str) -> Vec3:
+    """A point [m] of the car, within :data:`MAX_COORDINATE_M` of its origin (a value in mm is refused)."""
+    return f.vector(key, at_most=MAX_COORDINATE_M, unit="m")
+
+
+def _angle(f: Fields, key: str, at_most_deg: float) -> float:
+    """An alignment angle written in degrees, in radians."""
+    return math.radians(f.number(key, at_most=at_most_deg, unit="deg"))
+
+
+def _inertias(f: Fields, key: str, n: int) -> tuple[float, ...]:
+    inertia = f.vector(key, n, at_most=MAX_INERTIA_KGM2, unit="kg·m²")
+    if min(inertia) <= 0:
+        raise f.fail(key, f"expected positive inertias, got {list(inertia)}")
+    return inertia
 
 
 def _points(f: Fields, names: tuple[str, ...]) -> dict[str, Vec3]:
-    points = {name: f.vector(name) for name in names}
+    points = {name: _point(f, name) for name in names}
     for name, p in points.items():
         if p[1] <= 0 and name != "beam_centre":
             raise f.fail(name, f"expected a left-side point (y > 0), got {list(p)}")
@@ -183,15 +207,15 @@ def _points(f: Fields, names: tuple[str, ...]) -> dict[str, Vec3]:
 
 
 def _masses(f: Fields, names: tuple[str, ...]) -> dict[str, float]:
-    return {name: f.number(name, positive=True) for name in names}
+    return {name: f.number(name, positive=True, at_most=MAX_PART_MASS_KG, unit="kg") for name in names}
 
 
 def _per_side(f: Fields, key: str, default: Any = ...) -> tuple[float, float]:
     """A non-negative value for both sides, or ``{left: a, right: b}``: (left, right)."""
     if isinstance(f.raw(key, default), Mapping):
         sides = f.fields(key, ("left", "right"))
-        return sides.number("left", nonneg=True), sides.number("right", nonneg=True)
-    v = check_number(f.doc, f.path(key), f.raw(key, default), nonneg=True)
+        return tuple(sides.number(side, nonneg=True, at_most=MAX_FRICTION_N, unit="N") for side in ("left", "right"))
+    v = check_number(f.doc, f.path(key), f.raw(key, default), nonneg=True, at_most=MAX_FRICTION_N, unit="N")
     return v, v
 
 
@@ -302,7 +326,7 @@ def _bushing(doc: Document, path: KeyPath, value: Any, points: Mapping[str, np.n
             raise r.fail("location", f"unknown hardpoint {loc!r}; expected one of {', '.join(sorted(points))}")
         location = tuple(float(v) for v in points[loc])
     else:
-        location = r.vector("location")
+        location = _point(r, "location")
     ax = r.fields("axes", ("x", "y"))
     x = _axis(ax, "x", points)
     y = _axis(ax, "y", points)
@@ -333,4 +357,4 @@ def _families(top: Fields) -> Families:
             load_parameter_set(n).channel(m)
         except InputError as exc:
             raise r.doc.error(r.path("sets") + (m,), str(exc)) from exc
-    return Families(dict(sets), r.number("rotation_lever_arm", positive=True))
+    return Families(dict(sets), r.number("rotation_lever_arm", positive=True, at_most=MAX_RADIUS_M, unit="m"))

@@ -4,6 +4,7 @@ the rest phases before them, and the limits beyond which a run has diverged."""
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Mapping
@@ -24,6 +25,11 @@ SHAPES = ("triangle", "sine")
 RIG_TIMESTEP_S = BuildOptions().timestep
 #: Largest sine frequency accepted [Hz]: 20 rig steps per period.
 MAX_FREQUENCY_HZ = 1.0 / (20 * RIG_TIMESTEP_S)
+#: Longest input of one case and longest rest phase [s] of simulated time (about 4 min and 4 s of
+#: wall time at the car's 15× real time): longer is a typing error.
+MAX_INPUT_S, MAX_SETTLE_S = 3600.0, 60.0
+#: A scenario's name: plain, for it names its run file out/<name>.mcap.
+NAME_PATTERN = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.\-]*")
 
 
 @dataclass(frozen=True)

@@ -16,8 +16,10 @@ import numpy as np
 from vehicle.model.definition import BUSHING_MODELS
 from vehicle.scenarios.channels import (AXLES, CORNER_TAGS, FILE_UNITS, INPUT_CHANNELS, csv_columns, file_si,
                                         input_quantity)
-from vehicle.scenarios.scenario import (BISINE_INPUTS, MAX_FREQUENCY_HZ, RIG_TIMESTEP_S, SHAPES, SIGNAL_TYPES, TYPES,
-                                        Case, InputTable, Limits, Scenario, Settle, Waveform)
+from vehicle.scenarios.scenario import (BISINE_INPUTS, MAX_FREQUENCY_HZ, MAX_INPUT_S, MAX_SETTLE_S, NAME_PATTERN,
+                                        RIG_TIMESTEP_S, SHAPES, SIGNAL_TYPES, TYPES, Case, InputTable, Limits, Scenario,
+                                        Settle, Waveform)
+from vsim_core import units
 from vsim_core.documents import Document, Fields
 from vsim_core.errors import InputError
 from vsim_core.files import read_text
@@ -73,7 +75,7 @@ def _periodic(f: Fields, kind: str) -> tuple[Waveform, int]:
     """Triangle 0 → +A → −A → 0 or sine A·sin(2πft), ``cycles`` times, SI."""
     quantity = SIGNAL_TYPES[kind]
     unit, si = FILE_UNITS[quantity], file_si(quantity)
-    amplitude = f.number(f"amplitude_{unit}", positive=True) * si
+    amplitude = f.number(f"amplitude_{unit}", positive=True, at_most=units.plausible(unit), unit=unit) * si
     shape = f.choice("shape", SHAPES, "triangle")
     cycles = int(f.number("cycles", 1, positive=True, integer=True))
     speed_key = f"speed_{unit}_s"
@@ -113,12 +115,18 @@ def _bisine(f: Fields, axles: tuple[str, ...]) -> tuple[Waveform, tuple[float, .
     sines = []
     for i, item in enumerate(raw):
         c = Fields.of(f.doc, f.path("components") + (i,), item, (f"amplitude_{unit}", "frequency_hz"))
-        sines.append((c.number(f"amplitude_{unit}", nonzero=True) * si, _frequency(c)))
+        sines.append((c.number(f"amplitude_{unit}", nonzero=True, at_most=units.plausible(unit), unit=unit) * si,
+                      _frequency(c)))
     if f.has("duration_s") and f.has("cycles"):
         raise f.fail("duration_s", "give either cycles (of the slowest component) or duration_s, not both")
     duration = (f.number("duration_s", positive=True) if f.has("duration_s")
                 else f.number("cycles", 2, positive=True, integer=True) / min(fr for _, fr in sines))
     return Waveform((0.0, duration), (0.0, 0.0), tuple(sines)), _pattern(kind, axles)
+
+
+def _rack(f: Fields, key: str) -> float:
+    """A rack displacement written in mm, in m."""
+    return f.number(key, nonzero=True, at_most=units.plausible("mm"), unit="mm") * MM
 
 
 def _case(f: Fields, kind: str, axles: tuple[str, ...], base_dir: Path) -> Case:
@@ -128,11 +136,11 @@ def _case(f: Fields, kind: str, axles: tuple[str, ...], base_dir: Path) -> Case:
         waveform, cycles = _periodic(f, kind)
         return Case(label, params, cycles, waveform, _pattern(kind, axles))
     if kind == "rack_step":
-        levels = [(f.number("rack_mm", nonzero=True) * MM, f.number("hold_s", positive=True))]
+        levels = [(_rack(f, "rack_mm"), f.number("hold_s", positive=True))]
         return Case(label, params, 1, _ramps(f, levels), _pattern("rack", axles))
     if kind == "double_rack_step":
-        first = f.number("first_mm", nonzero=True) * MM
-        second = first + f.number("second_mm", nonzero=True) * MM
+        first = _rack(f, "first_mm")
+        second = first + _rack(f, "second_mm")
         levels = [(first, f.number("rest_s", positive=True)), (second, f.number("hold_s", positive=True))]
         return Case(label, params, 1, _ramps(f, levels), _pattern("rack", axles))
     if kind == "bisine":
@@ -160,7 +168,9 @@ def read_input_csv(path: Path) -> InputTable:
     if not present:
         raise InputError(f"expected t_s and at least one input column, got {','.join(header) or 'an empty file'}",
                          source=str(path), key="line 1")
-    data = read_csv_columns(path, ("t_s", *present), min_rows=2)
+    unit_of = {c: FILE_UNITS[input_quantity(ch)] for c, ch in zip(columns, INPUT_CHANNELS)}
+    limits = {"t_s": units.plausible("s")} | {c: units.plausible(unit_of[c]) for c in present}
+    data = read_csv_columns(path, ("t_s", *present), min_rows=2, limits=limits)
     if data["t_s"][0] != 0.0:
         raise InputError(f"expected the inputs to start at t_s = 0, got {data['t_s'][0]}", source=str(path),
                          key="first data line, column t_s")
@@ -221,8 +231,8 @@ def parse_scenario(text: str, path: Path, source: str | None = None) -> Scenario
     axles = _axles(top, kind)
 
     s = Fields.of(doc, ("settle",), top.raw("settle", {}), ("before_bushings_s", "before_input_s"))
-    settle = Settle(s.number("before_bushings_s", Settle.before_bushings_s, nonneg=True),
-                    s.number("before_input_s", Settle.before_input_s, nonneg=True))
+    settle = Settle(s.number("before_bushings_s", Settle.before_bushings_s, nonneg=True, at_most=MAX_SETTLE_S, unit="s"),
+                    s.number("before_input_s", Settle.before_input_s, nonneg=True, at_most=MAX_SETTLE_S, unit="s"))
     lim = Fields.of(doc, ("limits",), top.raw("limits", {}), ("translation_mm", "rotation_deg", "closure_error_mm"))
     limits = Limits(lim.number("translation_mm", Limits.translation_m * MM_PER_M, positive=True) * MM,
                     math.radians(lim.number("rotation_deg", math.degrees(Limits.rotation_rad), positive=True)),
@@ -237,10 +247,18 @@ def parse_scenario(text: str, path: Path, source: str | None = None) -> Scenario
     for i, item in enumerate(raw_cases):
         own = Fields.of(doc, ("cases", i), item, allowed)
         merged = Fields(doc, {**defaults.values, **own.values}, ("cases", i))
-        cases.append(_case(merged, kind, axles, path.parent))
+        case = _case(merged, kind, axles, path.parent)
+        if not case.duration_s <= MAX_INPUT_S:
+            raise doc.error(("cases", i), f"its input lasts {case.duration_s:.6g} s; expected at most {MAX_INPUT_S:g} s "
+                                          f"of simulated time per case")
+        cases.append(case)
     if kind == "bisine" and len({c.parameters["input"] for c in cases}) > 1:
         raise top.fail("cases", "expected every bi-sine case to drive the same input (put `input` in defaults)")
+    name = top.text("name", path.stem)
+    if not NAME_PATTERN.fullmatch(name):
+        raise top.fail("name", f"expected a plain name (letters, digits, '_', '.', '-'; the run file is "
+                               f"out/<name>.mcap), got {name!r}")
     return Scenario(
-        name=top.text("name", path.stem), description=top.text("description", ""), path=path, text=text, type=kind,
+        name=name, description=top.text("description", ""), path=path, text=text, type=kind,
         vehicle=vehicle, bushing_model=top.choice("bushings", BUSHING_MODELS, None), axles=axles,
         output_rate_hz=_output_rate(top), settle=settle, limits=limits, cases=tuple(cases))

@@ -8,7 +8,10 @@ import math
 from dataclasses import dataclass
 
 from vehicle.scenarios.scenario import Scenario
+from vsim_core.errors import InputError
 
+#: Largest factor on a scenario's durations (slower runs than that are typing errors).
+MAX_DURATION_SCALE = 100.0
 #: The phases of a case, in order (the ``phase`` signal of a recording is the index).
 PHASES = ("settle, bushings linear", "settle, bushing laws on", "input")
 
@@ -44,7 +47,11 @@ class Progress:
 def schedule(scenario: Scenario, duration_scale: float, dt: float) -> list[CaseSchedule]:
     """Phase lengths of every case (settle times and inputs scaled by ``duration_scale``), each
     rounded up to whole output intervals, and each case's start in the file: case k+1's first
-    sample follows case k's last one by one output interval."""
+    sample follows case k's last one by one output interval. InputError for a scale that is not
+    finite, positive and at most :data:`MAX_DURATION_SCALE`."""
+    if not (math.isfinite(duration_scale) and 0.0 < duration_scale <= MAX_DURATION_SCALE):
+        raise InputError(f"expected a duration scale > 0 and at most {MAX_DURATION_SCALE:g}, got {duration_scale}",
+                         key="duration_scale")
     every = output_interval(scenario, dt)
     out, start = [], 0.0
     for case in scenario.cases:

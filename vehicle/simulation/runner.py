@@ -28,7 +28,6 @@ from vehicle.scenarios.schedule import CaseSchedule, Progress, output_interval, 
 from vehicle.simulation.outputs import RigOutputs, Sample
 from vehicle.simulation.rig import KCRig
 from vsim_core.units import DEG_PER_RAD, MM_PER_M
-from vsim_core.errors import InputError
 
 
 class DivergenceError(RuntimeError):
@@ -77,14 +76,12 @@ class ScenarioRun:
 
     def __init__(self, scenario: Scenario, vehicle: VehicleDefinition, duration_scale: float = 1.0,
                  progress: Callable[[Progress], None] | None = None):
-        if not duration_scale > 0:
-            raise InputError(f"expected a positive duration scale, got {duration_scale}", key="--duration-scale")
         self.scenario, self.vehicle, self.duration_scale = scenario, vehicle, duration_scale
         self.progress = progress
         self.options = BuildOptions(bushing_model=scenario.bushing_model)
+        self.dt = self.options.timestep
+        self.plan = schedule(scenario, duration_scale, self.dt)   # checks the scale before the build
         self.rig = KCRig(vehicle, self.options)
-        self.dt = self.rig.model.opt.timestep
-        self.plan = schedule(scenario, duration_scale, self.dt)
         self.total_s = self.plan[-1].end_s(self.dt)
 
     def bodies(self) -> list[str]:
