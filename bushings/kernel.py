@@ -42,6 +42,11 @@ _MAX_NEWTON = 80
 _R_GROW = 0.02
 #: Relative predictor step up to which a node gets the second-order correction of the predictor.
 _R_CORRECT = 3.0
+#: Growth ratio beyond which _grow steps a node from the cap directly (r·w would overflow).
+_R_HUGE = 1e12
+#: Least slip [m or rad] the power law's slope pw·f/|w| is taken at: below it (a node released by
+#: a subnormal amount when pw is small) the slope would overflow to inf.
+_W_FLOOR = 1e-250
 # Fast-math without 'nnan'/'ninf', so the solver's NaN checks keep working.
 _FAST = {"nsz", "arcp", "contract", "afn", "reassoc"}
 # Rows of a channel's ladder array, its state and the solver's work rows side by side, so that a
@@ -261,6 +266,11 @@ def _grow(n, S, Kr, pw):
         dfl = S[_DFL + j]
         ks = S[_KL + j] + Kr
         theta = dfl / (ks + dfl)
+        if r > _R_HUGE:
+            # a node slipping a round-off amount (even a subnormal one): r·w would overflow; at this
+            # r the cap holds for pw < 1 and Newton's step for pw = 1
+            S[_W + j] += S[_RHS + j] * ((ks + dfl) / ks if pw < 1.0 else 1.0)
+            continue
         g = (1.0 - theta) * r + theta * (math.exp(math.log1p(pw * r) / pw) - 1.0)
         S[_W + j] *= 1.0 + min(g, r * (ks + dfl) / ks)
 
@@ -320,7 +330,7 @@ def _ladder_step(e, de, h, n, Kpa, Kr, Ff, Co, pw, tol_x, S):
             pos = S[_U + j] + S[_W + j]
             df = kl * ((S[_U + j - 1] + S[_W + j - 1]) - pos) - Kr * (pos - (S[_U + j + 1] + S[_W + j + 1]))
             S[_A0 + j] = df + (kl + Kr) * S[_W + j]
-            aw = abs(S[_W + j]) if S[_W + j] != 0.0 else h
+            aw = max(abs(S[_W + j]), _W_FLOOR) if S[_W + j] != 0.0 else h
             f = Co * _pow(aw / h, pw) if Co > 0.0 else 0.0
             S[_PSI + j] = f
             S[_DFL + j] = pw * f / aw

@@ -15,7 +15,7 @@ from bushings.effects import Effects, effects_to_si
 from bushings.parameters import MODELS, ChannelParams, to_si
 from vsim_core.documents import Document
 from vsim_core.errors import InputError
-from vsim_core.files import atomic_output, read_text
+from vsim_core.files import atomic_output, is_file, read_text
 from vsim_core.shipped import PARAMETER_SET_DIR
 
 
@@ -48,7 +48,7 @@ class ParameterSet:
         if target != self.model:
             if target in ("sts_continuous", "stsn") and "Ct" not in values and {"Ff", "Kr"} <= set(values):
                 values["Ct"] = 2.0 * values["Ff"] * values["Kr"]
-            if target not in MODELS:
+            if not isinstance(target, str) or target not in MODELS:
                 raise InputError(f"unknown model {target!r}; expected one of {', '.join(MODELS)}",
                                  source=str(self.path or self.name), key="model")
             required, optional = MODELS[target]
@@ -71,6 +71,9 @@ def parse_parameter_set(data: Any, source: str, name: str | None = None) -> Para
     for key in ("params", "effects"):
         if not isinstance(data.get(key, {}), Mapping):
             raise InputError(f"expected a mapping, got {data[key]!r}", source=source, key=key)
+    for key in ("name", "source", "description"):
+        if not isinstance(data.get(key, ""), str):
+            raise InputError(f"expected text, got {str(data[key])[:80]!r}", source=source, key=key)
     pset = ParameterSet(name=str(data.get("name", name or source)), model=str(data["model"]),
                         quantity=str(data.get("quantity", "translation")), values=dict(data["params"]),
                         source=str(data.get("source", "unspecified")),
@@ -86,7 +89,7 @@ def load_parameter_set(name_or_path: str | Path) -> ParameterSet:
     path = Path(name_or_path)
     if path.suffix not in (".yaml", ".yml"):
         path = PARAMETER_SET_DIR / f"{name_or_path}.yaml"
-    if not path.is_file():
+    if not is_file(path):
         known = ", ".join(sorted(p.stem for p in PARAMETER_SET_DIR.glob("*.yaml")))
         raise InputError(f"no parameter set {str(name_or_path)!r}; known sets: {known}", source=str(path))
     # a vehicle build reads the same few files once per bushing direction: parsed once per content;

@@ -18,6 +18,12 @@ from vsim_core.errors import InputError
 DEFAULT_CELLS = 15
 #: Most ladder cells a channel may have (the kernel's ladder rows are sized for it).
 MAX_CELLS = 200
+#: Largest magnitude of any parameter in the thesis units (N, mm, s; N·m, deg): a stiffness of 1e9 N/mm
+#: or a force of 1e9 N is a unit or typing error, not a bushing.
+MAX_MAGNITUDE = 1e9
+#: Smallest power-law exponent: the damper's inverse law v ∝ F^(1/pw) is then already a slider of
+#: exponent 33; below it the implicit step fails to converge on ordinary loads (measured at 0.02).
+PW_MIN = 0.03
 
 #: Each parameter's dimension: the power of the length unit L in value_SI = value_user · L**power, and
 #: its unit with F the force unit (N, or N·m for rotations) and L the length unit (mm, or deg). Co has
@@ -99,8 +105,9 @@ class ChannelParams:
 def _number(value: Any, source: str, key: str) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise InputError(f"expected a number, got {value!r}", source=source, key=key)
-    if not math.isfinite(value):
-        raise InputError(f"expected a finite number, got {value!r}", source=source, key=key)
+    if not abs(value) <= MAX_MAGNITUDE:
+        raise InputError(f"expected a finite number of at most {MAX_MAGNITUDE:g} in magnitude (N, mm, s: a unit or "
+                         f"typing error beyond), got {str(value)[:40]}", source=source, key=key)
     return float(value)
 
 
@@ -112,10 +119,10 @@ def to_si(model: str, values: Mapping[str, Any], quantity: str = "translation",
     C [N·s/mm], N_sup/N_inf/S_sup/S_inf [mm], P_sup/P_inf [N], Ct [N^n/mm], n, maxwell_k [N/mm],
     maxwell_c [N·s/mm] (N·m and deg in place of N and mm for ``quantity: rotation``).
     """
-    if model not in MODELS:
+    if not isinstance(model, str) or model not in MODELS:
         raise InputError(f"unknown model {model!r}; expected one of {', '.join(MODELS)}",
                          source=source, key="model")
-    if quantity not in LENGTH_UNIT_SI:
+    if not isinstance(quantity, str) or quantity not in LENGTH_UNIT_SI:
         raise InputError(f"unknown quantity {quantity!r}; expected translation or rotation",
                          source=source, key="quantity")
     required, optional = MODELS[model]
@@ -145,8 +152,9 @@ def to_si(model: str, values: Mapping[str, Any], quantity: str = "translation",
                                  source=source, key=key)
             si["n_cells"] = int(value)
             continue
-        if key == "pw" and not 0.0 < value <= 1.0:
-            raise InputError(f"expected 0 < pw <= 1, got {raw!r}", source=source, key=key)
+        if key == "pw" and not PW_MIN <= value <= 1.0:
+            raise InputError(f"expected {PW_MIN} <= pw <= 1 (a smaller exponent is a slider, Ff), got {raw!r}",
+                             source=source, key=key)
         if key == "n" and not value > 1.0:
             raise InputError(f"expected a root n > 1, got {raw!r}", source=source, key=key)
         if key in ("K0", "C", "Kpa", "Kr", "Ff", "Co", "Ct", "P_sup", "P_inf") and value < 0:

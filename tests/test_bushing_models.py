@@ -227,6 +227,29 @@ def test_large_steps_are_stable(name, amp_mm, freq_hz):
         assert np.max(np.abs(F)) < (ch.K0 + ch.Kpa) * amp_mm * MM + 200.0
 
 
+@pytest.mark.parametrize("model,values,amp_mm,freq_hz,dt", [
+    ("stvs", dict(Ff=30.0, Co=1e-4, pw=0.999), 1.0, 2.0, 1e-4),   # nodes released by subnormal slips
+    ("rt", dict(Co=41100.0, pw=0.03), 50.0, 0.1, 2e-3),             # the steepest law, subnormal slopes
+])
+def test_extreme_power_laws_stay_finite_bounded_and_passive(model, values, amp_mm, freq_hz, dt):
+    """Legal but extreme damper laws (issue 25's fuzz found NaN forces in each): the force stays
+    within the stiffest response K_mu·A, the last cycle dissipates, and at most 1 % of the steps end
+    unconverged (the steepest law, pw = 0.03, at 50 mm); a damper of negligible Co gives the STS with
+    the same slider."""
+    ch = inline(model, K0=508.2, Kpa=1076.7, Kr=2935.0, **values)
+    t = np.arange(0.0, 2.0 / freq_hz + dt / 2, dt)
+    e = amp_mm * MM * np.sin(2 * np.pi * freq_hz * t)
+    bank = BushingBank([ch])
+    F = bank.run(e, dt)[0]
+    assert np.all(np.isfinite(F)) and bank.failed_steps[0] <= 0.01 * len(t)
+    assert np.max(np.abs(F)) <= (ch.K0 + ch.Kpa) * amp_mm * MM * (1 + 1e-9)
+    last = t >= 1.0 / freq_hz - dt / 2
+    assert np.sum(0.5 * (F[last][1:] + F[last][:-1]) * np.diff(e[last])) >= -1e-9 * np.max(np.abs(F)) * amp_mm * MM
+    if model == "stvs":
+        sts = simulate(inline("sts", K0=508.2, Kpa=1076.7, Kr=2935.0, Ff=values["Ff"]), e, dt)
+        assert np.max(np.abs(F - sts)) < 1e-3 * np.max(np.abs(sts))
+
+
 def test_mixed_bank_equals_separate_banks():
     # The long ladders do not fit beside the others in one block of the ladder array.
     chans = [channel("fig5_9"), channel("fig3_14"), channel("fig5_8"), channel("table3_2"),

@@ -8,6 +8,7 @@ import ast
 import re
 import subprocess
 import sys
+import tomllib
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -115,6 +116,15 @@ def test_imports_stand_at_the_top_of_modules_except_in_the_command_line():
     assert not hidden, "\n".join(hidden)
 
 
+def test_the_wheel_packages_every_package_and_the_shipped_data():
+    """pyproject.toml lists the packages (a wheel carries no other), and maps models/ and scenarios/
+    into vsim_core, where vsim_core.shipped looks for them in an installed copy."""
+    setuptools = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]
+    packages = {m for m, path in MODULES.items() if path.name == "__init__.py"}
+    assert sorted(setuptools["packages"]) == sorted(packages | {"vsim_core.models", "vsim_core.scenarios"})
+    assert setuptools["package-dir"] == {"vsim_core.models": "models", "vsim_core.scenarios": "scenarios"}
+
+
 def _readme_table() -> dict[str, tuple[str, str]]:
     text = (ROOT / "README.md").read_text()
     section = text.split("## Layout", 1)[1].split("\n## ", 1)[0]
@@ -162,6 +172,7 @@ def test_modules_are_small():
 
 _NO_MUJOCO = """
 import sys
+import tomllib
 class Refuse:
     def find_spec(self, name, path=None, target=None):
         if name.split(".")[0] == "mujoco":

@@ -18,7 +18,7 @@ def _run(args: argparse.Namespace) -> int:
     write_csv_columns(args.output, columns)
     print(f"wrote {args.output}")
     if args.plot is not None:
-        for path in plot_bench(bench, columns, args.plot, args.bench.stem):
+        for path in plot_bench(bench, columns, args.plot, Path(args.bench).stem):
             print(f"wrote {path}")
     return 0
 
@@ -33,7 +33,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "force-deflection loop and the time histories (log time for a step), or for a sweep |K*| and "
         "tan delta against amplitude and frequency, with the equivalent-damping approximation (spec "
         "5.16/5.17) dashed over the time-domain result.")
-    run.add_argument("bench", type=Path, metavar="BENCH.yaml")
+    run.add_argument("bench", metavar="BENCH", help="bench file, or the name of a built-in one (bisine, sweep, ...)")
     run.add_argument("-o", "--output", type=output_file, required=True, metavar="OUT.csv")
     run.add_argument("--plot", type=output_folder, metavar="DIR", help="also write PNG plots into this directory")
     run.set_defaults(func=_run)

@@ -69,8 +69,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     "nothing significant is missing, or that the mismatch is unexplained.")
     p.add_argument("rigdir", type=Path, metavar="RIGDIR")
     group = p.add_mutually_exclusive_group()
-    group.add_argument("--vehicle", type=Path, metavar="V.yaml",
-                       help="baseline vehicle (K&C datasets; default: the built-in car)")
+    group.add_argument("--vehicle", metavar="VEHICLE",
+                       help="baseline vehicle file or built-in name (K&C datasets; default: the built-in car)")
     group.add_argument("--bushing-model", metavar="SET", help="baseline parameter set (bench datasets)")
     p.add_argument("-o", "--output", type=output_folder, metavar="REPORT_DIR",
                    help="write report.md, PNGs, diagnosis.json and extended_model.yaml here")

@@ -1,4 +1,4 @@
-"""`vsim kc [--vehicle V.yaml] [--bushings MODEL] [--json]`: standard K&C metrics of a vehicle."""
+"""`vsim kc [--vehicle VEHICLE] [--bushings MODEL] [--json]`: standard K&C metrics of a vehicle."""
 
 from __future__ import annotations
 
@@ -26,7 +26,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                                description="Runs bump, roll, lateral-force, longitudinal-force and "
                                            "aligning-torque triangles on both axles (vehicle/scenarios/kc_tests.py; "
                                            "metrics: vsim_analysis/kc_metrics.py).")
-    kc.add_argument("--vehicle", default=str(DEFAULT_VEHICLE), help="vehicle YAML file (default: %(default)s)")
+    kc.add_argument("--vehicle", default=DEFAULT_VEHICLE.stem, metavar="VEHICLE",
+                    help="vehicle file, or the name of a built-in one (default: %(default)s)")
     kc.add_argument("--bushings", choices=BUSHING_MODELS, default=None,
                     help="put this model on every bushing direction (models/vehicles/README.md)")
     kc.add_argument("--json", action="store_true", help="one JSON object keyed front and rear")

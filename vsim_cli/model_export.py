@@ -27,7 +27,7 @@ def _export(args: argparse.Namespace) -> int:
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``export`` (of the ``model`` group)."""
     export = subparsers.add_parser("export", help="write the MJCF of a vehicle definition")
-    export.add_argument("vehicle", help="vehicle YAML file (models/vehicles/)")
+    export.add_argument("vehicle", help="vehicle file, or the name of a built-in one (c_segment)")
     export.add_argument("-o", "--output", type=output_file, required=True, help="MJCF file to write")
     export.add_argument("--bushings", choices=BUSHING_MODELS, default=None,
                         help="read every bushing parameter set as this model")

@@ -1,11 +1,10 @@
-"""`vsim run SCENARIO.yaml`: run a scenario on the K&C rig with a progress line, record it, print its summary."""
+"""`vsim run SCENARIO`: run a scenario on the K&C rig with a progress line, record it, print its summary."""
 
 from __future__ import annotations
 
 import argparse
 import sys
 import time
-from pathlib import Path
 
 from vehicle.model.definition import BUSHING_MODELS
 from vsim_cli.arguments import output_file, positive_scale
@@ -53,7 +52,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description="Run every case of a scenario file (format: scenarios/README.md) and record them in one "
                     "MCAP file; print a summary (gradients and loop widths, K&C metrics, relaxation, peak bushing "
                     "deflections).")
-    run.add_argument("scenario", type=Path, metavar="SCENARIO.yaml")
+    run.add_argument("scenario", metavar="SCENARIO", help="scenario file, or the name of a built-in one (pumping, kc/roll, ...)")
     run.add_argument("-o", "--output", type=output_file, metavar="OUT.mcap", help="run file (default: out/<scenario>.mcap)")
     run.add_argument("--bushings", choices=BUSHING_MODELS, default=None,
                      help="this bushing model on every bushing direction (overrides the scenario's `bushings`)")

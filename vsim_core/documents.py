@@ -10,13 +10,15 @@ last one win silently). Values built in code are checked with the same readers
 from __future__ import annotations
 
 import math
+import re
+import sys
 from pathlib import Path
 from typing import Any, Mapping
 
 import yaml
 
 from vsim_core.errors import InputError
-from vsim_core.files import read_text
+from vsim_core.files import is_file, read_text
 
 #: Where a value sits in a document: mapping keys and list indices from the top.
 KeyPath = tuple[Any, ...]
@@ -49,6 +51,12 @@ class _Loader(yaml.SafeLoader):
         return super().compose_node(parent, index)
 
 
+# YAML 1.1 reads 1e-6 and 1.5e3 (no dot, or no exponent sign) as text; engineers mean numbers, as YAML 1.2 does.
+_Loader.add_implicit_resolver("tag:yaml.org,2002:float",
+                              re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9_]+)[eE][-+]?[0-9]+$"),
+                              list("-+0123456789."))
+
+
 class Document:
     """A YAML document as plain data plus the line of every key path (from the composed nodes)."""
 
@@ -65,6 +73,10 @@ class Document:
                 self._index(node, ())
         except yaml.YAMLError as exc:
             raise InputError(f"not valid YAML: {exc}", source=source) from None
+        except InputError:
+            raise
+        except ValueError as exc:   # an integer of more digits than Python converts (4300)
+            raise InputError(f"not valid here: {exc}", source=source) from None
         except _Refused as exc:
             raise InputError(str(exc), source=f"{source}:{exc.line}") from None
         except RecursionError:
@@ -76,7 +88,7 @@ class Document:
     def read(cls, path: str | Path, missing: str = "no such file") -> "Document":
         """The document in the file ``path``; InputError naming it (with the message ``missing`` when
         it does not exist) if it cannot be read, is not UTF-8 text or not valid YAML."""
-        if not Path(path).is_file():
+        if not is_file(path):
             raise InputError(missing, source=str(path))
         return cls(read_text(path), str(path))
 
@@ -125,8 +137,8 @@ def check_number(doc: Document, path: KeyPath, value: Any, *, positive: bool = F
     """``value`` (found at ``path`` of ``doc``) as a finite float with the properties asked for, and
     at most ``at_most`` in magnitude (a physical range; ``unit`` for the message); InputError at
     ``path`` otherwise."""
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise doc.error(path, f"expected a finite number, got {value!r}")
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not abs(value) <= sys.float_info.max:
+        raise doc.error(path, f"expected a finite number, got {value!r:.60}")
     if integer and value != int(value):
         raise doc.error(path, f"expected a whole number, got {value!r}")
     for bad, what in ((positive and value <= 0, "positive"), (nonneg and value < 0, "non-negative"),
@@ -143,7 +155,7 @@ def check_vector(doc: Document, path: KeyPath, value: Any, n: int, *, at_most: f
     """``value`` (found at ``path``) as a list of ``n`` finite numbers, each at most ``at_most`` in
     magnitude; InputError at ``path`` otherwise."""
     if not isinstance(value, (list, tuple)) or len(value) != n:
-        raise doc.error(path, f"expected a list of {n} numbers, got {value!r}")
+        raise doc.error(path, f"expected a list of {n} numbers, got {value!r:.80}")
     return tuple(check_number(doc, path + (i,), v, at_most=at_most, unit=unit) for i, v in enumerate(value))
 
 

@@ -23,6 +23,15 @@ def read_text(path: str | Path) -> str:
         raise InputError(f"cannot read: {exc.strerror}", source=str(path)) from exc
 
 
+def is_file(path: str | os.PathLike[str]) -> bool:
+    """Whether ``path`` names a file; False, not an OSError, for a name the system cannot even look
+    up (too long, a null byte): a user's file names are input like any other."""
+    try:
+        return Path(path).is_file()
+    except (OSError, ValueError):
+        return False
+
+
 def check_output(path: str | os.PathLike[str], *, folder: bool = False) -> Path:
     """``path`` as a Path if an output can be written there (a file, or a ``folder``), else an
     InputError naming it: a folder where a file is expected or the reverse, an ancestor that is a

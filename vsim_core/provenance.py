@@ -5,7 +5,7 @@ from __future__ import annotations
 import importlib.metadata
 import subprocess
 
-from vsim_core.shipped import ROOT
+from vsim_core.shipped import SOURCE_TREE
 
 
 def software_version() -> str:
@@ -17,10 +17,13 @@ def software_version() -> str:
 
 
 def git_revision() -> str:
-    """The source tree's commit (``-dirty`` if tracked files changed), or ``unknown``."""
+    """The source tree's commit (``-dirty`` if tracked files changed), or ``unknown`` (an installed
+    wheel has no source tree: asking git there could name an unrelated repository around it)."""
+    if SOURCE_TREE is None:
+        return "unknown"
     try:
-        rev = subprocess.run(["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True, text=True, check=True)
-        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=ROOT,
+        rev = subprocess.run(["git", "rev-parse", "HEAD"], cwd=SOURCE_TREE, capture_output=True, text=True, check=True)
+        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=SOURCE_TREE,
                                capture_output=True, text=True, check=True)
     except (OSError, subprocess.CalledProcessError):
         return "unknown"

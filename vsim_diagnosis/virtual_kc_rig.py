@@ -39,7 +39,7 @@ from vehicle.scenarios.channels import INPUT_CHANNELS
 from vehicle.scenarios.scenario import Scenario
 from vehicle.scenarios.scenario_file import load_scenario
 from vsim_core.errors import InputError
-from vsim_core.files import atomic_directory
+from vsim_core.files import atomic_directory, is_file
 from vsim_core.shipped import DEFAULT_VEHICLE, KC_SCENARIO_DIR
 from vsim_diagnosis.kc_catalogue import (BUSHING_CAUSES, DIRECTIONS, VEHICLE_CAUSES, Hypothesis, extended_vehicle,
                                          locations, parameters)
@@ -180,7 +180,7 @@ def _scenarios(raw: Any, source: str, base_dir: Path | None) -> tuple[Scenario, 
     out = []
     for i, path in enumerate(paths):
         key = f"scenarios[{i}]"
-        if not path.is_file():
+        if not is_file(path):
             raise InputError(f"no such scenario file {str(path)!r}", source=source, key=key)
         try:
             out.append(load_scenario(path))
@@ -203,7 +203,7 @@ def parse_kc_truth(data: Any, source: str, base_dir: Path | None = None) -> KCTr
         raise InputError(f"expected a vehicle file (relative to this file), got {raw_vehicle!r}", source=source,
                          key="vehicle")
     vehicle_path = DEFAULT_VEHICLE if raw_vehicle is None else _path(raw_vehicle, base_dir)
-    if not vehicle_path.is_file():
+    if not is_file(vehicle_path):
         raise InputError(f"no such vehicle file {str(vehicle_path)!r}", source=source, key="vehicle")
     try:
         baseline = load_vehicle(vehicle_path)

@@ -16,22 +16,23 @@ The order matters: the part's state (hysteresis memory, Mullins damage, heat) ca
 
 from __future__ import annotations
 
-import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any, Mapping, Sequence
 
 import numpy as np
 
 from bushings.bench.records import BenchRecord, read_bench_csv
 from vsim_core.errors import InputError
-from vsim_core.files import atomic_directory
-from vsim_recordings.datasets import read_manifest, write_manifest
+from vsim_core.files import atomic_directory, is_file
 from vsim_core.units import MM_PER_M
+from vsim_recordings.datasets import read_manifest, write_manifest
 
 _KEYS = ("level", "part", "quantity", "rig", "records")
 _RECORD_KEYS = {"file", "programme", "rest_before_s"}
+#: Longest rest before a test [s] (a day): beyond, a unit or typing error.
+MAX_REST_S = 86_400.0
 
 
 @dataclass(frozen=True)
@@ -76,14 +77,23 @@ def read_bench_dataset(directory: str | os.PathLike[str]) -> BenchDataset:
             raise InputError(f"unknown key {bad[0]!r}; expected {', '.join(sorted(_RECORD_KEYS))}", source=source,
                              key=f"{key}.{bad[0]}")
         rest = entry.get("rest_before_s", 0.0)
-        if isinstance(rest, bool) or not isinstance(rest, (int, float)) or not 0.0 <= rest < math.inf:
-            raise InputError(f"expected a rest duration >= 0 s, got {rest!r}", source=source, key=f"{key}.rest_before_s")
-        csv_path = root / str(entry["file"])
-        if not csv_path.is_file():
-            raise InputError(f"no such record file {str(entry['file'])!r}", source=source, key=f"{key}.file")
-        records.append(BenchTestRecord(Path(str(entry["file"])).stem, dict(entry.get("programme") or {}),
-                                       float(rest), read_bench_csv(csv_path)))
-    return BenchDataset(root, str(data.get("part", "")), quantity, records, dict(data.get("rig") or {}))
+        if isinstance(rest, bool) or not isinstance(rest, (int, float)) or not 0.0 <= rest <= MAX_REST_S:
+            raise InputError(f"expected a rest duration from 0 to {MAX_REST_S:g} s, got {rest!r}", source=source,
+                             key=f"{key}.rest_before_s")
+        file, programme = entry["file"], entry.get("programme") or {}
+        if not isinstance(file, str) or not is_file(root / file) or Path(file).name != file:
+            raise InputError(f"expected the name of a record file in {root}, got {file!r}", source=source,
+                             key=f"{key}.file")
+        if not isinstance(programme, Mapping):
+            raise InputError(f"expected a mapping describing the programme played, got {programme!r}", source=source,
+                             key=f"{key}.programme")
+        records.append(BenchTestRecord(Path(file).stem, dict(programme), float(rest), read_bench_csv(root / file)))
+    part, rig = data.get("part", ""), data.get("rig") or {}
+    if not isinstance(part, str) or not isinstance(rig, Mapping):
+        bad = "part" if not isinstance(part, str) else "rig"
+        raise InputError(f"expected {'free text' if bad == 'part' else 'a mapping'}, got {data[bad]!r}", source=source,
+                         key=bad)
+    return BenchDataset(root, part, quantity, records, dict(rig))
 
 
 def write_bench_dataset(directory: str | os.PathLike[str], part: str, records: Sequence[BenchTestRecord],

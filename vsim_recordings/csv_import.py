@@ -23,7 +23,7 @@ from vehicle.scenarios.scenario_file import load_scenario, parse_scenario
 from vsim_core import units
 from vsim_core.documents import Document, Fields
 from vsim_core.errors import InputError
-from vsim_core.files import read_text
+from vsim_core.files import is_file, read_text
 from vsim_core.tables import read_csv_columns
 from vsim_recordings.rig_recordings import TIME_NAME, measured_channels, write_rig_recording
 
@@ -83,7 +83,7 @@ def _scenario(top: Fields, meta: Path) -> Scenario:
     raw = top.raw("scenario")
     if isinstance(raw, str):
         path = meta.parent / raw
-        if not path.is_file():
+        if not is_file(path):
             raise top.fail("scenario", f"no such scenario file {str(path)!r}")
         return load_scenario(path)
     if not isinstance(raw, Mapping):

@@ -26,6 +26,7 @@ from vehicle.scenarios.scenario import Scenario
 from vehicle.scenarios.scenario_file import parse_scenario
 from vsim_core.documents import Document
 from vsim_core.errors import InputError
+from vsim_core.files import is_file
 from vsim_core.shipped import DEFAULT_VEHICLE
 from vsim_recordings.datasets import read_manifest, write_manifest
 from vsim_recordings.run_format import Run
@@ -88,7 +89,7 @@ def read_kc_dataset(directory: str | os.PathLike[str]) -> KCDataset:
             raise InputError(f"{entry!r} is listed twice", source=source, key=key)
         seen.add(entry)
         file = root / entry
-        if not file.is_file():
+        if not is_file(file):
             raise InputError(f"no such recording file {entry!r}", source=source, key=key)
         run = _load(file, source, key)
         tests.append(KCTest(file.stem, file, run, recorded_scenario(run, source=source, key=key)))
@@ -135,7 +136,7 @@ def recorded_scenario(run: Run, *, source: str | None = None, key: str | None = 
     base = None if file is None else file.parent
     data = dict(data)
     vehicle = _resolve(data.get("vehicle"), base)
-    found = isinstance(vehicle, str) and Path(vehicle).is_absolute() and Path(vehicle).is_file()
+    found = isinstance(vehicle, str) and Path(vehicle).is_absolute() and is_file(vehicle)
     data["vehicle"] = vehicle if found else str(DEFAULT_VEHICLE)
     for part in (data.get("defaults"), *(data.get("cases") or [])):
         if isinstance(part, dict) and isinstance(part.get("path"), str):
@@ -157,7 +158,7 @@ def _scenario_file(run: Run, recorded: str) -> Path | None:
         return None
     path = Path(recorded)
     candidates = [path] if path.is_absolute() else [run.path.parent / path, path]
-    return next((c.resolve() for c in candidates if c.is_file()), None)
+    return next((c.resolve() for c in candidates if is_file(c)), None)
 
 
 def _resolve(value: Any, base: Path | None) -> Any:

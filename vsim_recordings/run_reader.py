@@ -14,6 +14,7 @@ from mcap.records import Channel, Message, Metadata
 from mcap.stream_reader import StreamReader
 
 from vsim_core.errors import InputError
+from vsim_core.files import is_file
 from vsim_recordings.message_layouts import FrameTransformsLayout, JointStateLayout, timestamp_len
 from vsim_recordings.run_format import (FORMAT_VERSION, PARTIAL_SUFFIX, RUN_RECORD, SIGNAL_TOPIC_PREFIX, STATUS_RECORD,
                                         TF_TOPIC, GeomSpec, Run, RunMetadata, SignalSpec, signal_label)
@@ -62,7 +63,7 @@ def load_run(path: str | os.PathLike[str]) -> Run:
     A file cut short (a killed run: no summary, a last chunk unfinished) is read as far as it goes
     and marked incomplete."""
     path = Path(path)
-    if not path.is_file():
+    if not is_file(path):
         partial = path.with_name(path.name + PARTIAL_SUFFIX)
         hint = f" (an unfinished run left {partial.name}: name it to read what it holds)" if partial.exists() else ""
         raise InputError(f"no such run file{hint}", source=str(path))
@@ -94,10 +95,11 @@ def load_run(path: str | os.PathLike[str]) -> Run:
     payloads = {topic: [d for _, d in messages.get(topic, [])] for topic in topics}
 
     # A run stopped inside RunWriter.write may lack the last step on some channels: keep whole steps.
+    # (Log times are unsigned 64-bit in MCAP: a damaged one may not fit int64.)
     n_steps = min((len(t) for t in times.values()), default=0)
-    t_ns = np.array(next(iter(times.values()), [])[:n_steps], dtype=np.int64)
+    t_ns = np.array(next(iter(times.values()), [])[:n_steps], dtype=np.uint64)
     for topic, topic_times in times.items():
-        if not np.array_equal(np.asarray(topic_times[:n_steps], dtype=np.int64), t_ns):
+        if not np.array_equal(np.asarray(topic_times[:n_steps], dtype=np.uint64), t_ns):
             raise InputError(f"channel {topic} is not on the same time steps as the others", source=str(path))
 
     signals: dict[str, np.ndarray] = {}

@@ -8,7 +8,6 @@ cycle, :func:`bushings.frequency.first_harmonic`).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Mapping
@@ -23,8 +22,11 @@ from bushings.parameter_sets import load_parameter_set
 from bushings.parameters import MODELS, ChannelParams, to_si
 from vsim_core.documents import Document, Fields
 from vsim_core.errors import InputError
+from vsim_core.shipped import BENCH_DIR, resolve
 from vsim_core.units import MM
 
+#: Longest bench time step accepted [s]: the bench samples rubber that relaxes in tenths of a second.
+MAX_DT_S = 1.0
 _BENCH_KEYS = ("model", "params", "dt_s", "programme")
 
 
@@ -54,7 +56,7 @@ def read_bench(doc: Document, base_dir: Path | None = None) -> Bench:
     for key in ("params", "dt_s", "programme"):
         f.raw(key)
     model = f.raw("model", None)
-    if model is not None and model not in MODELS:
+    if model is not None and (not isinstance(model, str) or model not in MODELS):
         raise f.fail("model", f"unknown model {model!r}; expected one of {', '.join(MODELS)}")
     params = f.raw("params")
     effects = NO_EFFECTS
@@ -69,8 +71,8 @@ def read_bench(doc: Document, base_dir: Path | None = None) -> Bench:
     if channel.quantity != "translation":
         raise f.fail("params", f"the bench works in mm; set {params!r} is a {channel.quantity}")
     dt = f.raw("dt_s")
-    if isinstance(dt, bool) or not isinstance(dt, (int, float)) or not 0.0 < dt < math.inf:
-        raise f.fail("dt_s", f"expected a positive time step in s, got {dt!r}")
+    if isinstance(dt, bool) or not isinstance(dt, (int, float)) or not 0.0 < dt <= MAX_DT_S:
+        raise f.fail("dt_s", f"expected a positive time step of at most {MAX_DT_S:g} s, got {dt!r}")
     programme = read_programme(doc, f.path("programme"), float(dt), base_dir)
     if effects.active and isinstance(programme, Sweep):
         raise f.fail("params", f"set {params!r} has effects (state extensions), which a sweep's per-point restarts "
@@ -91,8 +93,9 @@ def _named_set(name: str, model: str | None, f: Fields, base_dir: Path | None) -
         raise f.fail("params", str(exc)) from exc
 
 
-def load_bench(path: Path) -> Bench:
-    """Read and validate a bench YAML file."""
+def load_bench(path: str | Path) -> Bench:
+    """Read and validate a bench YAML file, or a built-in bench programme by name (``bisine``)."""
+    path = resolve(path, BENCH_DIR, "bench")
     return read_bench(Document.read(path, "no such bench file"), path.parent)
 
 

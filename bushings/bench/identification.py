@@ -25,7 +25,7 @@ from scipy.optimize import least_squares
 
 from bushings.bench.records import BenchRecord, simulate_record
 from bushings.parameter_sets import ParameterSet
-from bushings.parameters import DEFAULT_CELLS, to_si
+from bushings.parameters import DEFAULT_CELLS, PW_MIN, to_si
 from vsim_core.errors import InputError
 from vsim_core.units import MM
 
@@ -38,8 +38,6 @@ FIT_PARAMETERS: dict[str, tuple[str, ...]] = {
 #: Share of a branch, ending at its tip, over which Tg2 is measured (within the STS's last linear
 #: segment for the thesis's sets: 0.46 of 4.05 mm for fig5_6).
 TG2_SPAN_FRACTION = 0.1
-#: Smallest power-law exponent the fit may reach (pw must stay in (0, 1]).
-PW_MIN = 0.01
 # Forward-difference step of the Jacobian, in log-parameter (relative) or pw units: large enough
 # to dominate the implicit solver's 1e-13 tolerance, small enough for a 0.1 % derivative error.
 _FD_STEP = 1e-3

@@ -26,6 +26,11 @@ from vsim_core.units import MM
 MIN_SAMPLES_PER_PERIOD = 20
 #: Most samples a programme may take (each an 8-byte number per channel): beyond, it is a typing error.
 MAX_SAMPLES = 10_000_000
+#: Largest value a programme key may take, in its unit: a bushing deflects tens of millimetres, a
+#: bench shakes at most a few kHz; beyond, it is a unit or typing error.
+LIMITS = {"amplitude_mm": (100.0, "mm"), "step_mm": (100.0, "mm"), "static_mm": (100.0, "mm"),
+          "amplitudes_mm": (100.0, "mm"), "speed_mm_s": (1e4, "mm/s"), "frequency_hz": (1e4, "Hz"),
+          "frequencies_hz": (1e4, "Hz"), "hold_s": (1e6, "s"), "rise_time_s": (1e6, "s"), "duration_s": (1e6, "s")}
 #: Speed of the ramps to and from a sine's static offset [mm/s], and the rest before the sine [s].
 STATIC_RAMP_MM_S, STATIC_REST_S = 1.0, 1.0
 
@@ -169,7 +174,7 @@ def read_programme(doc: Document, path: KeyPath, dt_s: float, base_dir: Path | N
     if not isinstance(data, Mapping):
         raise doc.error(path, f"expected a mapping with a type key, got {data!r}")
     kind = data.get("type")
-    if kind not in _KEYS:
+    if not isinstance(kind, str) or kind not in _KEYS:
         raise doc.error(path + ("type",), f"unknown programme type {kind!r}; expected one of {', '.join(_KEYS)}")
     allowed = _KEYS[kind]
     f = Fields(doc, {k: (v, path + (k,)) for k, v in data.items()}, path)
@@ -179,7 +184,8 @@ def read_programme(doc: Document, path: KeyPath, dt_s: float, base_dir: Path | N
         raise f.fail(missing[0], f"missing key for a {kind} programme")
 
     def number(key: str, **kind_of: bool) -> float:
-        return f.number(key, allowed[key], **(kind_of or {"positive": True}))
+        at_most, unit = LIMITS.get(key, (math.inf, ""))
+        return f.number(key, allowed[key], **(kind_of or {"positive": True}), at_most=at_most, unit=unit)
 
     def affordable(samples: float) -> None:
         if not samples <= MAX_SAMPLES:
@@ -209,7 +215,7 @@ def read_programme(doc: Document, path: KeyPath, dt_s: float, base_dir: Path | N
         frequency = number("frequency_hz")
         _check_sampling(f, "frequency_hz", frequency, dt_s)
         amplitude, cycles = number("amplitude_mm") * MM, int(number("cycles", positive=True, integer=True))
-        static_mm = f.number("static_mm") if f.has("static_mm") else 0.0
+        static_mm = f.number("static_mm", at_most=LIMITS["static_mm"][0], unit="mm") if f.has("static_mm") else 0.0
         affordable((cycles / frequency + 2.0 * abs(static_mm) / STATIC_RAMP_MM_S + STATIC_REST_S) / dt_s)
         if f.has("static_mm"):
             t, e = sine_about(static_mm * MM, abs(static_mm) / STATIC_RAMP_MM_S, amplitude, frequency, cycles, dt_s)
@@ -243,7 +249,9 @@ def _numbers(f: Fields, key: str) -> np.ndarray:
     raw = f.raw(key)
     if not isinstance(raw, list) or not raw:
         raise f.fail(key, f"expected a non-empty list of positive numbers, got {raw!r}")
-    return np.array([check_number(f.doc, f.path(key) + (i,), v, positive=True) for i, v in enumerate(raw)])
+    at_most, unit = LIMITS[key]
+    return np.array([check_number(f.doc, f.path(key) + (i,), v, positive=True, at_most=at_most, unit=unit)
+                     for i, v in enumerate(raw)])
 
 
 def _components(f: Fields) -> tuple[list[float], list[float]]:
@@ -255,8 +263,8 @@ def _components(f: Fields) -> tuple[list[float], list[float]]:
         if set(c) != {"amplitude_mm", "frequency_hz"}:
             raise f.fail("components", f"expected exactly the keys amplitude_mm and frequency_hz, got {dict(c)!r}")
         item = Fields.of(f.doc, f.path("components") + (i,), c, ("amplitude_mm", "frequency_hz"))
-        amplitudes.append(item.number("amplitude_mm", positive=True) * MM)
-        frequencies.append(item.number("frequency_hz", positive=True))
+        amplitudes.append(item.number("amplitude_mm", positive=True, at_most=LIMITS["amplitude_mm"][0], unit="mm") * MM)
+        frequencies.append(item.number("frequency_hz", positive=True, at_most=LIMITS["frequency_hz"][0], unit="Hz"))
     return amplitudes, frequencies
 
 

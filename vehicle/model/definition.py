@@ -147,7 +147,7 @@ class DirectionDef:
                              f"direction needs a {self.quantity} set", source=self.source, key="set")
         own = pset.values if pset is not None else self.params
         target = override_model or self.model
-        if target is not None and target not in MODELS:
+        if target is not None and (not isinstance(target, str) or target not in MODELS):
             raise InputError(f"unknown model {target!r}; expected one of {', '.join(MODELS)}",
                              source=self.source, key="model")
         if target is None or target == self.model or set(MODELS[target][0]) <= set(own):

@@ -73,9 +73,9 @@ def check_geometry(v: VehicleDefinition, doc: Document) -> None:
                                                                      f"axis; expected a wishbone that carries it")
     for axle in ("front", "rear"):
         spring, damper = getattr(v, axle).spring, getattr(v, axle).damper
-        _check_curve(doc, (axle, "spring", "curve"), spring.curve, "a spring's force must grow with compression",
+        _check_curve(doc, (axle, "spring", "curve"), spring.curve, "a spring force growing with compression",
                      lambda slope: slope > 0.0)
-        _check_curve(doc, (axle, "damper", "curve"), damper.curve, "a damper's force must not fall as the speed grows",
+        _check_curve(doc, (axle, "damper", "curve"), damper.curve, "a damper force not falling as the speed grows",
                      lambda slope: slope >= 0.0)
         for i, (speed, force) in enumerate(zip(damper.curve.x, damper.curve.y)):
             if speed * force < 0.0:
@@ -88,5 +88,5 @@ def _check_curve(doc: Document, path: KeyPath, curve: Curve, rule: str, ok: Call
     for i, (x0, x1, y0, y1) in enumerate(zip(curve.x, curve.x[1:], curve.y, curve.y[1:])):
         slope = (y1 - y0) / (x1 - x0)
         if not ok(slope) or abs(slope) > MAX_STIFFNESS_N_PER_M:
-            raise doc.error(path + (i + 1,), f"slope {slope:.6g} from point {i} to {i + 1}; expected {rule}, at most "
-                                             f"{MAX_STIFFNESS_N_PER_M:g} N/m (or N·s/m)")
+            raise doc.error(path + (i + 1,), f"slope {slope:.6g} from point {i} to {i + 1}; expected {rule}, a slope of "
+                                             f"at most {MAX_STIFFNESS_N_PER_M:g} N/m (or N·s/m)")

@@ -27,7 +27,7 @@ from vehicle.model.plausibility import (MAX_BODY_MASS_KG, MAX_CAMBER_DEG, MAX_CO
                                         MAX_TORSION_NM_PER_RAD, check_geometry)
 from vsim_core.documents import Document, Fields, KeyPath, check_number, check_vector, dotted
 from vsim_core.errors import InputError
-from vsim_core.shipped import DEFAULT_VEHICLE
+from vsim_core.shipped import DEFAULT_VEHICLE, VEHICLE_DIR, resolve
 
 #: Source named in the errors of :func:`with_extensions`.
 EXTENSIONS_SOURCE = "with_extensions"
@@ -35,8 +35,9 @@ _TOP = ("name", "description", "tyre", "body", "front", "rear", "bushing_familie
 
 
 def load_vehicle(path: str | Path = DEFAULT_VEHICLE) -> VehicleDefinition:
-    """Load and validate a vehicle file; raises :class:`InputError` naming file:line, key and value."""
-    path = Path(path)
+    """Load and validate a vehicle file, or a built-in vehicle by name (``c_segment``); raises
+    :class:`InputError` naming file:line, key and value."""
+    path = resolve(path, VEHICLE_DIR, "vehicle")
     doc = Document.read(path, "no such vehicle file")
     top = doc.top(_TOP)
     t = top.fields("tyre", ("radius", "wheel_mass", "wheel_inertia"))
@@ -89,7 +90,7 @@ def load_vehicle(path: str | Path = DEFAULT_VEHICLE) -> VehicleDefinition:
     name = top.raw("name")
     if not isinstance(name, str):
         raise top.fail("name", f"expected a name, got {name!r}")
-    vehicle = VehicleDefinition(name, str(top.raw("description", "")), path, tyre, body, front, rear, bushings)
+    vehicle = VehicleDefinition(name, top.text("description", ""), path, tyre, body, front, rear, bushings)
     check_geometry(vehicle, doc)
     return vehicle
 
@@ -298,7 +299,7 @@ def _axis(f: Fields, key: str, points: Mapping[str, np.ndarray]) -> np.ndarray:
         ends = []
         for end in ("from", "to"):
             ref = r.raw(end)
-            if ref not in points:
+            if not isinstance(ref, str) or ref not in points:
                 raise r.fail(end, f"unknown hardpoint {ref!r}; expected one of {', '.join(sorted(points))}")
             ends.append(points[ref])
         v = ends[1] - ends[0]

@@ -22,8 +22,8 @@ from vehicle.scenarios.scenario import (BISINE_INPUTS, MAX_FREQUENCY_HZ, MAX_INP
 from vsim_core import units
 from vsim_core.documents import Document, Fields
 from vsim_core.errors import InputError
-from vsim_core.files import read_text
-from vsim_core.shipped import DEFAULT_VEHICLE
+from vsim_core.files import is_file, read_text
+from vsim_core.shipped import DEFAULT_VEHICLE, SCENARIO_DIR, VEHICLE_DIR, resolve
 from vsim_core.tables import read_csv_columns, read_csv_header
 from vsim_core.units import MM, MM_PER_M
 
@@ -85,8 +85,14 @@ def _periodic(f: Fields, kind: str) -> tuple[Waveform, int]:
         if shape != "triangle":
             raise f.fail(speed_key, f"a speed defines a triangle only; give frequency_hz for a {shape}")
         period = 4.0 * amplitude / (f.number(speed_key, positive=True) * si)
+        if period * MAX_FREQUENCY_HZ < 1.0:
+            raise f.fail(speed_key, f"a triangle of period {period:.3g} s (4 × amplitude / speed); expected at "
+                                    f"most {MAX_FREQUENCY_HZ:g} Hz (20 rig steps per period)")
     else:
         period = 1.0 / _frequency(f)
+    if cycles * period > MAX_INPUT_S:   # checked before a triangle lists its corners
+        raise f.fail("cycles", f"{cycles:.6g} cycles of {period:.6g} s last {cycles * period:.6g} s; expected at most "
+                               f"{MAX_INPUT_S:g} s of simulated time per case")
     if shape == "sine":
         return Waveform((0.0, cycles * period), (0.0, 0.0), ((amplitude, 1.0 / period),)), cycles
     times = [0.0] + [period * (c + q) for c in range(cycles) for q in (0.25, 0.75, 1.0)]
@@ -148,7 +154,7 @@ def _case(f: Fields, kind: str, axles: tuple[str, ...], base_dir: Path) -> Case:
         return Case(label, params, 1, waveform, pattern)
     name = f.text("path")
     csv_path = Path(name) if Path(name).is_absolute() else base_dir / name
-    if not csv_path.is_file():
+    if not is_file(csv_path):
         raise f.fail("path", f"no such CSV file {str(csv_path)!r}")
     return Case(label, params, 1, table=read_input_csv(csv_path))
 
@@ -200,7 +206,7 @@ def _axles(top: Fields, kind: str) -> tuple[str, ...]:
 
 
 def _output_rate(top: Fields) -> float:
-    rate = top.number("output_rate_hz", 100.0, positive=True)
+    rate = top.number("output_rate_hz", 100.0, positive=True, at_most=1.0 / RIG_TIMESTEP_S, unit="Hz")
     every = 1.0 / (rate * RIG_TIMESTEP_S)
     if abs(every - round(every)) > 1e-9:
         raise top.fail("output_rate_hz", f"expected a whole divisor of {1 / RIG_TIMESTEP_S:g} Hz (the rig's "
@@ -209,10 +215,9 @@ def _output_rate(top: Fields) -> float:
 
 
 def load_scenario(path: str | Path) -> Scenario:
-    """Load and validate a scenario file; raises :class:`InputError` naming file:line, key and value."""
-    path = Path(path)
-    if not path.is_file():
-        raise InputError("no such scenario file", source=str(path))
+    """Load and validate a scenario file, or a built-in scenario by name (``pumping``, ``kc/roll``);
+    raises :class:`InputError` naming file:line, key and value."""
+    path = resolve(path, SCENARIO_DIR, "scenario")
     return parse_scenario(read_text(path), path)
 
 
@@ -224,10 +229,10 @@ def parse_scenario(text: str, path: Path, source: str | None = None) -> Scenario
     doc = Document(text, source or str(path))
     top = doc.top(_TOP_KEYS)
     kind = top.choice("type", TYPES)
-    vehicle = Path(top.text("vehicle", str(DEFAULT_VEHICLE)))
-    vehicle = vehicle if vehicle.is_absolute() else path.parent / vehicle
-    if not vehicle.is_file():
-        raise top.fail("vehicle", f"no such vehicle file {str(vehicle)!r}")
+    try:
+        vehicle = resolve(top.text("vehicle", str(DEFAULT_VEHICLE)), VEHICLE_DIR, "vehicle", base=path.parent)
+    except InputError as error:
+        raise top.fail("vehicle", f"{error.source}: {error.bare}") from None
     axles = _axles(top, kind)
 
     s = Fields.of(doc, ("settle",), top.raw("settle", {}), ("before_bushings_s", "before_input_s"))

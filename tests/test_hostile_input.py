@@ -1,0 +1,246 @@
+"""The hostile inputs of issue 25, one by one: each is refused with one line naming the file, the
+line or key and the value (or, for signals and cut recordings, leaves what can be read). The fuzz
+test (test_fuzz.py) draws many more; these pin the classes the issue lists."""
+
+from __future__ import annotations
+
+import copy
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+import yaml
+
+from bushings.bench.bench_file import load_bench
+from vehicle.model.builder import build
+from vehicle.model.elements import BuildOptions
+from vehicle.model.statics import resolve_preloads
+from vehicle.model.vehicle_file import load_vehicle
+from vehicle.scenarios.scenario_file import load_scenario
+from vsim_cli.main import main
+from vsim_core.documents import Document
+from vsim_core.errors import InputError
+from vsim_core.shipped import BENCH_DIR, DEFAULT_VEHICLE, SCENARIO_DIR
+from vsim_recordings.csv_import import import_csv
+from vsim_recordings.run_reader import load_run
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLE = ROOT / "data" / "examples" / "kc_import"
+VEHICLE = yaml.safe_load(DEFAULT_VEHICLE.read_text())
+
+
+def _set(data: Any, path: tuple, value: Any) -> Any:
+    data = copy.deepcopy(data)
+    node = data
+    for key in path[:-1]:
+        node = node[key]
+    node[path[-1]] = value
+    return data
+
+
+# -- vehicles: out of range, inconsistent, unbuildable ---------------------------------------------
+@pytest.mark.parametrize("path,value,expected", [
+    (("tyre", "radius"), 310, r"tyre\.radius: expected at most 1 m.*got 310"),
+    (("tyre", "radius"), 0.35, r"tyre\.radius: a loaded radius of 0\.35 m puts the front contact point -40\.0 mm"),
+    (("front", "static_toe"), 90.0, r"front\.static_toe: expected at most 5 deg.*got 90"),
+    (("front", "spring", "preload"), -500.0, r"front\.spring\.preload: expected a non-negative number, got -500"),
+    (("front", "damper", "curve"), [[-1.0, -3600.0], [0.0, 0.0], [0.5, 1400.0], [1.0, 1000.0]],
+     r"front\.damper\.curve\[3\]: slope -800 from point 2 to 3; expected a damper force not falling"),
+    (("rear", "damper", "curve"), [[-1.0, 200.0], [0.0, 300.0], [1.0, 1400.0]],
+     r"rear\.damper\.curve\[0\]: force 200 N at speed -1 m/s would push the motion on and create energy"),
+    (("front", "strut_friction"), 1e9, r"front\.strut_friction: expected at most 5000 N.*got 1000000000"),
+    (("body", "mass"), 1e12, r"body\.mass: expected at most 10000 kg.*got 1000000000000"),
+    (("body", "inertia"), [-450.0, 1700.0, 1850.0], r"body\.inertia: expected positive inertias"),
+    (("body", "inertia"), [100.0, 1700.0, 1850.0], r"body\.inertia: .*break the triangle inequality"),
+    (("front", "hardpoints", "tie_rod_inner"), [0.140, 0.660, 0.190],
+     r"front\.hardpoints\.tie_rod_outer: 0\.0 mm from tie_rod_inner: the tie rod has no length"),
+    (("front", "hardpoints", "lower_ball_joint"), [-0.140, 0.375, 0.145],
+     r"front\.hardpoints\.lower_ball_joint: .* from the wishbone's pivot axis"),
+    (("front", "hardpoints", "wheel_centre"), [0.0, 745.0, 310.0],
+     r"front\.hardpoints\.wheel_centre\[1\]: expected at most 5 m.*got 745"),
+    (("front", "masses", "knuckle"), -15.0, r"front\.masses\.knuckle: expected a positive number, got -15"),
+])
+def test_implausible_vehicles_are_refused_at_their_key_before_building(tmp_path: Path, path: tuple, value: Any,
+                                                                        expected: str) -> None:
+    file = tmp_path / "car.yaml"
+    file.write_text(yaml.safe_dump(_set(VEHICLE, path, value), sort_keys=False))
+    with pytest.raises(InputError, match=rf"car\.yaml:\d+: {expected}"):
+        build(resolve_preloads(load_vehicle(file)), BuildOptions())
+
+
+def test_a_repeated_key_is_refused_rather_than_the_last_one_winning(tmp_path: Path) -> None:
+    lines = DEFAULT_VEHICLE.read_text().splitlines()
+    line = next(i for i, s in enumerate(lines) if s.startswith("  mass: 1110.0")) + 2   # the repeat's line
+    lines.insert(line - 1, "  mass: 5.0")
+    file = tmp_path / "car.yaml"
+    file.write_text("\n".join(lines) + "\n")
+    with pytest.raises(InputError, match=rf"car\.yaml:{line}: body\.mass: duplicate key .mass."):
+        load_vehicle(file)
+
+
+@pytest.mark.parametrize("text,expected", [
+    ("a: &x [1, 2]\nb: *x\n", r"t\.yaml:2: YAML aliases \(\*x\) are not accepted"),
+    (b"name: caf\xe9\n", r"t\.yaml: .*UTF-8"),
+    ("a: " + "[" * 5000 + "]" * 5000 + "\n", r"t\.yaml: not valid here: nested too deeply"),
+    ("a: " + "1" * 5000 + "\n", r"t\.yaml: not valid here: Exceeds the limit \(4300 digits\)"),
+], ids=["alias", "latin-1", "deep", "huge-integer"])
+def test_aliases_undecodable_bytes_and_unparsable_yaml_are_refused(tmp_path: Path, text: str | bytes,
+                                                                  expected: str) -> None:
+    file = tmp_path / "t.yaml"
+    file.write_bytes(text if isinstance(text, bytes) else text.encode())
+    with pytest.raises(InputError, match=expected):
+        Document.read(file)
+
+
+def test_exponents_without_a_dot_are_numbers_as_in_yaml_1_2() -> None:
+    data = Document("a: 1e-6\nb: 1.5e3\nc: .5E2\nd: 1e400\ne: x1e5\n", "t.yaml").data
+    assert data == {"a": 1e-6, "b": 1500.0, "c": 50.0, "d": float("inf"), "e": "x1e5"}
+
+
+# -- scenarios and benches: names, durations, samples -----------------------------------------------
+@pytest.mark.parametrize("name", ["../../x", "/tmp/x", "a/b", ".hidden"])
+def test_a_scenario_name_cannot_leave_the_output_folder(tmp_path: Path, name: str) -> None:
+    text = (SCENARIO_DIR / "pumping.yaml").read_text().replace("name: pumping", f"name: {name!r}", 1)
+    text = "\n".join("vehicle: c_segment" if s.startswith("vehicle:") else s for s in text.splitlines())
+    file = tmp_path / "s.yaml"
+    file.write_text(text)
+    with pytest.raises(InputError, match=r"s\.yaml:\d+: name: expected a plain name"):
+        load_scenario(file)
+
+
+def test_a_scenario_input_longer_than_an_hour_is_refused_before_it_is_built(tmp_path: Path) -> None:
+    data = yaml.safe_load((SCENARIO_DIR / "lateral_force.yaml").read_text())
+    data["defaults"]["cycles"], data["vehicle"] = 10 ** 300, "c_segment"
+    file = tmp_path / "s.yaml"
+    file.write_text(yaml.safe_dump(data, sort_keys=False))
+    started = time.perf_counter()
+    with pytest.raises(InputError, match=r"cycles: 1e\+300 cycles of 10 s last 1e\+301 s; expected at most 3600 s"):
+        load_scenario(file)
+    assert time.perf_counter() - started < 5.0
+
+
+def test_a_triangle_faster_than_the_rig_samples_is_refused(tmp_path: Path) -> None:
+    data = {**yaml.safe_load((SCENARIO_DIR / "pumping_speeds.yaml").read_text()), "vehicle": "c_segment"}
+    data["cases"][0]["speed_mm_s"] = 1e300
+    file = tmp_path / "s.yaml"
+    file.write_text(yaml.safe_dump(data, sort_keys=False))
+    with pytest.raises(InputError, match=r"cases\[0\]\.speed_mm_s: a triangle of period 2\.4e-298 s .* at most 50 Hz"):
+        load_scenario(file)
+
+
+@pytest.mark.parametrize("change,expected", [
+    ({"dt_s": 1e-12}, r"dt_s|samples"),
+    ({"programme": {"type": "sine", "amplitude_mm": 1.0, "frequency_hz": 1.0, "cycles": 1e9}},
+     r"programme: 2e\+12 samples at dt_s = 0\.0005 s; expected at most 1e\+07"),
+])
+def test_a_bench_asking_for_terabytes_is_refused(tmp_path: Path, change: dict, expected: str) -> None:
+    data = {**yaml.safe_load((BENCH_DIR / "bisine.yaml").read_text()), **change}
+    data["params"] = "fig5_9"
+    file = tmp_path / "b.yaml"
+    file.write_text(yaml.safe_dump(data, sort_keys=False))
+    with pytest.raises(InputError, match=expected):
+        load_bench(file)
+
+
+# -- rig CSV files --------------------------------------------------------------------------------
+@pytest.mark.parametrize("edit,expected", [
+    (lambda lines: [lines[0] + "," + lines[0].split(",")[1]] + [r + ",0" for r in lines[1:]],
+     r"line 1: column '\w+' appears 2 times"),
+    (lambda lines: lines[:3] + [lines[3] + ",1"] + lines[4:], r"line 4: 26 fields; expected 25"),
+    (lambda lines: lines[:5] + [",".join(["1e300"] + lines[5].split(",")[1:])] + lines[6:],
+     r"line 6, column time_ms: '1e300' is beyond any plausible value"),
+])
+def test_malformed_rig_csv_files_are_refused_at_their_line(tmp_path: Path, edit, expected: str) -> None:
+    lines = (EXAMPLE / "kc_pumping.csv").read_text().splitlines()
+    meta = yaml.safe_load((EXAMPLE / "META.yaml").read_text())
+    meta["scenario"] = str(SCENARIO_DIR / "pumping.yaml")
+    (tmp_path / "META.yaml").write_text(yaml.safe_dump(meta, sort_keys=False))
+    (tmp_path / "data.csv").write_text("\n".join(edit(lines)) + "\n")
+    with pytest.raises(InputError, match=expected):
+        import_csv(tmp_path / "data.csv", tmp_path / "META.yaml", tmp_path / "rig.mcap")
+    assert not (tmp_path / "rig.mcap").exists()
+
+
+# -- the command line: arguments and output paths checked before any work --------------------------
+def _vsim(capsys: pytest.CaptureFixture, *argv: str) -> tuple[int, str]:
+    try:
+        code = main(list(argv))
+    except SystemExit as exc:   # argparse's own refusals
+        code = int(exc.code)
+    return code, capsys.readouterr().err
+
+
+@pytest.mark.parametrize("scale", ["inf", "nan", "0", "-1", "1e400", "abc"])
+def test_a_duration_scale_that_is_not_a_finite_positive_number_is_refused(capsys, scale: str) -> None:
+    code, err = _vsim(capsys, "run", "pumping", "--duration-scale", scale)
+    assert code == 2 and "--duration-scale" in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize("kind", ["directory", "under_a_file", "existing"])
+def test_output_paths_are_checked_before_the_run_starts(tmp_path: Path, capsys, kind: str) -> None:
+    target = {"directory": tmp_path, "under_a_file": tmp_path / "f.txt" / "run.mcap",
+              "existing": tmp_path / "run.mcap"}[kind]
+    (tmp_path / "f.txt").write_text("a file")
+    (tmp_path / "run.mcap").write_bytes(b"earlier run")
+    started = time.perf_counter()
+    code, err = _vsim(capsys, "run", "pumping", "-o", str(target))
+    assert code == 2 and "Traceback" not in err, err
+    assert time.perf_counter() - started < 10.0   # the run would take over a minute
+    assert (tmp_path / "run.mcap").read_bytes() == b"earlier run"
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root writes into read-only folders")
+def test_a_read_only_output_folder_is_refused_before_the_run(tmp_path: Path, capsys) -> None:
+    folder = tmp_path / "ro"
+    folder.mkdir(mode=0o555)
+    code, err = _vsim(capsys, "run", "pumping", "-o", str(folder / "run.mcap"))
+    assert code == 2 and "permission denied" in err
+
+
+# -- signals and cut recordings -------------------------------------------------------------------
+def test_sigterm_leaves_a_readable_incomplete_recording_and_status_143(tmp_path: Path) -> None:
+    output = tmp_path / "run.mcap"
+    proc = subprocess.Popen([sys.executable, "-m", "vsim_cli", "run", "pumping", "-o", str(output)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+    deadline = time.monotonic() + 120.0
+    while not list(tmp_path.glob("*.partial")) and time.monotonic() < deadline and proc.poll() is None:
+        time.sleep(0.2)
+    time.sleep(3.0)   # some simulated time recorded
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 128 + signal.SIGTERM, err
+    assert "SIGTERM" in err and "Traceback" not in err
+    run = load_run(output)
+    assert not run.complete and "SIGTERM" in run.reason
+    assert len(run.t_s) > 10 and np.all(np.diff(run.t_s) > 0)
+    assert not list(tmp_path.glob("*.partial"))
+
+
+@pytest.fixture(scope="module")
+def short_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    output = tmp_path_factory.mktemp("run") / "run.mcap"
+    assert main(["run", "pumping", "--duration-scale", "0.05", "-o", str(output)]) == 0
+    return output
+
+
+def test_a_cut_recording_is_read_as_far_as_it_goes_and_marked_incomplete(short_run: Path, tmp_path: Path) -> None:
+    whole = load_run(short_run)
+    data = short_run.read_bytes()
+    cut = tmp_path / "cut.mcap"
+    cut.write_bytes(data[: len(data) * 2 // 3])
+    part = load_run(cut)
+    assert whole.complete and not part.complete
+    n = len(part.t_s)
+    assert 0 < n < len(whole.t_s)
+    np.testing.assert_array_equal(part.t_s, whole.t_s[:n])
+    for name in list(whole.signals)[:5]:
+        np.testing.assert_array_equal(part.signals[name], whole.signals[name][:n])
+    cut.write_bytes(data[:8])   # the magic bytes only
+    with pytest.raises(InputError, match=r"cut\.mcap"):
+        load_run(cut)

@@ -1,0 +1,79 @@
+"""The software works wherever it is installed (issue 25): built-in vehicles, scenarios and bench
+programmes can be named, and a wheel, installed outside the source tree, carries them and runs a
+built-in scenario from an empty folder."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from bushings.bench.bench_file import load_bench
+from vehicle.model.vehicle_file import load_vehicle
+from vehicle.scenarios.scenario_file import load_scenario
+from vsim_core.errors import InputError
+from vsim_core.shipped import BENCH_DIR, DEFAULT_VEHICLE, KC_SCENARIO_DIR, SCENARIO_DIR
+from vsim_recordings.run_reader import load_run
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_built_in_files_are_found_by_name_from_any_folder(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    assert load_scenario("pumping") == load_scenario(SCENARIO_DIR / "pumping.yaml")
+    assert load_scenario("kc/roll") == load_scenario(KC_SCENARIO_DIR / "roll.yaml")
+    assert load_vehicle("c_segment") == load_vehicle(DEFAULT_VEHICLE)
+    named, by_path = load_bench("bisine").programme, load_bench(BENCH_DIR / "bisine.yaml").programme
+    assert named.kind == "bisine" and np.array_equal(named.e_m, by_path.e_m)
+    (tmp_path / "s.yaml").write_text("type: pumping\nvehicle: c_segment\ncases: [{amplitude_mm: 5, frequency_hz: 1}]\n")
+    assert load_scenario("s.yaml").vehicle == DEFAULT_VEHICLE   # a file in the working folder comes first
+
+
+@pytest.mark.parametrize("name, load, words", [
+    ("pumpin", load_scenario, ["pumpin: no such scenario file, and no built-in one of that name", "kc/roll", "pumping"]),
+    ("../models/vehicles/c_segment", load_scenario, ["no built-in one of that name"]),   # names stay in their folder
+    ("c_segmnt", load_vehicle, ["built-in ones: c_segment"]),
+    ("nope.yaml", load_bench, ["nope.yaml: no such bench file", "built-in ones: bisine"]),
+])
+def test_an_unknown_name_lists_the_built_in_ones(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, name: str, load,
+                                                 words: list[str]) -> None:
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(InputError) as error:
+        load(name)
+    for word in words:
+        assert word in str(error.value), str(error.value)
+
+
+def test_a_scenario_names_an_unknown_vehicle_at_its_line(tmp_path: Path) -> None:
+    scenario = tmp_path / "s.yaml"
+    scenario.write_text("type: pumping\nvehicle: c_segmnt\ncases: [{amplitude_mm: 5, frequency_hz: 1}]\n")
+    with pytest.raises(InputError, match=r"s\.yaml:2: vehicle: .*c_segmnt: no such vehicle file.*built-in ones: c_segment"):
+        load_scenario(scenario)
+
+
+def test_the_wheel_runs_a_built_in_scenario_from_an_empty_folder(tmp_path: Path) -> None:
+    """Build the wheel from the project's files, install it (without dependencies: they are this
+    environment's) into a folder of its own, and run ``vsim run pumping`` from an empty folder with
+    only that folder on the path: the shipped data must come from the wheel, not the source tree."""
+    wheels, target, empty = tmp_path / "wheels", tmp_path / "site", tmp_path / "empty"
+    empty.mkdir()
+    subprocess.run([sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", "--no-build-isolation", "-w", str(wheels),
+                    str(ROOT)], check=True, capture_output=True, timeout=300, cwd=tmp_path)
+    wheel, = wheels.glob("vsim-*.whl")
+    subprocess.run([sys.executable, "-m", "pip", "install", "-q", "--no-deps", "--target", str(target), str(wheel)],
+                   check=True, capture_output=True, timeout=300)
+    env = {**os.environ, "PYTHONPATH": str(target)}
+    where = subprocess.run([sys.executable, "-c", "import vsim_core.shipped as s; print(s.SCENARIO_DIR)"],
+                           env=env, cwd=empty, capture_output=True, text=True, check=True).stdout.strip()
+    assert Path(where) == target / "vsim_core" / "scenarios"
+    done = subprocess.run([sys.executable, "-m", "vsim_cli", "run", "pumping", "--duration-scale", "0.05"],
+                          env=env, cwd=empty, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    run = load_run(empty / "out" / "pumping.mcap")
+    assert run.complete and run.metadata.extra["scenario"] == "pumping"
+    assert run.metadata.git_revision == "unknown"   # no source tree around an installed copy
+    assert "c_segment" in run.metadata.vehicle_yaml and run.t_s[-1] > 5.0
