@@ -52,6 +52,10 @@ MODELS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
     "tvs": (("K0", "Kpa", "Kr", "Ff") + _MAXWELL_KEYS, ("N", "C") + _ELASTIC_KEYS),
 }
 
+#: The models the bench identification fits (all their required parameters, N fixed): a constant
+#: here, so that the command line lists them without importing the fit (and scipy).
+FITTED_MODELS = ("sts", "rt", "stvs")
+
 #: Length unit of user-facing parameter values, per quantity, in SI.
 LENGTH_UNIT_SI = {"translation": units.si("mm"), "rotation": units.si("deg")}
 UNIT_LABELS = {"translation": ("N", "mm"), "rotation": ("N·m", "deg")}

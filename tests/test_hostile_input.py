@@ -18,6 +18,7 @@ import pytest
 import yaml
 
 from bushings.bench.bench_file import load_bench
+from bushings.bench.records import read_bench_csv
 from vehicle.model.builder import build
 from vehicle.model.elements import BuildOptions
 from vehicle.model.statics import resolve_preloads
@@ -165,6 +166,13 @@ def test_malformed_rig_csv_files_are_refused_at_their_line(tmp_path: Path, edit,
     with pytest.raises(InputError, match=expected):
         import_csv(tmp_path / "data.csv", tmp_path / "META.yaml", tmp_path / "rig.mcap")
     assert not (tmp_path / "rig.mcap").exists()
+
+
+def test_a_bench_record_with_one_absurd_force_sample_is_refused(tmp_path: Path) -> None:
+    file = tmp_path / "r.csv"
+    file.write_text("t_s,e_mm,F_N\n0,0,0\n0.01,0.1,1e30\n0.02,0.2,3\n")
+    with pytest.raises(InputError, match=r"r\.csv: line 3, column F_N: '1e30' is beyond any plausible value"):
+        read_bench_csv(file)
 
 
 # -- the command line: arguments and output paths checked before any work --------------------------

@@ -67,6 +67,11 @@ def test_shortened_default_scenario_runs_and_records(tmp_path: Path, name: str, 
         assert np.all(np.isfinite(run.signals[spec.name])), spec.name
     text = summary(run)
     assert "peak bushing deflections" in text and ("gradient = centre-line slope" in text or "toe over the final hold" in text)
+    # the run kept in memory is the file's, bit for bit, and summarises the same (vsim run prints it)
+    assert np.array_equal(result.run.t_s, run.t_s) and result.run.signals.keys() == run.signals.keys()
+    assert all(np.array_equal(result.run.signals[k], v) for k, v in run.signals.items())
+    assert summary(result.run) == text
+    assert 0.0 < result.stepping_s < result.wall_s
 
 
 def test_pumping_records_loops_against_wheel_travel(tmp_path: Path) -> None:

@@ -5,8 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from bushings.bench.identification import FIT_PARAMETERS
-from bushings.parameters import DEFAULT_CELLS
+from bushings.parameters import DEFAULT_CELLS, FITTED_MODELS
 from vsim_cli.arguments import output_file
 
 
@@ -35,7 +34,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     "start is the direct STS identification of the slowest triangular record "
                     "(thesis eqs 5.5-5.8, then 5.10 for the STVS) unless --init is given.")
     p.add_argument("records", nargs="+", type=Path, metavar="RECORD.csv", help="bench records (t_s,e_mm,F_N)")
-    p.add_argument("--model", choices=tuple(FIT_PARAMETERS), default="stvs", help="model to fit (default stvs)")
+    p.add_argument("--model", choices=FITTED_MODELS, default="stvs", help="model to fit (default stvs)")
     p.add_argument("-o", "--output", type=output_file, metavar="SET.yaml", help="write the fitted parameter set here")
     p.add_argument("--n-cells", type=int, default=None, metavar="N",
                    help=f"ladder cells (default: the --init set's, else {DEFAULT_CELLS})")

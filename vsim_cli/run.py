@@ -23,13 +23,14 @@ def _run(args: argparse.Namespace) -> int:
     scenario = load_scenario(args.scenario)
     output = args.output or check_output(default_output(scenario))
     bar = ProgressBar()
-    status, note = 0, ""
+    status, note, run = 0, "", None
     started = time.perf_counter()
     try:
         result = run_scenario(scenario, output, bushing_model=args.bushings, overwrite=args.overwrite,
                               duration_scale=args.duration_scale, progress=bar)
+        run = result.run
         note = f"({result.simulated_s:.1f} s simulated in {result.wall_s:.1f} s, " \
-               f"{result.simulated_s / result.wall_s:.1f}x real time)"
+               f"{result.simulated_s / result.wall_s:.1f}x real time; compiled stepping {result.stepping_s:.2f} s)"
     except DivergenceError as exc:
         status, note = 1, f"stopped: {exc}"
     except KeyboardInterrupt as exc:
@@ -40,7 +41,7 @@ def _run(args: argparse.Namespace) -> int:
         kept = f"the incomplete recording is kept in {output}" if output.exists() else "nothing was recorded"
         print(f"vsim: run {note}; {kept}", file=sys.stderr)
     if output.exists():
-        print(summary(load_run(output)))
+        print(summary(run or load_run(output)))   # a stopped run is summarised from what the file kept
         print(f"wrote {output} {note if not status else '(incomplete)'}")
     return status
 

@@ -30,11 +30,15 @@ from vsim_recordings.run_writer import RunWriter
 
 @dataclass(frozen=True)
 class RunResult:
-    """A finished run: the file, its simulated and wall-clock durations."""
+    """A finished run: the file, its simulated and wall-clock durations, the time spent in the
+    compiled stepping loop, and the recorded signals as read back from the file would give them
+    (without the body poses), so that a summary needs no second reading."""
 
     path: Path
     simulated_s: float
     wall_s: float
+    stepping_s: float
+    run: Run
 
 
 def default_output(scenario: Scenario) -> Path:
@@ -69,12 +73,19 @@ def run_scenario(scenario: Scenario, output: Path, *, bushing_model: str | None 
     layout = layout_of(play.rig, scenario.x_quantity)
     output.parent.mkdir(parents=True, exist_ok=True)
     bodies = play.bodies()
+    metadata = _metadata(play)
+    times_ns, rows = [], []
     with RunWriter(output, signals=layout.specs, bodies=bodies, geometry=geometry_from_model(play.rig.model, bodies),
-                   metadata=_metadata(play), overwrite=overwrite) as writer:
+                   metadata=metadata, overwrite=overwrite) as writer:
         with closing(play.samples()) as samples:  # leaves the rig's context at once if writing fails
             for s in samples:
-                writer.write(s.time_s, layout.values(s), s.body_pos, s.body_quat_wxyz)
-    return RunResult(output, play.total_s, time.perf_counter() - started)
+                values = layout.values(s)
+                writer.write(s.time_s, values, s.body_pos, s.body_quat_wxyz)
+                times_ns.append(writer.last_time_ns)
+                rows.append(values)
+    # the times as the file holds them: whole nanoseconds
+    run = _in_memory(output, np.array(times_ns, dtype=np.uint64) / 1e9, rows, layout, metadata)
+    return RunResult(output, play.total_s, time.perf_counter() - started, play.stepping_s, run)
 
 
 def simulate(scenario: Scenario, vehicle: VehicleDefinition | None = None, *, duration_scale: float = 1.0,
@@ -93,16 +104,22 @@ def simulate(scenario: Scenario, vehicle: VehicleDefinition | None = None, *, du
         for s in samples:
             times.append(s.time_s)
             rows.append(layout.values(s))
-    specs = layout.specs
-    values = np.array(rows).reshape(len(rows), len(specs))
     metadata = _metadata(play)
     if vehicle is not None:
         metadata = replace(metadata, vehicle_yaml="", extra={**metadata.extra, "vehicle_file": "(in memory)"})
+    return _in_memory(Path("(in memory)"), np.array(times), rows, layout, metadata)
+
+
+def _in_memory(path: Path, t_s: np.ndarray, rows: list[np.ndarray], layout: SignalLayout,
+               metadata: RunMetadata) -> Run:
+    """A complete :class:`Run` of the samples' ``rows`` (one per time in ``t_s``), without body poses."""
+    specs = layout.specs
+    values = np.array(rows).reshape(len(rows), len(specs))
     signals = {s.name: values[:, i] for i, s in enumerate(specs)}
-    return Run(path=Path("(in memory)"), t_s=np.array(times), signals=signals,
-               units={s.name: s.unit for s in specs}, groups={s.name: s.group for s in specs}, specs=specs,
-               body_names=[], body_pos=np.empty((len(values), 0, 3)), body_quat_wxyz=np.empty((len(values), 0, 4)),
-               geometry=[], metadata=metadata, complete=True, reason="")
+    return Run(path=path, t_s=t_s, signals=signals, units={s.name: s.unit for s in specs},
+               groups={s.name: s.group for s in specs}, specs=specs, body_names=[],
+               body_pos=np.empty((len(values), 0, 3)), body_quat_wxyz=np.empty((len(values), 0, 4)), geometry=[],
+               metadata=metadata, complete=True, reason="")
 
 
 def geometry_from_model(model: mujoco.MjModel, bodies: list[str]) -> list[GeomSpec]:

@@ -172,6 +172,11 @@ class RunWriter:
             entities = [_scene_entity(b, [g for g in geometry if g.body == b]) for b in with_geoms]
             scene.log(SceneUpdate(entities=entities), log_time=0)
 
+    @property
+    def last_time_ns(self) -> int:
+        """The log time of the last step written [ns] (the file's time base: whole nanoseconds)."""
+        return self._last_t_ns
+
     def write(self, t_s: float, values: np.ndarray, body_pos_m: np.ndarray, body_quat_wxyz: np.ndarray) -> None:
         """Record one step at simulation time ``t_s`` (s, ≥ 0, strictly increasing)."""
         if self._closed:

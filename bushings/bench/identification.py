@@ -25,16 +25,12 @@ from scipy.optimize import least_squares
 
 from bushings.bench.records import BenchRecord, simulate_record
 from bushings.parameter_sets import ParameterSet
-from bushings.parameters import DEFAULT_CELLS, PW_MIN, to_si
+from bushings.parameters import DEFAULT_CELLS, FITTED_MODELS, MODELS, PW_MIN, to_si
 from vsim_core.errors import InputError
 from vsim_core.units import MM
 
-#: Parameters adjusted by :func:`fit`, per model (N is fixed).
-FIT_PARAMETERS: dict[str, tuple[str, ...]] = {
-    "sts": ("K0", "Kpa", "Kr", "Ff"),
-    "rt": ("K0", "Kpa", "Kr", "Co", "pw"),
-    "stvs": ("K0", "Kpa", "Kr", "Ff", "Co", "pw"),
-}
+#: Parameters adjusted by :func:`fit`, per model: the model's required ones (N is fixed).
+FIT_PARAMETERS: dict[str, tuple[str, ...]] = {model: MODELS[model][0] for model in FITTED_MODELS}
 #: Share of a branch, ending at its tip, over which Tg2 is measured (within the STS's last linear
 #: segment for the thesis's sets: 0.46 of 4.05 mm for fig5_6).
 TG2_SPAN_FRACTION = 0.1

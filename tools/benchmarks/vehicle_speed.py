@@ -12,7 +12,14 @@
   and at H/2 (60 mm, 0.1 Hz pumping, vehicle.simulation.kc_triangles.run_triangle, STVS; both branches compared at
   the same pad heights over ±55 mm, four wheels); ``closure_error_max_m``: largest loop-closure error on that loop at H.
 
-Targets (issue 3): rtf_stvs_all ≥ 10, ratio_stvs_to_linear ≤ 1.5, camber change ≤ 0.005 deg.
+* ``end_to_end_*``: the README's main job as a user runs it (``vsim run pumping``, a fresh
+  process, ``--run-scale`` on its durations): ``wall_s`` from the process's start to its end,
+  ``stepping_s`` the part spent in the compiled stepping loop (as the command reports it),
+  ``ratio`` their quotient, ``rtf`` simulated time / wall time, ``peak_rss_mb`` the process's peak
+  resident memory.
+
+Targets (issue 3): rtf_stvs_all ≥ 10, ratio_stvs_to_linear ≤ 1.5, camber change ≤ 0.005 deg;
+(issue 28): end_to_end_ratio ≤ 1.3.
 """
 
 from __future__ import annotations
@@ -20,7 +27,13 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import re
+import resource
+import subprocess
+import sys
+import tempfile
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -90,12 +103,31 @@ def bench(h: float) -> dict[str, float]:
     }
 
 
+def end_to_end(scale: float) -> dict[str, float]:
+    """The ``end_to_end_*`` figures of ``vsim run pumping --duration-scale scale`` in a fresh process."""
+    with tempfile.TemporaryDirectory() as folder:
+        started = time.perf_counter()
+        done = subprocess.run([sys.executable, "-m", "vsim_cli", "run", "pumping", "--duration-scale", str(scale),
+                               "-o", str(Path(folder) / "run.mcap")], capture_output=True, text=True, check=True)
+        wall = time.perf_counter() - started
+    last = done.stdout.strip().splitlines()[-1]
+    found = re.search(r"\(([\d.]+) s simulated in [\d.]+ s, .* compiled stepping ([\d.]+) s\)", last)
+    if found is None:
+        raise RuntimeError(f"unexpected last line of vsim run: {last!r}")
+    simulated, stepping = float(found[1]), float(found[2])
+    return {"end_to_end_wall_s": wall, "end_to_end_stepping_s": stepping, "end_to_end_ratio": wall / stepping,
+            "end_to_end_rtf": simulated / wall,
+            "end_to_end_peak_rss_mb": resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024}
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--json", action="store_true", help="print one JSON object (default: aligned text)")
     parser.add_argument("--timestep", type=float, default=1e-3, help="time step H [s] (default: %(default)s)")
+    parser.add_argument("--run-scale", type=float, default=1.0,
+                        help="duration scale of the end-to-end main job (default: %(default)s, the README's)")
     args = parser.parse_args()
-    result = bench(args.timestep)
+    result = {**bench(args.timestep), **end_to_end(args.run_scale)}
     if args.json:
         print(json.dumps(result))
     else:

@@ -15,6 +15,7 @@ a recording keeps it.
 
 from __future__ import annotations
 
+import functools
 from typing import Callable, Iterator
 
 import mujoco
@@ -52,8 +53,7 @@ def check_divergence(rig: KCRig, o: RigOutputs, scenario: Scenario, time_s: floa
         raise DivergenceError(time_s, case, "non-finite joint positions")
     if rig.data.warning[mujoco.mjtWarning.mjWARN_BADQACC].number:
         raise DivergenceError(time_s, case, "MuJoCo found a non-finite or huge acceleration and reset the state")
-    rotation = np.array([is_rotation(n) for n in names])
-    limit = np.where(rotation, scenario.limits.rotation_rad, scenario.limits.translation_m)
+    rotation, limit = _deflection_limits(names, scenario.limits.rotation_rad, scenario.limits.translation_m)
     ratio = np.abs(o.bushing_deflection) / limit
     i = int(np.argmax(ratio))
     if ratio[i] > 1.0:
@@ -65,6 +65,13 @@ def check_divergence(rig: KCRig, o: RigOutputs, scenario: Scenario, time_s: floa
     if o.closure_error > scenario.limits.closure_error_m:
         raise DivergenceError(time_s, case, f"loop-closure error {o.closure_error * MM_PER_M:.3f} mm beyond the "
                                             f"limit {scenario.limits.closure_error_m * MM_PER_M:g} mm")
+
+
+@functools.lru_cache(maxsize=8)
+def _deflection_limits(names: tuple[str, ...], rotation_rad: float, translation_m: float) -> tuple[np.ndarray, np.ndarray]:
+    """Which bushing directions turn, and each one's deflection limit (computed once per run, not per sample)."""
+    rotation = np.array([is_rotation(n) for n in names])
+    return rotation, np.where(rotation, rotation_rad, translation_m)
 
 
 class ScenarioRun:
@@ -83,6 +90,8 @@ class ScenarioRun:
         self.plan = schedule(scenario, duration_scale, self.dt)   # checks the scale before the build
         self.rig = KCRig(vehicle, self.options)
         self.total_s = self.plan[-1].end_s(self.dt)
+        #: Wall time the cases spent in the compiled stepping loop [s] (their rigs' ``stepping_s``).
+        self.stepping_s = 0.0
 
     def bodies(self) -> list[str]:
         """Names of the model's bodies whose poses the samples carry (the world excepted)."""
@@ -95,7 +104,10 @@ class ScenarioRun:
         for k, (case, when) in enumerate(zip(cases, self.plan), start=1):
             if k > 1:
                 rig = KCRig(self.vehicle, self.options)
-            yield from self._case(rig, case, k, when)
+            try:
+                yield from self._case(rig, case, k, when)
+            finally:
+                self.stepping_s += rig.stepping_s
 
     def _case(self, rig: KCRig, case: Case, number: int, when: CaseSchedule) -> Iterator[Sample]:
         """The samples of one case from a fresh rig, one every output interval."""
