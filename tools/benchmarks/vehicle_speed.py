@@ -28,14 +28,13 @@ import argparse
 import json
 import math
 import re
-import resource
-import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
+from processes import run_measured
 
 from vehicle.model.definition import CORNERS
 from vehicle.model.elements import BuildOptions
@@ -106,18 +105,18 @@ def bench(h: float) -> dict[str, float]:
 def end_to_end(scale: float) -> dict[str, float]:
     """The ``end_to_end_*`` figures of ``vsim run pumping --duration-scale scale`` in a fresh process."""
     with tempfile.TemporaryDirectory() as folder:
-        started = time.perf_counter()
-        done = subprocess.run([sys.executable, "-m", "vsim_cli", "run", "pumping", "--duration-scale", str(scale),
-                               "-o", str(Path(folder) / "run.mcap")], capture_output=True, text=True, check=True)
-        wall = time.perf_counter() - started
+        done = run_measured([sys.executable, "-m", "vsim_cli", "run", "pumping", "--duration-scale", str(scale),
+                             "-o", str(Path(folder) / "run.mcap")])
+    if done.returncode:
+        raise RuntimeError(f"vsim run failed:\n{done.stderr}")
     last = done.stdout.strip().splitlines()[-1]
     found = re.search(r"\(([\d.]+) s simulated in [\d.]+ s, .* compiled stepping ([\d.]+) s\)", last)
     if found is None:
         raise RuntimeError(f"unexpected last line of vsim run: {last!r}")
     simulated, stepping = float(found[1]), float(found[2])
-    return {"end_to_end_wall_s": wall, "end_to_end_stepping_s": stepping, "end_to_end_ratio": wall / stepping,
-            "end_to_end_rtf": simulated / wall,
-            "end_to_end_peak_rss_mb": resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024}
+    return {"end_to_end_wall_s": done.wall_s, "end_to_end_stepping_s": stepping,
+            "end_to_end_ratio": done.wall_s / stepping, "end_to_end_rtf": simulated / done.wall_s,
+            "end_to_end_peak_rss_mb": done.peak_rss_mb}
 
 
 def main() -> int:
