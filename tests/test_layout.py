@@ -17,6 +17,7 @@ LAYERS = (
     ("vsim_core",),                          # foundation
     ("bushings",),                           # bushing laws
     ("bushings.bench",),                     # the bushing test bench
+    ("vsim_tyres",),                         # tyre property files and laws
     ("vehicle", "vehicle.model"),            # the vehicle model
     ("vehicle.scenarios",),                  # what the car is made to do
     ("vehicle.simulation",),                 # running it
