@@ -267,9 +267,13 @@ def _grow(n, S, Kr, pw):
         ks = S[_KL + j] + Kr
         theta = dfl / (ks + dfl)
         if r > _R_HUGE:
-            # a node slipping a round-off amount (even a subnormal one): r·w would overflow; at this
-            # r the cap holds for pw < 1 and Newton's step for pw = 1
-            S[_W + j] += S[_RHS + j] * ((ks + dfl) / ks if pw < 1.0 else 1.0)
+            # a node slipping a round-off amount (even a subnormal one): r, r·w and (1 + pw·r)^(1/pw)
+            # may overflow. The same step from Newton's d = r·w, in logarithms: log r from d and w,
+            # and (1 + pw·r)^(1/pw) / r = pw^(1/pw)·r^(1/pw − 1) (pw·r ≫ 1; the −1 of g is below round-off)
+            w, d = S[_W + j], S[_RHS + j]
+            log_r = math.log(abs(d)) - math.log(max(abs(w), 5e-324))
+            growth = (1.0 - theta) + theta * math.exp(min(math.log(pw) / pw + (1.0 / pw - 1.0) * log_r, 700.0))
+            S[_W + j] = w + d * min(growth, (ks + dfl) / ks)
             continue
         g = (1.0 - theta) * r + theta * (math.exp(math.log1p(pw * r) / pw) - 1.0)
         S[_W + j] *= 1.0 + min(g, r * (ks + dfl) / ks)

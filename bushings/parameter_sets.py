@@ -9,11 +9,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
 
-import yaml
 
 from bushings.effects import Effects, effects_to_si
 from bushings.parameters import MODELS, ChannelParams, to_si
-from vsim_core.documents import Document
+from vsim_core.documents import Document, dump_yaml
 from vsim_core.errors import InputError
 from vsim_core.files import atomic_output, is_file, read_text
 from vsim_core.shipped import PARAMETER_SET_DIR
@@ -110,7 +109,7 @@ def save_parameter_set(pset: ParameterSet, path: str | Path) -> Path:
     if pset.effects:
         data["effects"] = {k: float(v) for k, v in pset.effects.items()}
     with atomic_output(Path(path)) as tmp:
-        tmp.write_text(yaml.safe_dump(data, sort_keys=False, default_flow_style=None, width=10_000,
+        tmp.write_text(dump_yaml(data, sort_keys=False, default_flow_style=None, width=10_000,
                                       allow_unicode=True))
     return Path(path)
 

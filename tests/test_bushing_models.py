@@ -229,6 +229,7 @@ def test_large_steps_are_stable(name, amp_mm, freq_hz):
 
 @pytest.mark.parametrize("model,values,amp_mm,freq_hz,dt", [
     ("stvs", dict(Ff=30.0, Co=1e-4, pw=0.999), 1.0, 2.0, 1e-4),   # nodes released by subnormal slips
+    ("stvs", dict(Ff=9.0, Co=1e-4, pw=0.995), 1.0, 2.0, 1e-4),    # ... whose Newton ratio r overflows
     ("rt", dict(Co=41100.0, pw=0.03), 50.0, 0.1, 2e-3),             # the steepest law, subnormal slopes
 ])
 def test_extreme_power_laws_stay_finite_bounded_and_passive(model, values, amp_mm, freq_hz, dt):

@@ -2,9 +2,11 @@
 input class (scenario, vehicle, bushing parameter set, bench programme, rig CSV + META, bench
 dataset, MCAP run), mutated in structure (values out of range, of the wrong type, non-finite or in
 the wrong unit; keys removed, added, repeated; aliases) and in bytes (undecodable, truncated, cut
-or flipped), are each loaded and used as the command line would: built, scheduled, run for a
-moment, imported, read. Every outcome must be a result or an InputError; anything else, a hang
-(each case has :data:`CASE_TIMEOUT_S`) or a silent acceptance of what must be refused fails.
+or flipped), are each loaded and taken as far as the command's own checks go: vehicles built into
+MuJoCo models (not simulated), scenarios scheduled, parameter sets and short bench programmes run,
+rig CSVs imported, datasets and recordings read. Every outcome must be a result or an InputError;
+anything else, a hang (each case has :data:`CASE_TIMEOUT_S`) or a silent acceptance of what must be
+refused (non-finite or beyond 1e300, a repeated key, an alias bomb, undecodable bytes) fails.
 
 The cases are drawn from a fixed seed (reruns try the same cases; ``VSIM_FUZZ_SEED`` draws others)
 and their number per class is :data:`EXAMPLES` (1250 in all, README "Hostile input").
@@ -284,7 +286,7 @@ def mutated_csv(draw: st.DrawFn, text: str) -> tuple[str, bool]:
         value = draw(st.sampled_from(["", "abc", "nan", "inf", "-inf", "1e300", "1e-300", "0", "-1e9", "1,2"]))
         cells[draw(st.integers(0, len(cells) - 1))] = value
         lines[row] = ",".join(cells)
-        return "\n".join(lines) + "\n", value in ("abc", "nan", "inf", "-inf", "1e300")
+        return "\n".join(lines) + "\n", value in ("abc", "nan", "inf", "-inf", "1e300", "1,2")   # 1,2: an extra field
     if action == "repeat_column":
         cells = lines[0].split(",")
         lines[0] = ",".join(cells[:-1] + [cells[1]])

@@ -25,7 +25,7 @@ from vehicle.model.statics import resolve_preloads
 from vehicle.model.vehicle_file import load_vehicle
 from vehicle.scenarios.scenario_file import load_scenario
 from vsim_cli.main import main
-from vsim_core.documents import Document
+from vsim_core.documents import Document, dump_yaml
 from vsim_core.errors import InputError
 from vsim_core.shipped import BENCH_DIR, DEFAULT_VEHICLE, SCENARIO_DIR
 from vsim_recordings.csv_import import import_csv
@@ -89,7 +89,7 @@ def test_a_repeated_key_is_refused_rather_than_the_last_one_winning(tmp_path: Pa
     ("a: &x [1, 2]\nb: *x\n", r"t\.yaml:2: YAML aliases \(\*x\) are not accepted"),
     (b"name: caf\xe9\n", r"t\.yaml: .*UTF-8"),
     ("a: " + "[" * 5000 + "]" * 5000 + "\n", r"t\.yaml: not valid here: nested too deeply"),
-    ("a: " + "1" * 5000 + "\n", r"t\.yaml: not valid here: Exceeds the limit \(4300 digits\)"),
+    ("a: " + "1" * 5000 + "\n", r"t\.yaml:1: '1+' cannot be read as a value \(Exceeds the limit \(4300 digits\)"),
 ], ids=["alias", "latin-1", "deep", "huge-integer"])
 def test_aliases_undecodable_bytes_and_unparsable_yaml_are_refused(tmp_path: Path, text: str | bytes,
                                                                   expected: str) -> None:
@@ -99,9 +99,16 @@ def test_aliases_undecodable_bytes_and_unparsable_yaml_are_refused(tmp_path: Pat
         Document.read(file)
 
 
-def test_exponents_without_a_dot_are_numbers_as_in_yaml_1_2() -> None:
-    data = Document("a: 1e-6\nb: 1.5e3\nc: .5E2\nd: 1e400\ne: x1e5\n", "t.yaml").data
-    assert data == {"a": 1e-6, "b": 1500.0, "c": 50.0, "d": float("inf"), "e": "x1e5"}
+def test_exponents_without_a_dot_are_numbers_as_in_yaml_1_2_and_written_back_quoted_as_text() -> None:
+    data = Document("a: 1e-6\nb: 1.5e3\nc: .5E2\nd: 1e400\ne: x1e5\nf: ._e5\n", "t.yaml").data
+    assert data == {"a": 1e-6, "b": 1500.0, "c": 50.0, "d": float("inf"), "e": "x1e5", "f": "._e5"}
+    texts = {"label": "2e3", "other": "1.5E-3", "number": 2e3}
+    assert Document(dump_yaml(texts), "t.yaml").data == texts   # the project's own files read back alike
+
+
+def test_a_scalar_python_cannot_convert_is_refused_at_its_line() -> None:
+    with pytest.raises(InputError, match=r"t\.yaml:2: '2024-13-45' cannot be read as a value \(month must be"):
+        Document("a: 1\nb: 2024-13-45\n", "t.yaml")
 
 
 # -- scenarios and benches: names, durations, samples -----------------------------------------------

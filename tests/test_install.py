@@ -5,6 +5,7 @@ built-in scenario from an empty folder."""
 from __future__ import annotations
 
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -29,8 +30,11 @@ def test_built_in_files_are_found_by_name_from_any_folder(tmp_path: Path, monkey
     assert load_vehicle("c_segment") == load_vehicle(DEFAULT_VEHICLE)
     named, by_path = load_bench("bisine").programme, load_bench(BENCH_DIR / "bisine.yaml").programme
     assert named.kind == "bisine" and np.array_equal(named.e_m, by_path.e_m)
-    (tmp_path / "s.yaml").write_text("type: pumping\nvehicle: c_segment\ncases: [{amplitude_mm: 5, frequency_hz: 1}]\n")
-    assert load_scenario("s.yaml").vehicle == DEFAULT_VEHICLE   # a file in the working folder comes first
+    # a file in the working folder comes first, even one named as a built-in
+    (tmp_path / "pumping").write_text("name: mine\ntype: pumping\nvehicle: c_segment\n"
+                                      "cases: [{amplitude_mm: 5, frequency_hz: 1}]\n")
+    mine = load_scenario("pumping")
+    assert mine.name == "mine" and mine.vehicle == DEFAULT_VEHICLE
 
 
 @pytest.mark.parametrize("name, load, words", [
@@ -59,10 +63,13 @@ def test_the_wheel_runs_a_built_in_scenario_from_an_empty_folder(tmp_path: Path)
     """Build the wheel from the project's files, install it (without dependencies: they are this
     environment's) into a folder of its own, and run ``vsim run pumping`` from an empty folder with
     only that folder on the path: the shipped data must come from the wheel, not the source tree."""
-    wheels, target, empty = tmp_path / "wheels", tmp_path / "site", tmp_path / "empty"
+    wheels, target, empty, source = tmp_path / "wheels", tmp_path / "site", tmp_path / "empty", tmp_path / "source"
     empty.mkdir()
+    # a copy without earlier builds (a stale build/ would hide a package missing from pyproject.toml)
+    shutil.copytree(ROOT, source, ignore=shutil.ignore_patterns(".git", ".venv", "build", "*.egg-info", "out", "data",
+                                                                 "tests", "__pycache__", ".hypothesis"))
     subprocess.run([sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", "--no-build-isolation", "-w", str(wheels),
-                    str(ROOT)], check=True, capture_output=True, timeout=300, cwd=tmp_path)
+                    str(source)], check=True, capture_output=True, timeout=300, cwd=tmp_path)
     wheel, = wheels.glob("vsim-*.whl")
     subprocess.run([sys.executable, "-m", "pip", "install", "-q", "--no-deps", "--target", str(target), str(wheel)],
                    check=True, capture_output=True, timeout=300)

@@ -50,11 +50,32 @@ class _Loader(yaml.SafeLoader):
                            event.start_mark.line + 1)
         return super().compose_node(parent, index)
 
+    def construct_object(self, node: yaml.Node, deep: bool = False) -> Any:
+        """YAML's construction, with the line of a scalar Python cannot convert (a 13th month, an
+        integer of more than 4300 digits) rather than a bare ValueError."""
+        try:
+            return super().construct_object(node, deep)
+        except ValueError as exc:
+            if isinstance(exc, InputError):
+                raise
+            raise _Refused(f"{str(node.value)[:40]!r} cannot be read as a value ({exc})", node.start_mark.line + 1) from None
+
+
+class _Dumper(yaml.SafeDumper):
+    """YAML's safe dumper, quoting the texts that the loader reads as numbers (``'2e3'``)."""
+
 
 # YAML 1.1 reads 1e-6 and 1.5e3 (no dot, or no exponent sign) as text; engineers mean numbers, as YAML 1.2 does.
-_Loader.add_implicit_resolver("tag:yaml.org,2002:float",
-                              re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9_]+)[eE][-+]?[0-9]+$"),
-                              list("-+0123456789."))
+for _yaml_class in (_Loader, _Dumper):
+    _yaml_class.add_implicit_resolver("tag:yaml.org,2002:float",
+                                      re.compile(r"^[-+]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)[eE][-+]?[0-9]+$"),
+                                      list("-+0123456789."))
+
+
+def dump_yaml(data: Any, **options: Any) -> str:
+    """``data`` as YAML text that :class:`Document` reads back as the same data (``yaml.safe_dump``'s
+    ``options``)."""
+    return yaml.dump(data, Dumper=_Dumper, **options)
 
 
 class Document:
@@ -73,10 +94,6 @@ class Document:
                 self._index(node, ())
         except yaml.YAMLError as exc:
             raise InputError(f"not valid YAML: {exc}", source=source) from None
-        except InputError:
-            raise
-        except ValueError as exc:   # an integer of more digits than Python converts (4300)
-            raise InputError(f"not valid here: {exc}", source=source) from None
         except _Refused as exc:
             raise InputError(str(exc), source=f"{source}:{exc.line}") from None
         except RecursionError:

@@ -19,12 +19,11 @@ from dataclasses import dataclass
 from typing import Any, Mapping
 
 import numpy as np
-import yaml
 
 from bushings.parameter_sets import ParameterSet, load_parameter_set
 from vehicle.model.definition import BushingDef, DirectionDef, VehicleDefinition
 from vehicle.model.vehicle_file import with_extensions
-from vsim_core.documents import Document
+from vsim_core.documents import Document, dump_yaml
 from vsim_core.errors import InputError
 from vsim_core.units import DEG_PER_RAD, MM_PER_M
 from vsim_diagnosis.catalogue import CAUSES, Entry, Parameter, draw_parameters
@@ -233,7 +232,7 @@ def extended_vehicle_yaml(baseline: VehicleDefinition, hypotheses: list[Hypothes
             entries[name]["directions"][direction] = {"model": law.model, "params": _plain(law.values),
                                                       **({"effects": _plain(law.effects)} if law.effects else {})}
     header = "".join(f"# {line}\n" for line in note.splitlines())
-    return header + yaml.safe_dump(data, sort_keys=False, allow_unicode=True)
+    return header + dump_yaml(data, sort_keys=False, allow_unicode=True)
 
 
 def _plain(values: Mapping[str, Any]) -> dict[str, Any]:

@@ -80,7 +80,8 @@ def read_bench_dataset(directory: str | os.PathLike[str]) -> BenchDataset:
         if isinstance(rest, bool) or not isinstance(rest, (int, float)) or not 0.0 <= rest <= MAX_REST_S:
             raise InputError(f"expected a rest duration from 0 to {MAX_REST_S:g} s, got {rest!r}", source=source,
                              key=f"{key}.rest_before_s")
-        file, programme = entry["file"], entry.get("programme") or {}
+        file, programme = entry["file"], entry.get("programme")
+        programme = {} if programme is None else programme   # an empty `programme:` (but not 0, '' or [])
         if not isinstance(file, str) or not is_file(root / file) or Path(file).name != file:
             raise InputError(f"expected the name of a record file in {root}, got {file!r}", source=source,
                              key=f"{key}.file")
@@ -88,7 +89,8 @@ def read_bench_dataset(directory: str | os.PathLike[str]) -> BenchDataset:
             raise InputError(f"expected a mapping describing the programme played, got {programme!r}", source=source,
                              key=f"{key}.programme")
         records.append(BenchTestRecord(Path(file).stem, dict(programme), float(rest), read_bench_csv(root / file)))
-    part, rig = data.get("part", ""), data.get("rig") or {}
+    part, rig = data.get("part", ""), data.get("rig")
+    rig = {} if rig is None else rig
     if not isinstance(part, str) or not isinstance(rig, Mapping):
         bad = "part" if not isinstance(part, str) else "rig"
         raise InputError(f"expected {'free text' if bad == 'part' else 'a mapping'}, got {data[bad]!r}", source=source,

@@ -15,13 +15,12 @@ from pathlib import Path
 from typing import Any, Mapping
 
 import numpy as np
-import yaml
 
 from vehicle.scenarios.channels import CORNER_TAGS
 from vehicle.scenarios.scenario import Scenario
 from vehicle.scenarios.scenario_file import load_scenario, parse_scenario
 from vsim_core import units
-from vsim_core.documents import Document, Fields
+from vsim_core.documents import Document, Fields, dump_yaml
 from vsim_core.errors import InputError
 from vsim_core.files import is_file, read_text
 from vsim_core.tables import read_csv_columns
@@ -90,7 +89,7 @@ def _scenario(top: Fields, meta: Path) -> Scenario:
         raise top.fail("scenario", f"expected a scenario file (relative to this file) or an inline scenario "
                                    f"mapping, got {raw!r}")
     try:  # as if written in a file beside META: relative paths are taken from there
-        return parse_scenario(yaml.safe_dump(dict(raw), sort_keys=False), meta, source="inline scenario")
+        return parse_scenario(dump_yaml(dict(raw), sort_keys=False), meta, source="inline scenario")
     except InputError as exc:
         raise top.fail("scenario", f"inline scenario{f', {exc.key}' if exc.key else ''}: {exc.bare}") from None
 

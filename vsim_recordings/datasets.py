@@ -8,9 +8,7 @@ import os
 from pathlib import Path
 from typing import Any, Mapping
 
-import yaml
-
-from vsim_core.documents import Document
+from vsim_core.documents import Document, dump_yaml
 from vsim_core.errors import InputError
 
 RIG_FILE = "rig.yaml"
@@ -52,5 +50,5 @@ def read_manifest(directory: str | os.PathLike[str], level: str, keys: tuple[str
 def write_manifest(directory: str | os.PathLike[str], manifest: Mapping[str, Any]) -> Path:
     """Write a dataset's rig.yaml (the caller writes the tests and the folder atomically)."""
     path = Path(directory) / RIG_FILE
-    path.write_text(yaml.safe_dump(dict(manifest), sort_keys=False, allow_unicode=True))
+    path.write_text(dump_yaml(dict(manifest), sort_keys=False, allow_unicode=True))
     return path

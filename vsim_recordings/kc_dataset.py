@@ -20,11 +20,10 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Mapping, Sequence
 
-import yaml
 
 from vehicle.scenarios.scenario import Scenario
 from vehicle.scenarios.scenario_file import parse_scenario
-from vsim_core.documents import Document
+from vsim_core.documents import Document, dump_yaml
 from vsim_core.errors import InputError
 from vsim_core.files import is_file
 from vsim_core.shipped import DEFAULT_VEHICLE
@@ -143,7 +142,7 @@ def recorded_scenario(run: Run, *, source: str | None = None, key: str | None = 
             part["path"] = _resolve(part["path"], base)
     where = file or Path(recorded or run.path)
     try:
-        scenario = parse_scenario(yaml.safe_dump(data, sort_keys=False, allow_unicode=True), where)
+        scenario = parse_scenario(dump_yaml(data, sort_keys=False, allow_unicode=True), where)
     except InputError as exc:
         sub = f", {exc.key}" if exc.key else ""
         raise InputError(f"{run.path.name}: its scenario{sub}: {exc.bare}", source=source, key=key) from None

@@ -31,8 +31,10 @@ from vsim_recordings.run_writer import RunWriter
 @dataclass(frozen=True)
 class RunResult:
     """A finished run: the file, its simulated and wall-clock durations, the time spent in the
-    compiled stepping loop, and the recorded signals as read back from the file would give them
-    (without the body poses), so that a summary needs no second reading."""
+    compiled stepping loop (first call excepted), and the run kept in memory, so that a summary
+    needs no second reading: times and signals as the file holds them, bit for bit; the metadata
+    as written (tuples and key order where the file, through JSON, has lists and sorted keys); no
+    body poses, names or geometry."""
 
     path: Path
     simulated_s: float
