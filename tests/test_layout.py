@@ -173,7 +173,6 @@ def test_modules_are_small():
 
 _NO_MUJOCO = """
 import sys
-import tomllib
 class Refuse:
     def find_spec(self, name, path=None, target=None):
         if name.split(".")[0] == "mujoco":

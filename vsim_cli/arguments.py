@@ -13,16 +13,17 @@ from vsim_core.files import check_output
 
 def output_file(text: str) -> Path:
     """A file path an output can be written to (:func:`vsim_core.files.check_output`)."""
-    try:
-        return check_output(text)
-    except InputError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
+    return _output(text, folder=False)
 
 
 def output_folder(text: str) -> Path:
     """A folder path outputs can be written into."""
+    return _output(text, folder=True)
+
+
+def _output(text: str, folder: bool) -> Path:
     try:
-        return check_output(text, folder=True)
+        return check_output(text, folder=folder)
     except InputError as exc:
         raise argparse.ArgumentTypeError(str(exc)) from None
 

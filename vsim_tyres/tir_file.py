@@ -143,22 +143,27 @@ def _without_comment(raw: str) -> str:
     return raw
 
 
+def _number(text: str) -> float | None:
+    """``text`` as a finite number (Fortran's D exponent too), or None."""
+    value = float(text.replace("D", "e").replace("d", "e")) if _NUMBER.match(text) else math.nan
+    return value if math.isfinite(value) else None
+
+
 def _value(text: str, where: str, key: str) -> float | str:
     if len(text) >= 2 and text[0] == text[-1] == "'":
         return text[1:-1].strip()
-    if _NUMBER.match(text):
-        value = float(text.replace("D", "e").replace("d", "e"))
-        if math.isfinite(value):
-            return value
-    raise InputError(f"expected a finite number or a quoted text, got {text[:60]!r}", source=where, key=key)
+    value = _number(text)
+    if value is None:
+        raise InputError(f"expected a finite number or a quoted text, got {text[:60]!r}", source=where, key=key)
+    return value
 
 
 def _table_row(line: str, width: int, where: str, section: str) -> list[float]:
     cells = line.split()
     if len(cells) != width or not all(_NUMBER.match(c) for c in cells):
         raise InputError(f"expected a row of {width} numbers, got {line[:60]!r}", source=where, key=f"[{section}]")
-    row = [float(c.replace("D", "e").replace("d", "e")) for c in cells]
-    if not all(math.isfinite(v) for v in row):
+    row = [_number(c) for c in cells]
+    if None in row:
         raise InputError(f"expected finite numbers, got {line[:60]!r}", source=where, key=f"[{section}]")
     return row
 

@@ -31,6 +31,9 @@ MAX_SAMPLES = 10_000_000
 LIMITS = {"amplitude_mm": (100.0, "mm"), "step_mm": (100.0, "mm"), "static_mm": (100.0, "mm"),
           "amplitudes_mm": (100.0, "mm"), "speed_mm_s": (1e4, "mm/s"), "frequency_hz": (1e4, "Hz"),
           "frequencies_hz": (1e4, "Hz"), "hold_s": (1e6, "s"), "rise_time_s": (1e6, "s"), "duration_s": (1e6, "s")}
+#: Largest magnitude of each column of a bench CSV record (``t_s,e_mm,F_N``): beyond any bushing on a
+#: bench, below what a typing error gives.
+RECORD_LIMITS = {"t_s": units.plausible("s"), "e_mm": units.plausible("mm"), "F_N": units.plausible("N")}
 #: Speed of the ramps to and from a sine's static offset [mm/s], and the rest before the sine [s].
 STATIC_RAMP_MM_S, STATIC_REST_S = 1.0, 1.0
 
@@ -137,8 +140,7 @@ def read_csv_record(path: Path) -> tuple[np.ndarray, np.ndarray]:
     Raises InputError naming the file, line and column for a missing column, a non-number, a
     NaN, or a time that does not increase strictly.
     """
-    cols = read_csv_columns(path, ("t_s", "e_mm"), min_rows=2,
-                            limits={"t_s": units.plausible("s"), "e_mm": units.plausible("mm")})
+    cols = read_csv_columns(path, ("t_s", "e_mm"), min_rows=2, limits=RECORD_LIMITS)
     return cols["t_s"], cols["e_mm"] * MM
 
 
@@ -184,8 +186,7 @@ def read_programme(doc: Document, path: KeyPath, dt_s: float, base_dir: Path | N
         raise f.fail(missing[0], f"missing key for a {kind} programme")
 
     def number(key: str, **kind_of: bool) -> float:
-        at_most, unit = LIMITS.get(key, (math.inf, ""))
-        return f.number(key, allowed[key], **(kind_of or {"positive": True}), at_most=at_most, unit=unit)
+        return _limited(f, key, allowed[key], **(kind_of or {"positive": True}))
 
     def affordable(samples: float) -> None:
         if not samples <= MAX_SAMPLES:
@@ -215,7 +216,7 @@ def read_programme(doc: Document, path: KeyPath, dt_s: float, base_dir: Path | N
         frequency = number("frequency_hz")
         _check_sampling(f, "frequency_hz", frequency, dt_s)
         amplitude, cycles = number("amplitude_mm") * MM, int(number("cycles", positive=True, integer=True))
-        static_mm = f.number("static_mm", at_most=LIMITS["static_mm"][0], unit="mm") if f.has("static_mm") else 0.0
+        static_mm = _limited(f, "static_mm") if f.has("static_mm") else 0.0
         affordable((cycles / frequency + 2.0 * abs(static_mm) / STATIC_RAMP_MM_S + STATIC_REST_S) / dt_s)
         if f.has("static_mm"):
             t, e = sine_about(static_mm * MM, abs(static_mm) / STATIC_RAMP_MM_S, amplitude, frequency, cycles, dt_s)
@@ -245,6 +246,12 @@ def read_programme(doc: Document, path: KeyPath, dt_s: float, base_dir: Path | N
     return TimeSeries(kind, t, e)
 
 
+def _limited(f: Fields, key: str, default: Any = ..., **kind_of: bool) -> float:
+    """The number at ``key`` of ``f``, within its :data:`LIMITS` (if it has one)."""
+    at_most, unit = LIMITS.get(key, (math.inf, ""))
+    return f.number(key, default, at_most=at_most, unit=unit, **kind_of)
+
+
 def _numbers(f: Fields, key: str) -> np.ndarray:
     raw = f.raw(key)
     if not isinstance(raw, list) or not raw:
@@ -263,8 +270,8 @@ def _components(f: Fields) -> tuple[list[float], list[float]]:
         if set(c) != {"amplitude_mm", "frequency_hz"}:
             raise f.fail("components", f"expected exactly the keys amplitude_mm and frequency_hz, got {dict(c)!r}")
         item = Fields.of(f.doc, f.path("components") + (i,), c, ("amplitude_mm", "frequency_hz"))
-        amplitudes.append(item.number("amplitude_mm", positive=True, at_most=LIMITS["amplitude_mm"][0], unit="mm") * MM)
-        frequencies.append(item.number("frequency_hz", positive=True, at_most=LIMITS["frequency_hz"][0], unit="Hz"))
+        amplitudes.append(_limited(item, "amplitude_mm", positive=True) * MM)
+        frequencies.append(_limited(item, "frequency_hz", positive=True))
     return amplitudes, frequencies
 
 

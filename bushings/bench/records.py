@@ -14,17 +14,15 @@ from typing import Sequence
 import numpy as np
 
 from bushings.bank import BushingBank
+from bushings.bench.programmes import RECORD_LIMITS
 from bushings.parameters import ChannelParams
 from vsim_core.tables import read_csv_columns
-from vsim_core import units
 from vsim_core.units import MM
 
 #: Columns a bench record must have (extra columns are ignored).
 RECORD_COLUMNS = ("t_s", "e_mm", "F_N")
 #: Fewest samples a record may have to be usable for identification.
 MIN_SAMPLES = 10
-#: Largest magnitude of each column: beyond any bushing on a bench, below what a typing error gives.
-PLAUSIBLE = {"t_s": units.plausible("s"), "e_mm": units.plausible("mm"), "F_N": units.plausible("N")}
 
 
 @dataclass(frozen=True)
@@ -50,7 +48,7 @@ class BenchRecord:
 
 def read_bench_csv(path: str | Path) -> BenchRecord:
     """Read a ``t_s,e_mm,F_N`` bench record; errors name the file, line and column."""
-    cols = read_csv_columns(path, RECORD_COLUMNS, MIN_SAMPLES, limits=PLAUSIBLE)
+    cols = read_csv_columns(path, RECORD_COLUMNS, MIN_SAMPLES, limits=RECORD_LIMITS)
     return BenchRecord(source=Path(path).name, t=cols["t_s"], e=cols["e_mm"] * MM, F=cols["F_N"])
 
 
