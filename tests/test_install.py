@@ -74,9 +74,9 @@ def test_the_wheel_runs_a_built_in_scenario_from_an_empty_folder(tmp_path: Path)
     subprocess.run([sys.executable, "-m", "pip", "install", "-q", "--no-deps", "--target", str(target), str(wheel)],
                    check=True, capture_output=True, timeout=300)
     env = {**os.environ, "PYTHONPATH": str(target)}
-    where = subprocess.run([sys.executable, "-c", "import vsim_core.shipped as s; print(s.SCENARIO_DIR)"],
-                           env=env, cwd=empty, capture_output=True, text=True, check=True).stdout.strip()
-    assert Path(where) == target / "vsim_core" / "scenarios"
+    where = subprocess.run([sys.executable, "-c", "import vsim_core.shipped as s; print(s.SCENARIO_DIR, s.DEFAULT_TYRE.is_file())"],
+                           env=env, cwd=empty, capture_output=True, text=True, check=True).stdout.split()
+    assert Path(where[0]) == target / "vsim_core" / "scenarios" and where[1] == "True"   # the .tir travels too
     done = subprocess.run([sys.executable, "-m", "vsim_cli", "run", "pumping", "--duration-scale", "0.05"],
                           env=env, cwd=empty, capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stderr

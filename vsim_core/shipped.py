@@ -27,6 +27,9 @@ BENCH_DIR = PARAMETER_SET_DIR / "benches"
 VEHICLE_DIR = SHIPPED_ROOT / "models" / "vehicles"
 #: The built-in default vehicle.
 DEFAULT_VEHICLE = VEHICLE_DIR / "c_segment.yaml"
+#: Tyre property files (``models/tyres/``, ``.tir``) and the default car's tyre.
+TYRE_DIR = SHIPPED_ROOT / "models" / "tyres"
+DEFAULT_TYRE = TYRE_DIR / "195_65R15.tir"
 #: Rig scenarios (``scenarios/``) and the K&C campaign of the virtual rig (``scenarios/kc/``).
 SCENARIO_DIR = SHIPPED_ROOT / "scenarios"
 KC_SCENARIO_DIR = SCENARIO_DIR / "kc"

@@ -1,1 +1,1 @@
-"""Tyres: the industry's .tir property files (the Magic Formula's coefficients) read and checked."""
+"""Tyres: .tir property files read and checked, the Magic Formula 6.1 compiled, transient slip."""

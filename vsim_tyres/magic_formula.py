@@ -1,0 +1,274 @@
+"""The Magic Formula 6.1 tyre: steady-state forces and moments of one tyre from its ``.tir``
+coefficients, compiled so that the vehicle's step loop calls it for the four wheels.
+
+Equations: H. B. Pacejka, *Tire and Vehicle Dynamics*, 3rd ed. (2012), §4.3.2, eqs 4.E1–4.E78
+(the numbers are quoted at each line), for a tyre rolling forward (every sgn(V_cx) = 1), without
+turn slip (every ζ = 1) and with the friction's speed dependence off (``LMUV`` must be 0). Two choices the book leaves open are the MF-Tyre
+solver's: the trail's lateral force ``Fy'`` is the combined force at zero camber (4.E74: camber
+thrust acts at the contact centre), and the rolling resistance (4.E70) is written with the nominal
+load in front, ``My = −R0·Fz0'·(…)·(Fz/Fz0')^QSY7·(p/p0)^QSY8``.
+
+Axes and signs are the ``.tir`` file's (ISO-W): x along the wheel's heading on the road, z up,
+y left; longitudinal slip ``κ = (Ω·Re − Vx)/|Vx|`` (positive driving); slip angle ``α`` with
+``tan α = Vsy/|Vx|`` (a positive ``α`` gives a negative ``Fy`` for the usual negative PKY1);
+inclination ``γ`` about x (right-hand rule). SI: N, m, rad, s; the operating pressure is the
+file's ``INFLPRES``.
+
+A tyre's coefficients are one numpy record (:func:`coefficients`); numba compiles field access on
+a record to a fixed offset, so the compiled functions read ``p.PKY1`` as fast as an array element.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+from vsim_tyres.tir_file import TirFile
+
+#: Keys of the Magic Formula 6.1 read from each section; all must be in the file (the scaling
+#: factors, :data:`SCALING`, default to 1).
+REQUIRED = {
+    "MODEL": ("LONGVL", "VXLOW"),
+    "DIMENSION": ("UNLOADED_RADIUS",),
+    "OPERATING_CONDITIONS": ("INFLPRES", "NOMPRES"),
+    "VERTICAL": ("FNOMIN", "VERTICAL_STIFFNESS", "VERTICAL_DAMPING", "Q_FZ2", "PFZ1"),
+    "STRUCTURAL": ("LONGITUDINAL_STIFFNESS", "LATERAL_STIFFNESS", "PCFX1", "PCFX2", "PCFX3", "PCFY1", "PCFY2",
+                   "PCFY3", "DAMP_VLOW"),
+    "LONGITUDINAL_COEFFICIENTS": ("PCX1", "PDX1", "PDX2", "PDX3", "PEX1", "PEX2", "PEX3", "PEX4", "PKX1", "PKX2",
+                                  "PKX3", "PHX1", "PHX2", "PVX1", "PVX2", "PPX1", "PPX2", "PPX3", "PPX4", "RBX1",
+                                  "RBX2", "RBX3", "RCX1", "REX1", "REX2", "RHX1"),
+    "LATERAL_COEFFICIENTS": ("PCY1", "PDY1", "PDY2", "PDY3", "PEY1", "PEY2", "PEY3", "PEY4", "PEY5", "PKY1", "PKY2",
+                             "PKY3", "PKY4", "PKY5", "PKY6", "PKY7", "PHY1", "PHY2", "PVY1", "PVY2", "PVY3", "PVY4",
+                             "PPY1", "PPY2", "PPY3", "PPY4", "PPY5", "RBY1", "RBY2", "RBY3", "RBY4", "RCY1", "REY1",
+                             "REY2", "RHY1", "RHY2", "RVY1", "RVY2", "RVY3", "RVY4", "RVY5", "RVY6"),
+    "ROLLING_COEFFICIENTS": ("QSY1", "QSY2", "QSY3", "QSY4", "QSY5", "QSY6", "QSY7", "QSY8"),
+    "ALIGNING_COEFFICIENTS": ("QBZ1", "QBZ2", "QBZ3", "QBZ4", "QBZ5", "QBZ9", "QBZ10", "QCZ1", "QDZ1", "QDZ2", "QDZ3",
+                              "QDZ4", "QDZ6", "QDZ7", "QDZ8", "QDZ9", "QDZ10", "QDZ11", "QEZ1", "QEZ2", "QEZ3", "QEZ4",
+                              "QEZ5", "QHZ1", "QHZ2", "QHZ3", "QHZ4", "PPZ1", "PPZ2", "SSZ1", "SSZ2", "SSZ3", "SSZ4"),
+}
+#: The scaling factors evaluated (``[SCALING_COEFFICIENTS]``, 1 when absent).
+SCALING = ("LFZO", "LCX", "LMUX", "LEX", "LKX", "LHX", "LVX", "LCY", "LMUY", "LEY", "LKY", "LHY", "LVY", "LTR", "LRES",
+           "LXAL", "LYKA", "LVYKA", "LS", "LKYC", "LKZC", "LMY")
+#: The record type of a tyre's coefficients: one float64 field per key.
+DTYPE = np.dtype([(key, np.float64) for keys in REQUIRED.values() for key in keys] +
+                 [(key, np.float64) for key in SCALING])
+#: The small number ε of 4.E6 that keeps the stiffness factors finite at zero load or friction.
+_EPS = 1e-6
+#: A_μ of 4.E8: the degressive scaling of friction's vertical shifts.
+_A_MU = 10.0
+
+
+def coefficients(tir: TirFile) -> np.record:
+    """The Magic Formula 6.1 coefficients of ``tir`` as one record of :data:`DTYPE`. InputError naming
+    the file, line, section and key for a missing coefficient, a non-positive nominal load, radius,
+    pressure, stiffness or low-speed limit, or a speed-dependent friction (``LMUV`` ≠ 0)."""
+    record = np.zeros(1, DTYPE)[0]
+    for section, keys in REQUIRED.items():
+        for key in keys:
+            record[key] = tir.number(section, key)
+    for key in SCALING:
+        record[key] = tir.number("SCALING_COEFFICIENTS", key, default=1.0)
+    for section, key in (("VERTICAL", "FNOMIN"), ("DIMENSION", "UNLOADED_RADIUS"), ("OPERATING_CONDITIONS", "INFLPRES"),
+                         ("OPERATING_CONDITIONS", "NOMPRES"), ("VERTICAL", "VERTICAL_STIFFNESS"),
+                         ("STRUCTURAL", "LONGITUDINAL_STIFFNESS"), ("STRUCTURAL", "LATERAL_STIFFNESS"),
+                         ("MODEL", "LONGVL"), ("MODEL", "VXLOW"), ("SCALING_COEFFICIENTS", "LFZO")):
+        if not record[key] > 0.0:
+            raise tir.error(section, key, f"{record[key]:g}: expected a positive number")
+    if tir.number("SCALING_COEFFICIENTS", "LMUV", default=0.0) != 0.0:
+        raise tir.error("SCALING_COEFFICIENTS", "LMUV", "friction's dependence on slip speed is not evaluated; "
+                                                        "expected 0")
+    vertical = (record["VERTICAL_STIFFNESS"] * record["UNLOADED_RADIUS"] / record["FNOMIN"]) ** 2
+    if vertical <= 4.0 * record["Q_FZ2"]:
+        raise tir.error("VERTICAL", "Q_FZ2", f"{record['Q_FZ2']:g} leaves no linear term in the load–deflection "
+                                             f"law; expected below (VERTICAL_STIFFNESS·R0/FNOMIN)²/4 = {vertical / 4:g}")
+    return record
+
+
+@nb.njit(cache=True, inline="always")
+def _sign(x: float) -> float:
+    """sgn(x) with sgn(0) = 0, as the book's."""
+    return 1.0 if x > 0.0 else (-1.0 if x < 0.0 else 0.0)
+
+
+@nb.njit(cache=True, inline="always")
+def _nonzero_sign(x: float) -> float:
+    """sgn(x) with sgn(0) = 1: the side a small ε is added on."""
+    return -1.0 if x < 0.0 else 1.0
+
+
+@nb.njit(cache=True, inline="always")
+def _magic(b: float, c: float, e: float, x: float) -> float:
+    """sin-free core of the Magic Formula: ``C·atan(B·x − E·(B·x − atan(B·x)))``."""
+    return c * math.atan(b * x - e * (b * x - math.atan(b * x)))
+
+
+@nb.njit(cache=True, inline="always")
+def _normalised(p, fz: float) -> tuple[float, float, float]:
+    """Scaled nominal load Fz0' [N] (4.E1), load and pressure increments dfz, dpi (4.E2)."""
+    fz0 = p.FNOMIN * p.LFZO
+    return fz0, (fz - fz0) / fz0, (p.INFLPRES - p.NOMPRES) / p.NOMPRES
+
+
+@nb.njit(cache=True)
+def _lateral_pure(p, fz: float, dfz: float, dpi: float, alpha_star: float, gamma_star: float):
+    """Pure side slip (4.E19–4.E30): Fy0, K_yα, μy, B_y, C_y, S_Hy, S_Vy."""
+    fz0 = p.FNOMIN * p.LFZO                                                                  # 4.E1
+    lmuy_prime = _A_MU * p.LMUY / (1.0 + (_A_MU - 1.0) * p.LMUY)                             # 4.E8
+    g2 = gamma_star * gamma_star
+    kya = (p.PKY1 * fz0 * (1.0 + p.PPY1 * dpi) * (1.0 - p.PKY3 * abs(gamma_star))
+           * math.sin(p.PKY4 * math.atan(fz / fz0 / ((p.PKY2 + p.PKY5 * g2) * (1.0 + p.PPY2 * dpi)))) * p.LKY)  # 4.E25
+    svyg = fz * (p.PVY3 + p.PVY4 * dfz) * gamma_star * p.LKYC * lmuy_prime                  # 4.E28
+    kyg0 = fz * (p.PKY6 + p.PKY7 * dfz) * (1.0 + p.PPY5 * dpi) * p.LKYC                     # 4.E30
+    shy = (p.PHY1 + p.PHY2 * dfz) * p.LHY + (kyg0 * gamma_star - svyg) / (kya + _EPS * _nonzero_sign(kya))  # 4.E27
+    svy = fz * (p.PVY1 + p.PVY2 * dfz) * p.LVY * lmuy_prime + svyg                          # 4.E29
+    alpha_y = alpha_star + shy                                                               # 4.E20
+    cy = p.PCY1 * p.LCY                                                                      # 4.E21
+    muy = (p.PDY1 + p.PDY2 * dfz) * (1.0 + p.PPY3 * dpi + p.PPY4 * dpi * dpi) * (1.0 - p.PDY3 * g2) * p.LMUY  # 4.E23
+    dy = muy * fz                                                                            # 4.E22
+    ey = min((p.PEY1 + p.PEY2 * dfz) * (1.0 + p.PEY5 * g2 - (p.PEY3 + p.PEY4 * gamma_star) * _sign(alpha_y))
+             * p.LEY, 1.0)                                                                   # 4.E24
+    by = kya / (cy * dy + _EPS * _nonzero_sign(dy))                                          # 4.E26
+    fy0 = dy * math.sin(_magic(by, cy, ey, alpha_y)) + svy                                   # 4.E19
+    return fy0, kya, muy, by, cy, shy, svy
+
+
+@nb.njit(cache=True)
+def _longitudinal_pure(p, fz: float, dfz: float, dpi: float, kappa: float, gamma_star: float):
+    """Pure longitudinal slip (4.E9–4.E18): Fx0 and K_xκ."""
+    lmux_prime = _A_MU * p.LMUX / (1.0 + (_A_MU - 1.0) * p.LMUX)                             # 4.E8
+    kappa_x = kappa + (p.PHX1 + p.PHX2 * dfz) * p.LHX                                        # 4.E10, 4.E17
+    cx = p.PCX1 * p.LCX                                                                      # 4.E11
+    mux = ((p.PDX1 + p.PDX2 * dfz) * (1.0 + p.PPX3 * dpi + p.PPX4 * dpi * dpi)
+           * (1.0 - p.PDX3 * gamma_star * gamma_star) * p.LMUX)                              # 4.E13
+    dx = mux * fz                                                                            # 4.E12
+    ex = min((p.PEX1 + p.PEX2 * dfz + p.PEX3 * dfz * dfz) * (1.0 - p.PEX4 * _sign(kappa_x)) * p.LEX, 1.0)  # 4.E14
+    kxk = fz * (p.PKX1 + p.PKX2 * dfz) * math.exp(p.PKX3 * dfz) * (1.0 + p.PPX1 * dpi + p.PPX2 * dpi * dpi) * p.LKX  # 4.E15
+    bx = kxk / (cx * dx + _EPS * _nonzero_sign(dx))                                          # 4.E16
+    svx = fz * (p.PVX1 + p.PVX2 * dfz) * p.LVX * lmux_prime                                  # 4.E18
+    return dx * math.sin(_magic(bx, cx, ex, kappa_x)) + svx, kxk
+
+
+@nb.njit(cache=True, inline="always")
+def _weighting(b: float, c: float, e: float, shift: float, x: float) -> float:
+    """Combined-slip weighting G (4.E53/4.E63): cos(C·atan(…x…)) over its value at the shift."""
+    return math.cos(_magic(b, c, e, x)) / math.cos(_magic(b, c, e, shift))
+
+
+@nb.njit(cache=True)
+def forces(p, fz: float, kappa: float, alpha: float, gamma: float, vx: float):
+    """Combined-slip forces and moments of one tyre (4.E50–4.E78): ``(Fx, Fy, Mz, My)`` [N, N·m] at
+    vertical load ``fz`` [N], longitudinal slip ``kappa``, slip angle ``alpha`` and inclination
+    ``gamma`` [rad], forward speed ``vx`` [m/s]. The tyre rolls forward: the book's sgn(V_cx) factors
+    are +1 (a car at rest holds through the transient slips' deflections, not through the sign of a
+    vanishing speed); the rolling resistance opposes ``vx`` and fades linearly to zero below
+    ``VXLOW``, so that a wheel at rest is not pushed. A tyre off the ground (``fz ≤ 0``) gives zeros."""
+    if fz <= 0.0:
+        return 0.0, 0.0, 0.0, 0.0
+    fz0, dfz, dpi = _normalised(p, fz)
+    alpha_star = math.tan(alpha)                                                             # 4.E3
+    gamma_star = math.sin(gamma)                                                             # 4.E4
+    cos_alpha = math.cos(alpha)                                                              # 4.E6 (V_cx/V_c)
+    g2 = gamma_star * gamma_star
+    fx0, kxk = _longitudinal_pure(p, fz, dfz, dpi, kappa, gamma_star)
+    fy0, kya, muy, by, cy, shy, svy = _lateral_pure(p, fz, dfz, dpi, alpha_star, gamma_star)
+    kya_prime = kya + _EPS * _nonzero_sign(kya)                                              # 4.E39
+
+    # Fx in combined slip (4.E50–4.E57)
+    bxa = (p.RBX1 + p.RBX3 * g2) * math.cos(math.atan(p.RBX2 * kappa)) * p.LXAL             # 4.E54
+    exa = min(p.REX1 + p.REX2 * dfz, 1.0)                                                    # 4.E56
+    fx = _weighting(bxa, p.RCX1, exa, p.RHX1, alpha_star + p.RHX1) * fx0                     # 4.E50–4.E53, 4.E57
+
+    # Fy in combined slip (4.E58–4.E67)
+    dvyk = muy * fz * (p.RVY1 + p.RVY2 * dfz + p.RVY3 * gamma_star) * math.cos(math.atan(p.RVY4 * alpha_star))  # 4.E67
+    svyk = dvyk * math.sin(p.RVY5 * math.atan(p.RVY6 * kappa)) * p.LVYKA                     # 4.E66
+    shyk = p.RHY1 + p.RHY2 * dfz                                                             # 4.E65
+    byk = (p.RBY1 + p.RBY4 * g2) * math.cos(math.atan(p.RBY2 * (alpha_star - p.RBY3))) * p.LYKA  # 4.E62
+    eyk = min(p.REY1 + p.REY2 * dfz, 1.0)                                                    # 4.E64
+    gyk = _weighting(byk, p.RCY1, eyk, shyk, kappa + shyk)                                   # 4.E59–4.E61, 4.E63
+    fy = gyk * fy0 + svyk                                                                    # 4.E58
+
+    # Mz in combined slip (4.E31–4.E49, 4.E71–4.E78)
+    r0 = p.UNLOADED_RADIUS
+    sht = p.QHZ1 + p.QHZ2 * dfz + (p.QHZ3 + p.QHZ4 * dfz) * gamma_star                       # 4.E35
+    alpha_t = alpha_star + sht                                                               # 4.E34
+    alpha_r = alpha_star + shy + svy / kya_prime                                             # 4.E37, 4.E38
+    bt = ((p.QBZ1 + p.QBZ2 * dfz + p.QBZ3 * dfz * dfz) * (1.0 + p.QBZ4 * gamma_star + p.QBZ5 * abs(gamma_star))
+          * p.LKY / p.LMUY)                                                                  # 4.E40
+    ct = p.QCZ1                                                                              # 4.E41
+    dt = (fz * (r0 / fz0) * (p.QDZ1 + p.QDZ2 * dfz) * (1.0 - p.PPZ1 * dpi) * p.LTR
+          * (1.0 + p.QDZ3 * abs(gamma_star) + p.QDZ4 * g2))                                  # 4.E42, 4.E43
+    et = min((p.QEZ1 + p.QEZ2 * dfz + p.QEZ3 * dfz * dfz)
+             * (1.0 + (p.QEZ4 + p.QEZ5 * gamma_star) * (2.0 / math.pi) * math.atan(bt * ct * alpha_t)), 1.0)  # 4.E44
+    br = p.QBZ9 * p.LKY / p.LMUY + p.QBZ10 * by * cy                                         # 4.E45
+    dr = (fz * r0 * ((p.QDZ6 + p.QDZ7 * dfz) * p.LRES + ((p.QDZ8 + p.QDZ9 * dfz) * (1.0 + p.PPZ2 * dpi)
+                                                          + (p.QDZ10 + p.QDZ11 * dfz) * abs(gamma_star))
+                     * gamma_star * p.LKZC) * p.LMUY * cos_alpha)                   # 4.E47
+    slip_ratio = (kxk / kya_prime) * kappa
+    alpha_t_eq = math.sqrt(alpha_t * alpha_t + slip_ratio * slip_ratio) * _sign(alpha_t)    # 4.E77
+    alpha_r_eq = math.sqrt(alpha_r * alpha_r + slip_ratio * slip_ratio) * _sign(alpha_r)    # 4.E78
+    trail = dt * math.cos(_magic(bt, ct, et, alpha_t_eq)) * cos_alpha                        # 4.E73
+    residual = dr * math.cos(math.atan(br * alpha_r_eq))                                     # 4.E75 (C_r = 1)
+    fy_untilted = gyk * _lateral_pure(p, fz, dfz, dpi, alpha_star, 0.0)[0]                   # 4.E74
+    scrub = r0 * (p.SSZ1 + p.SSZ2 * fy / fz0 + (p.SSZ3 + p.SSZ4 * dfz) * gamma_star) * p.LS  # 4.E76
+    mz = -trail * fy_untilted + residual + scrub * fx                                        # 4.E71, 4.E72
+
+    # My, rolling resistance (4.E70), fading to zero at rest
+    speed = vx / p.LONGVL
+    my = (-r0 * fz0 * p.LMY * (p.QSY1 + p.QSY2 * fx / fz0 + p.QSY3 * abs(speed) + p.QSY4 * speed ** 4
+                                 + (p.QSY5 + p.QSY6 * fz / fz0) * gamma * gamma)
+          * (fz / fz0) ** p.QSY7 * (p.INFLPRES / p.NOMPRES) ** p.QSY8 * max(-1.0, min(1.0, vx / p.VXLOW)))
+    return fx, fy, mz, my
+
+
+@nb.njit(cache=True)
+def slip_stiffnesses(p, fz: float, gamma: float) -> tuple[float, float]:
+    """Slip stiffnesses at zero slip: ``(K_xκ [N], K_yα [N/rad])`` (4.E15, 4.E25) at load ``fz`` [N]
+    and inclination ``gamma`` [rad]."""
+    _, dfz, dpi = _normalised(p, fz)
+    gamma_star = math.sin(gamma)
+    return _longitudinal_pure(p, fz, dfz, dpi, 0.0, gamma_star)[1], _lateral_pure(p, fz, dfz, dpi, 0.0, gamma_star)[1]
+
+
+@nb.njit(cache=True)
+def carcass_stiffnesses(p, fz: float) -> tuple[float, float]:
+    """The carcass's longitudinal and lateral stiffnesses [N/m] at load ``fz`` [N] (MF 6.1's
+    [STRUCTURAL] keys with their load and pressure dependence, Besselink et al. 2010)."""
+    _, dfz, dpi = _normalised(p, fz)
+    cx = p.LONGITUDINAL_STIFFNESS * (1.0 + p.PCFX1 * dfz + p.PCFX2 * dfz * dfz) * (1.0 + p.PCFX3 * dpi)
+    cy = p.LATERAL_STIFFNESS * (1.0 + p.PCFY1 * dfz + p.PCFY2 * dfz * dfz) * (1.0 + p.PCFY3 * dpi)
+    return cx, cy
+
+
+@nb.njit(cache=True)
+def vertical_force(p, deflection: float, deflection_rate: float) -> float:
+    """Vertical load [N] of the tyre pressed ``deflection`` [m] into a flat road at ``deflection_rate``
+    [m/s] (MF 6.1: ``Fz = Fz0·(1 + PFZ1·dpi)·(q1·ρ/R0 + Q_FZ2·(ρ/R0)²)`` with q1 such that the
+    stiffness at the nominal load is ``VERTICAL_STIFFNESS``, plus ``VERTICAL_DAMPING``·ρ̇); never
+    negative: the road pushes, it does not pull."""
+    if deflection <= 0.0:
+        return 0.0
+    fz0 = p.FNOMIN
+    x = deflection / p.UNLOADED_RADIUS
+    q1 = math.sqrt((p.VERTICAL_STIFFNESS * p.UNLOADED_RADIUS / fz0) ** 2 - 4.0 * p.Q_FZ2)
+    dpi = (p.INFLPRES - p.NOMPRES) / p.NOMPRES
+    return max(0.0, fz0 * (1.0 + p.PFZ1 * dpi) * (q1 * x + p.Q_FZ2 * x * x) + p.VERTICAL_DAMPING * deflection_rate)
+
+
+@nb.njit(cache=True)
+def _evaluate(p, fz, kappa, alpha, gamma, vx, out) -> None:
+    for i in range(fz.shape[0]):
+        out[i, 0], out[i, 1], out[i, 2], out[i, 3] = forces(p, fz[i], kappa[i], alpha[i], gamma[i], vx[i])
+
+
+def evaluate(p: np.record, fz, kappa=0.0, alpha=0.0, gamma=0.0, vx=None) -> dict[str, np.ndarray]:
+    """:func:`forces` over arrays (broadcast together): ``{"Fx", "Fy", "Mz", "My"}`` [N, N·m]; ``vx``
+    [m/s] defaults to the file's reference speed ``LONGVL``."""
+    vx = p["LONGVL"] if vx is None else vx
+    arrays = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (fz, kappa, alpha, gamma, vx)))
+    shape = arrays[0].shape
+    fz_, kappa_, alpha_, gamma_, vx_ = (np.ascontiguousarray(a).ravel() for a in arrays)
+    out = np.empty((fz_.size, 4))
+    _evaluate(p, fz_, kappa_, alpha_, gamma_, vx_, out)
+    return {name: out[:, j].reshape(shape) for j, name in enumerate(("Fx", "Fy", "Mz", "My"))}
