@@ -4,17 +4,16 @@ by one compiled call around the base kernel; and whole deflection histories run 
 
 from __future__ import annotations
 
-import os
 from typing import Sequence
 
 import numba as nb
 import numpy as np
-from numba.core import caching
 
 from bushings import kernel as kn
 from bushings.bank import DEFAULT_TOLERANCE, BushingBank
 from bushings.effects import NO_EFFECTS, Effects
 from bushings.parameters import ChannelParams
+from vsim_core.compiled_cache import follow
 
 # Columns of the effect parameter matrix (one row per channel) and of the effect state.
 E_PRELOAD, E_ASYM, E_MULLINS, E_HEAT, E_HEAT_TAU, E_BACKLASH, E_TARE = range(7)
@@ -25,35 +24,9 @@ N_SCOLS = 3
 MOUNT_S, MOUNT_STEPS = 10.0, 200
 
 
-def kernel_stamped_locator(owner: str) -> type:
-    """A numba cache locator for the compiled functions of the file ``owner`` whose stamp also
-    covers the bushing kernels (``bushings/kernel.py`` and this file).
-
-    A function that calls the kernel compiles it into itself, but numba checks only the stamp of
-    the function's own file: after a kernel change its cache would run the old kernel (on the new
-    bank's arrays: wrong bits at best, memory corruption at worst). Register the class with
-    ``numba.core.caching.CacheImpl._locator_classes.insert(0, ...)`` before the functions are defined.
-    """
-    owner_path = os.path.realpath(owner)
-
-    class KernelStampedLocator(caching.InTreeCacheLocator):
-        @classmethod
-        def from_function(cls, py_func, py_file):
-            if os.path.realpath(py_file) != owner_path:
-                return None  # other files keep numba's own locators
-            return super().from_function(py_func, py_file)
-
-        def get_source_stamp(self):
-            stamps = [super().get_source_stamp()]
-            for path in (kn.__file__, __file__):
-                st = os.stat(path)
-                stamps.append(caching._hash_source_file(path, st.st_mtime, st.st_size))
-            return tuple(stamps)
-
-    return KernelStampedLocator
-
-
-caching.CacheImpl._locator_classes.insert(0, kernel_stamped_locator(__file__))
+#: The files a function that steps the bank compiles into itself (see vsim_core.compiled_cache).
+KERNEL_FILES = (kn.__file__, __file__)
+follow(__file__, *KERNEL_FILES)
 
 
 @nb.njit(cache=True)

@@ -46,13 +46,15 @@ def reference(c: dict, fz: float, kappa: float, alpha: float, gamma: float, vx: 
 
     fz0 = c["LFZO"] * c["FNOMIN"]
     dfz = fz / fz0 - 1.0
+    # MF-Tyre's low-speed reduction of the shifts
+    low = 1.0 if abs(vx) >= c["VXLOW"] else (1 - math.cos(math.pi * abs(vx) / c["VXLOW"])) / 2
     dpi = c["INFLPRES"] / c["NOMPRES"] - 1.0
     a = math.tan(alpha)
     g = math.sin(gamma)
     lmux_p = 10 * c["LMUX"] / (1 + 9 * c["LMUX"])
     lmuy_p = 10 * c["LMUY"] / (1 + 9 * c["LMUY"])
     # pure longitudinal
-    shx = (c["PHX1"] + c["PHX2"] * dfz) * c["LHX"]
+    shx = (c["PHX1"] + c["PHX2"] * dfz) * c["LHX"] * low
     kx = kappa + shx
     mux = (c["PDX1"] + c["PDX2"] * dfz) * (1 + c["PPX3"] * dpi + c["PPX4"] * dpi ** 2) * (1 - c["PDX3"] * g ** 2) \
         * c["LMUX"]
@@ -61,7 +63,7 @@ def reference(c: dict, fz: float, kappa: float, alpha: float, gamma: float, vx: 
         * c["LKX"]
     cx = c["PCX1"] * c["LCX"]
     bx = kxk / (cx * mux * fz + 1e-6)
-    fx0 = mf_curve(bx, cx, mux * fz, ex, kx) + fz * (c["PVX1"] + c["PVX2"] * dfz) * c["LVX"] * lmux_p
+    fx0 = mf_curve(bx, cx, mux * fz, ex, kx) + fz * (c["PVX1"] + c["PVX2"] * dfz) * c["LVX"] * lmux_p * low
 
     # pure lateral (as a function of camber, for Fy' at γ = 0)
     def lateral(g):
@@ -69,8 +71,8 @@ def reference(c: dict, fz: float, kappa: float, alpha: float, gamma: float, vx: 
             c["PKY4"] * math.atan(fz / ((c["PKY2"] + c["PKY5"] * g ** 2) * (1 + c["PPY2"] * dpi) * fz0)))
         svyg = fz * (c["PVY3"] + c["PVY4"] * dfz) * g * c["LKYC"] * lmuy_p
         kyg0 = fz * (c["PKY6"] + c["PKY7"] * dfz) * (1 + c["PPY5"] * dpi) * c["LKYC"]
-        shy = (c["PHY1"] + c["PHY2"] * dfz) * c["LHY"] + (kyg0 * g - svyg) / (kya + math.copysign(1e-6, kya))
-        svy = fz * (c["PVY1"] + c["PVY2"] * dfz) * c["LVY"] * lmuy_p + svyg
+        shy = low * ((c["PHY1"] + c["PHY2"] * dfz) * c["LHY"] + (kyg0 * g - svyg) / (kya + math.copysign(1e-6, kya)))
+        svy = low * (fz * (c["PVY1"] + c["PVY2"] * dfz) * c["LVY"] * lmuy_p + svyg)
         ay = a + shy
         muy = (c["PDY1"] + c["PDY2"] * dfz) * (1 + c["PPY3"] * dpi + c["PPY4"] * dpi ** 2) * (1 - c["PDY3"] * g ** 2) \
             * c["LMUY"]
@@ -213,6 +215,8 @@ def test_rolling_resistance_opposes_rolling_and_fades_out_at_rest(tyre: np.recor
     vx = np.array([0.0, 0.25, 0.5, 1.0, 16.7, -16.7])
     my = mf.evaluate(tyre, 4000.0, vx=vx)["My"]
     assert my[0] == 0.0 and my[4] < 0 < my[5]
+    at_rest = mf.evaluate(tyre, 4000.0, gamma=0.05, vx=0.0)
+    assert at_rest["Fx"] == 0.0 and at_rest["Fy"] == 0.0     # no offsets nor camber thrust standing still
 
     def speed_law(v):  # the file's QSY2 and camber terms are zero
         return tyre["QSY1"] + tyre["QSY3"] * abs(v / tyre["LONGVL"]) + tyre["QSY4"] * (v / tyre["LONGVL"]) ** 4

@@ -1,1 +1,1 @@
-"""Tyres: .tir property files read and checked, the Magic Formula 6.1 compiled, transient slip."""
+"""Tyres: .tir property files read and checked, the Magic Formula 6.1 compiled, transient slip, tyres on a flat road."""

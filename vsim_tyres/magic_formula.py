@@ -33,7 +33,7 @@ REQUIRED = {
     "MODEL": ("LONGVL", "VXLOW"),
     "DIMENSION": ("UNLOADED_RADIUS",),
     "OPERATING_CONDITIONS": ("INFLPRES", "NOMPRES"),
-    "VERTICAL": ("FNOMIN", "VERTICAL_STIFFNESS", "VERTICAL_DAMPING", "Q_FZ2", "PFZ1"),
+    "VERTICAL": ("FNOMIN", "VERTICAL_STIFFNESS", "VERTICAL_DAMPING", "Q_FZ2", "PFZ1", "BREFF", "DREFF", "FREFF"),
     "STRUCTURAL": ("LONGITUDINAL_STIFFNESS", "LATERAL_STIFFNESS", "PCFX1", "PCFX2", "PCFX3", "PCFY1", "PCFY2",
                    "PCFY3", "DAMP_VLOW"),
     "LONGITUDINAL_COEFFICIENTS": ("PCX1", "PDX1", "PDX2", "PDX3", "PEX1", "PEX2", "PEX3", "PEX4", "PKX1", "PKX2",
@@ -111,9 +111,18 @@ def _normalised(p, fz: float) -> tuple[float, float, float]:
     return fz0, (fz - fz0) / fz0, (p.INFLPRES - p.NOMPRES) / p.NOMPRES
 
 
+@nb.njit(cache=True, inline="always")
+def _shift_scale(p, vx: float) -> float:
+    """MF-Tyre's low-speed reduction of the shifts S_Hx, S_Vx, S_Hy, S_Vy: 1 from ``VXLOW`` up, down
+    to 0 at rest along a half cosine, so that a tyre standing still without slip pushes nowhere
+    (no camber thrust, conicity or ply steer at rest)."""
+    speed = abs(vx)
+    return 1.0 if speed >= p.VXLOW else 0.5 * (1.0 - math.cos(math.pi * speed / p.VXLOW))
+
+
 @nb.njit(cache=True)
-def _lateral_pure(p, fz: float, dfz: float, dpi: float, alpha_star: float, gamma_star: float):
-    """Pure side slip (4.E19–4.E30): Fy0, K_yα, μy, B_y, C_y, S_Hy, S_Vy."""
+def _lateral_pure(p, fz: float, dfz: float, dpi: float, alpha_star: float, gamma_star: float, shifts: float):
+    """Pure side slip (4.E19–4.E30): Fy0, K_yα, μy, B_y, C_y, S_Hy, S_Vy; ``shifts`` scales S_Hy, S_Vy."""
     fz0 = p.FNOMIN * p.LFZO                                                                  # 4.E1
     lmuy_prime = _A_MU * p.LMUY / (1.0 + (_A_MU - 1.0) * p.LMUY)                             # 4.E8
     g2 = gamma_star * gamma_star
@@ -121,8 +130,9 @@ def _lateral_pure(p, fz: float, dfz: float, dpi: float, alpha_star: float, gamma
            * math.sin(p.PKY4 * math.atan(fz / fz0 / ((p.PKY2 + p.PKY5 * g2) * (1.0 + p.PPY2 * dpi)))) * p.LKY)  # 4.E25
     svyg = fz * (p.PVY3 + p.PVY4 * dfz) * gamma_star * p.LKYC * lmuy_prime                  # 4.E28
     kyg0 = fz * (p.PKY6 + p.PKY7 * dfz) * (1.0 + p.PPY5 * dpi) * p.LKYC                     # 4.E30
-    shy = (p.PHY1 + p.PHY2 * dfz) * p.LHY + (kyg0 * gamma_star - svyg) / (kya + _EPS * _nonzero_sign(kya))  # 4.E27
-    svy = fz * (p.PVY1 + p.PVY2 * dfz) * p.LVY * lmuy_prime + svyg                          # 4.E29
+    shy = ((p.PHY1 + p.PHY2 * dfz) * p.LHY
+           + (kyg0 * gamma_star - svyg) / (kya + _EPS * _nonzero_sign(kya))) * shifts        # 4.E27
+    svy = (fz * (p.PVY1 + p.PVY2 * dfz) * p.LVY * lmuy_prime + svyg) * shifts               # 4.E29
     alpha_y = alpha_star + shy                                                               # 4.E20
     cy = p.PCY1 * p.LCY                                                                      # 4.E21
     muy = (p.PDY1 + p.PDY2 * dfz) * (1.0 + p.PPY3 * dpi + p.PPY4 * dpi * dpi) * (1.0 - p.PDY3 * g2) * p.LMUY  # 4.E23
@@ -135,10 +145,10 @@ def _lateral_pure(p, fz: float, dfz: float, dpi: float, alpha_star: float, gamma
 
 
 @nb.njit(cache=True)
-def _longitudinal_pure(p, fz: float, dfz: float, dpi: float, kappa: float, gamma_star: float):
-    """Pure longitudinal slip (4.E9–4.E18): Fx0 and K_xκ."""
+def _longitudinal_pure(p, fz: float, dfz: float, dpi: float, kappa: float, gamma_star: float, shifts: float):
+    """Pure longitudinal slip (4.E9–4.E18): Fx0 and K_xκ; ``shifts`` scales S_Hx, S_Vx."""
     lmux_prime = _A_MU * p.LMUX / (1.0 + (_A_MU - 1.0) * p.LMUX)                             # 4.E8
-    kappa_x = kappa + (p.PHX1 + p.PHX2 * dfz) * p.LHX                                        # 4.E10, 4.E17
+    kappa_x = kappa + (p.PHX1 + p.PHX2 * dfz) * p.LHX * shifts                               # 4.E10, 4.E17
     cx = p.PCX1 * p.LCX                                                                      # 4.E11
     mux = ((p.PDX1 + p.PDX2 * dfz) * (1.0 + p.PPX3 * dpi + p.PPX4 * dpi * dpi)
            * (1.0 - p.PDX3 * gamma_star * gamma_star) * p.LMUX)                              # 4.E13
@@ -146,7 +156,7 @@ def _longitudinal_pure(p, fz: float, dfz: float, dpi: float, kappa: float, gamma
     ex = min((p.PEX1 + p.PEX2 * dfz + p.PEX3 * dfz * dfz) * (1.0 - p.PEX4 * _sign(kappa_x)) * p.LEX, 1.0)  # 4.E14
     kxk = fz * (p.PKX1 + p.PKX2 * dfz) * math.exp(p.PKX3 * dfz) * (1.0 + p.PPX1 * dpi + p.PPX2 * dpi * dpi) * p.LKX  # 4.E15
     bx = kxk / (cx * dx + _EPS * _nonzero_sign(dx))                                          # 4.E16
-    svx = fz * (p.PVX1 + p.PVX2 * dfz) * p.LVX * lmux_prime                                  # 4.E18
+    svx = fz * (p.PVX1 + p.PVX2 * dfz) * p.LVX * lmux_prime * shifts                         # 4.E18
     return dx * math.sin(_magic(bx, cx, ex, kappa_x)) + svx, kxk
 
 
@@ -162,8 +172,9 @@ def forces(p, fz: float, kappa: float, alpha: float, gamma: float, vx: float):
     vertical load ``fz`` [N], longitudinal slip ``kappa``, slip angle ``alpha`` and inclination
     ``gamma`` [rad], forward speed ``vx`` [m/s]. The tyre rolls forward: the book's sgn(V_cx) factors
     are +1 (a car at rest holds through the transient slips' deflections, not through the sign of a
-    vanishing speed); the rolling resistance opposes ``vx`` and fades linearly to zero below
-    ``VXLOW``, so that a wheel at rest is not pushed. A tyre off the ground (``fz ≤ 0``) gives zeros."""
+    vanishing speed). Below ``VXLOW`` the curves' shifts fade out (:func:`_shift_scale`) and the
+    rolling resistance, which opposes ``vx``, fades linearly to zero, so that a wheel at rest is not
+    pushed. A tyre off the ground (``fz ≤ 0``) gives zeros."""
     if fz <= 0.0:
         return 0.0, 0.0, 0.0, 0.0
     fz0, dfz, dpi = _normalised(p, fz)
@@ -171,8 +182,9 @@ def forces(p, fz: float, kappa: float, alpha: float, gamma: float, vx: float):
     gamma_star = math.sin(gamma)                                                             # 4.E4
     cos_alpha = math.cos(alpha)                                                              # 4.E6 (V_cx/V_c)
     g2 = gamma_star * gamma_star
-    fx0, kxk = _longitudinal_pure(p, fz, dfz, dpi, kappa, gamma_star)
-    fy0, kya, muy, by, cy, shy, svy = _lateral_pure(p, fz, dfz, dpi, alpha_star, gamma_star)
+    shifts = _shift_scale(p, vx)
+    fx0, kxk = _longitudinal_pure(p, fz, dfz, dpi, kappa, gamma_star, shifts)
+    fy0, kya, muy, by, cy, shy, svy = _lateral_pure(p, fz, dfz, dpi, alpha_star, gamma_star, shifts)
     kya_prime = kya + _EPS * _nonzero_sign(kya)                                              # 4.E39
 
     # Fx in combined slip (4.E50–4.E57)
@@ -210,7 +222,7 @@ def forces(p, fz: float, kappa: float, alpha: float, gamma: float, vx: float):
     alpha_r_eq = math.sqrt(alpha_r * alpha_r + slip_ratio * slip_ratio) * _sign(alpha_r)    # 4.E78
     trail = dt * math.cos(_magic(bt, ct, et, alpha_t_eq)) * cos_alpha                        # 4.E73
     residual = dr * math.cos(math.atan(br * alpha_r_eq))                                     # 4.E75 (C_r = 1)
-    fy_untilted = gyk * _lateral_pure(p, fz, dfz, dpi, alpha_star, 0.0)[0]                   # 4.E74
+    fy_untilted = gyk * _lateral_pure(p, fz, dfz, dpi, alpha_star, 0.0, shifts)[0]           # 4.E74
     scrub = r0 * (p.SSZ1 + p.SSZ2 * fy / fz0 + (p.SSZ3 + p.SSZ4 * dfz) * gamma_star) * p.LS  # 4.E76
     mz = -trail * fy_untilted + residual + scrub * fx                                        # 4.E71, 4.E72
 
@@ -228,7 +240,8 @@ def slip_stiffnesses(p, fz: float, gamma: float) -> tuple[float, float]:
     and inclination ``gamma`` [rad]."""
     _, dfz, dpi = _normalised(p, fz)
     gamma_star = math.sin(gamma)
-    return _longitudinal_pure(p, fz, dfz, dpi, 0.0, gamma_star)[1], _lateral_pure(p, fz, dfz, dpi, 0.0, gamma_star)[1]
+    return (_longitudinal_pure(p, fz, dfz, dpi, 0.0, gamma_star, 1.0)[1],
+            _lateral_pure(p, fz, dfz, dpi, 0.0, gamma_star, 1.0)[1])
 
 
 @nb.njit(cache=True)

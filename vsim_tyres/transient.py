@@ -21,7 +21,11 @@ import math
 
 import numba as nb
 
+from vsim_core.compiled_cache import follow
+from vsim_tyres import magic_formula
 from vsim_tyres.magic_formula import carcass_stiffnesses, slip_stiffnesses
+
+follow(__file__, magic_formula.__file__)
 
 #: Least relaxation length [m]: a tyre unloaded to zero has σ → 0; its slips then follow the
 #: kinematic ones within a step instead of dividing by zero.

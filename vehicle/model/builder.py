@@ -16,6 +16,9 @@ Topology (per side; the right side mirrors the left):
 * K&C rig (``rig=True``): under each wheel a pad slides vertically (driven by an
   ``equality/joint``) and carries a carriage free in x and y, tied to the wheel's contact point
   by a ``connect``; wheel hinges are locked (brakes on); the rack position is driven.
+* road (``road=True``): the body free, the wheels spinning on their hinges, the rack position
+  driven (the steering), a ground plane to look at; the tyres' forces come from
+  :mod:`vehicle.simulation.road` (MuJoCo's contacts stay off).
 
 Linear bushing directions live in the joints' ``stiffness``/``damping`` (implicit under
 ``integrator="discrete"``); the others (and any law with effects) get a reference stiffness in the
@@ -175,6 +178,11 @@ class _Builder:
     # -- the car -----------------------------------------------------------------------------
     def build(self) -> CarModel:
         v = self.v
+        if self.o.road and (self.o.rig or self.o.clamped):
+            raise ValueError("a car on the road is neither on the rig nor clamped")
+        if self.o.road:
+            self.spec.worldbody.add_geom(name="road", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0, 0, 1],
+                                         rgba=[0.45, 0.45, 0.45, 1], **_NO_COLLISION)
         chassis_rot = np.eye(3)
         chassis = self.body("world", "chassis", np.zeros(3), chassis_rot, v.body.mass, v.body.cg,
                             v.body.inertia)
@@ -204,7 +212,7 @@ class _Builder:
         self.body("chassis", "rack", centre, np.eye(3), f.masses["rack"], centre, [0.05, 1e-3, 0.05])
         self.bodies["rack"].add_joint(name="rack", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[0, 1, 0])
         self.capsule("rack", mirror(inner, 1), mirror(inner, -1), 0.015)
-        if self.o.rig:
+        if self.o.rig or self.o.road:
             self.drive("rack_drive", "rack")
 
     def front_corner(self, side: str, sign: float):
@@ -342,6 +350,8 @@ class _Builder:
         i_spin, i_diam = t.wheel_inertia
         self.body(parent, name, centre, rot, t.wheel_mass, centre, [i_diam, i_spin, i_diam])
         hinge = self.bodies[name].add_joint(name=f"spin_{corner}", type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 1, 0])
+        if self.o.road:  # the brake is the hinge's dry friction, as stiff as the closures (the default creeps)
+            hinge.solref_friction, hinge.solimp_friction = [2.0 * self.o.timestep, 1.0], list(CLOSURE_SOLIMP)
         self.bodies[name].add_geom(type=mujoco.mjtGeom.mjGEOM_CYLINDER, size=[t.radius, 0.095, 0],
                                    quat=_quat(frame_from(np.array([0, 1.0, 0]), np.array([1.0, 0, 0]))),
                                    rgba=[0.1, 0.1, 0.1, 0.6], **_NO_COLLISION)

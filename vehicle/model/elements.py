@@ -18,6 +18,7 @@ class BuildOptions:
 
     rig: bool = True                    #: add the K&C rig (pads, rack drive, wheel locks)
     clamped: bool = True                #: body fixed to the world; otherwise a free joint
+    road: bool = False                  #: on a flat road: free body, rack drive, ground plane (tyres: vehicle.simulation.road)
     bushing_model: str | None = None    #: read every named bushing set as this model
     rigid_bushings: bool = False        #: translations rigid (kinematics); rotations unchanged
     timestep: float = 1e-3              #: [s]

@@ -19,17 +19,22 @@ from pathlib import Path
 import mujoco
 import numba as nb
 import numpy as np
-from numba.core import caching
 
 from bushings import extended_bank as _xb
+from vsim_core.compiled_cache import follow
+from vsim_tyres import road_contact
+from vsim_tyres.road_contact import tyre_wrenches
 
-# coupling_step compiles the bushing kernels into itself: its cache must follow their files too
-caching.CacheImpl._locator_classes.insert(0, _xb.kernel_stamped_locator(__file__))
+# the loops compile the bushing kernels and the tyres into themselves: their cache follows those files
+follow(__file__, *_xb.KERNEL_FILES, *road_contact.TYRE_FILES)
 
 _LIB = ctypes.CDLL(str(next(Path(mujoco.__file__).parent.glob("libmujoco.so*"))))
 _mj_step = _LIB.mj_step
 _mj_step.argtypes = (ctypes.c_size_t, ctypes.c_size_t)  # mjModel*, mjData* as addresses
 _mj_step.restype = None
+_mj_step1, _mj_step2 = _LIB.mj_step1, _LIB.mj_step2   # positions and velocities, then forces and integration
+for _f in (_mj_step1, _mj_step2):
+    _f.argtypes, _f.restype = (ctypes.c_size_t, ctypes.c_size_t), None
 
 
 @nb.njit(cache=True)
@@ -136,6 +141,34 @@ def _run(mj_step, n, inputs, active, eq_data, pad_eq, rack_eq, xfrc, carriage, w
 def run(*args) -> None:
     """:func:`_run` with MuJoCo's ``mj_step``; ``args`` are the rest of its arguments, from ``n``."""
     _run(_mj_step, *args)
+
+
+@nb.njit(cache=True)
+def _run_road(mj_step1, mj_step2, n, inputs, eq_data, rack_eq, spin_dof, frictionloss, m_addr, d_addr, h, coupling,
+              tyres):
+    """Advance the car on the road ``n`` steps, row i of ``inputs`` set before step i (none if it has
+    no rows): the rack [m], the four wheels' drive torques [N·m] (order of CORNERS, positive
+    driving, reacting on the knuckle) and brake torques [N·m] (the spin joints' dry friction: it
+    holds a wheel still up to that torque). Each step: the coupling's forces, ``mj_step1`` (positions and
+    velocities), the tyres' wrenches from them (``tyres`` = the arguments of
+    :func:`vsim_tyres.road_contact.tyre_wrenches` after ``h``), ``mj_step2``: MuJoCo's split step,
+    bit-identical to ``mj_step``, so that the tyres see this step's state and not the last one's."""
+    qfrc = coupling[2]
+    for i in range(n):
+        coupling_step(h, *coupling)
+        if inputs.shape[0]:
+            eq_data[rack_eq, 0] = inputs[i, 0]
+            for c in range(4):
+                qfrc[spin_dof[c]] += inputs[i, 1 + c]
+                frictionloss[spin_dof[c]] = inputs[i, 5 + c]
+        mj_step1(m_addr, d_addr)
+        tyre_wrenches(tyres[0], tyres[1], h, *tyres[2:])
+        mj_step2(m_addr, d_addr)
+
+
+def run_road(*args) -> None:
+    """:func:`_run_road` with MuJoCo's ``mj_step1`` and ``mj_step2``; ``args`` from ``n``."""
+    _run_road(_mj_step1, _mj_step2, *args)
 
 
 def coupling_arrays(coupling) -> tuple:
