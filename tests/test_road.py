@@ -9,7 +9,10 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
+from vehicle.model.builder import build
 from vehicle.model.definition import CORNERS
+from vehicle.model.elements import BuildOptions
+from vehicle.model.statics import resolve_preloads
 from vehicle.model.vehicle_file import load_vehicle
 from vehicle.simulation.rig import KCRig
 from vehicle.simulation.road import RoadCar
@@ -83,3 +86,18 @@ def test_a_coasting_car_loses_energy_steadily_and_keeps_straight() -> None:
     assert 0.008 < resistance / weight < 0.02
     assert abs(car.data.qpos[1]) < 1e-3 and abs(car.data.qvel[5]) < 1e-3   # no drift nor yaw
     np.testing.assert_allclose(car.tyre_signals[:, VX], speed[-1], rtol=0.01)
+
+
+def test_the_road_mounting_is_the_rig_car_without_the_rig() -> None:
+    vehicle = resolve_preloads(load_vehicle(DEFAULT_VEHICLE))
+    road = build(vehicle, BuildOptions(rig=False, clamped=False, road=True)).model
+    rig = build(vehicle, BuildOptions()).model
+    name = lambda m, kind, i: mujoco.mj_id2name(m, kind, i)
+    bodies = lambda m: {name(m, mujoco.mjtObj.mjOBJ_BODY, i) for i in range(m.nbody)}
+    assert bodies(rig) - bodies(road) == {f"{part}_{c}" for part in ("pad", "carriage") for c in CORNERS}
+    assert bodies(road) <= bodies(rig)
+    assert mujoco.mj_name2id(road, mujoco.mjtObj.mjOBJ_EQUALITY, "rack_drive") >= 0
+    assert mujoco.mj_name2id(road, mujoco.mjtObj.mjOBJ_GEOM, "road") >= 0
+    assert road.jnt_type[0] == mujoco.mjtJoint.mjJNT_FREE
+    with pytest.raises(ValueError, match="neither on the rig nor clamped"):
+        build(vehicle, BuildOptions(road=True))

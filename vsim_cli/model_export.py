@@ -16,7 +16,9 @@ def _export(args: argparse.Namespace) -> int:
     from vsim_core.files import atomic_output
 
     vehicle = resolve_preloads(load_vehicle(args.vehicle))
-    car = build(vehicle, BuildOptions(rig=not args.road, clamped=not args.free, bushing_model=args.bushings))
+    options = (BuildOptions(rig=False, clamped=False, road=True, bushing_model=args.bushings) if args.road else
+               BuildOptions(rig=not args.bare, clamped=not args.free, bushing_model=args.bushings))
+    car = build(vehicle, options)
     with atomic_output(args.output) as tmp:
         tmp.write_text(car.xml())
     print(f"wrote {args.output}: {car.model.nbody - 1} bodies, {car.model.nv} DOF, "
@@ -31,6 +33,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     export.add_argument("-o", "--output", type=output_file, required=True, help="MJCF file to write")
     export.add_argument("--bushings", choices=BUSHING_MODELS, default=None,
                         help="read every bushing parameter set as this model")
-    export.add_argument("--road", action="store_true", help="without the K&C rig")
-    export.add_argument("--free", action="store_true", help="free body instead of clamped")
+    mounting = export.add_mutually_exclusive_group()
+    mounting.add_argument("--road", action="store_true", help="mounted on the road: free body, steered rack, "
+                                                              "ground plane (the tyres' forces are not in the MJCF)")
+    mounting.add_argument("--bare", action="store_true", help="without the K&C rig")
+    export.add_argument("--free", action="store_true", help="free body instead of clamped (on the rig or --bare)")
     export.set_defaults(func=_export)
