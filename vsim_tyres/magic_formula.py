@@ -111,11 +111,12 @@ def _normalised(p, fz: float) -> tuple[float, float, float]:
     return fz0, (fz - fz0) / fz0, (p.INFLPRES - p.NOMPRES) / p.NOMPRES
 
 
-@nb.njit(cache=True, inline="always")
-def _shift_scale(p, vx: float) -> float:
-    """MF-Tyre's low-speed reduction of the shifts S_Hx, S_Vx, S_Hy, S_Vy: 1 from ``VXLOW`` up, down
-    to 0 at rest along a half cosine, so that a tyre standing still without slip pushes nowhere
-    (no camber thrust, conicity or ply steer at rest)."""
+@nb.njit(cache=True)
+def low_speed_ramp(p, vx: float) -> float:
+    """MF-Tyre's low-speed weighting: 0 at rest, 1 from ``VXLOW`` up, a half cosine between
+    (continuous in value and slope). It scales the shifts S_Hx, S_Vx, S_Hy, S_Vy, so that a tyre
+    standing still without slip pushes nowhere (no camber thrust, conicity or ply steer at rest);
+    one minus it weights the low-speed damping (:func:`vsim_tyres.transient.low_speed_damping`)."""
     speed = abs(vx)
     return 1.0 if speed >= p.VXLOW else 0.5 * (1.0 - math.cos(math.pi * speed / p.VXLOW))
 
@@ -172,7 +173,7 @@ def forces(p, fz: float, kappa: float, alpha: float, gamma: float, vx: float):
     vertical load ``fz`` [N], longitudinal slip ``kappa``, slip angle ``alpha`` and inclination
     ``gamma`` [rad], forward speed ``vx`` [m/s]. The tyre rolls forward: the book's sgn(V_cx) factors
     are +1 (a car at rest holds through the transient slips' deflections, not through the sign of a
-    vanishing speed). Below ``VXLOW`` the curves' shifts fade out (:func:`_shift_scale`) and the
+    vanishing speed). Below ``VXLOW`` the curves' shifts fade out (:func:`low_speed_ramp`) and the
     rolling resistance, which opposes ``vx``, fades linearly to zero, so that a wheel at rest is not
     pushed. A tyre off the ground (``fz ≤ 0``) gives zeros."""
     if fz <= 0.0:
@@ -182,7 +183,7 @@ def forces(p, fz: float, kappa: float, alpha: float, gamma: float, vx: float):
     gamma_star = math.sin(gamma)                                                             # 4.E4
     cos_alpha = math.cos(alpha)                                                              # 4.E6 (V_cx/V_c)
     g2 = gamma_star * gamma_star
-    shifts = _shift_scale(p, vx)
+    shifts = low_speed_ramp(p, vx)
     fx0, kxk = _longitudinal_pure(p, fz, dfz, dpi, kappa, gamma_star, shifts)
     fy0, kya, muy, by, cy, shy, svy = _lateral_pure(p, fz, dfz, dpi, alpha_star, gamma_star, shifts)
     kya_prime = kya + _EPS * _nonzero_sign(kya)                                              # 4.E39

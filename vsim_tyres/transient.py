@@ -23,7 +23,7 @@ import numba as nb
 
 from vsim_core.compiled_cache import follow
 from vsim_tyres import magic_formula
-from vsim_tyres.magic_formula import carcass_stiffnesses, slip_stiffnesses
+from vsim_tyres.magic_formula import carcass_stiffnesses, low_speed_ramp, slip_stiffnesses
 
 follow(__file__, magic_formula.__file__)
 
@@ -57,10 +57,9 @@ def lag(q: float, slip_velocity: float, vx: float, sigma: float, h: float) -> fl
 def low_speed_damping(p, fz: float, vx: float) -> tuple[float, float]:
     """Damping coefficients [N·s/m] of the longitudinal and lateral sliding velocities at forward
     speed ``vx`` [m/s]: ``DAMP_VLOW`` times the carcass stiffnesses at rest, fading to zero at
-    ``VXLOW`` along a half cosine (continuous in value and slope)."""
-    speed = abs(vx)
-    if speed >= p.VXLOW:
+    ``VXLOW`` as one minus the shifts' low-speed ramp."""
+    weight = 1.0 - low_speed_ramp(p, vx)
+    if weight == 0.0:
         return 0.0, 0.0
-    weight = 0.5 * (1.0 + math.cos(math.pi * speed / p.VXLOW))
     cx, cy = carcass_stiffnesses(p, max(fz, 0.0))
     return weight * p.DAMP_VLOW * cx, weight * p.DAMP_VLOW * cy

@@ -70,6 +70,13 @@ class CarModel:
         """The MJCF of the model."""
         return self.spec.to_xml()
 
+    def body_point(self, data: mujoco.MjData, point) -> np.ndarray:
+        """World position [m] at ``data``'s state (its kinematics recomputed) of a point given in the
+        body's design frame."""
+        mujoco.mj_kinematics(self.model, data)
+        chassis = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, "chassis")
+        return data.xpos[chassis] + data.xmat[chassis].reshape(3, 3) @ np.asarray(point, float)
+
 
 def _quat(rot: np.ndarray) -> np.ndarray:
     q = np.zeros(4)

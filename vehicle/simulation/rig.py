@@ -176,11 +176,7 @@ class KCRig:
 
     def ride_height(self) -> float:
         """Height of the body's ride-height point above the ground (pads at zero) [m]."""
-        m, d = self.model, self.data
-        mujoco.mj_kinematics(m, d)
-        body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "chassis")
-        point = d.xpos[body] + d.xmat[body].reshape(3, 3) @ np.asarray(self.vehicle.body.ride_height_point)
-        return float(point[2])
+        return float(self.car.body_point(self.data, self.vehicle.body.ride_height_point)[2])
 
     def _closure_error(self, first_rows: np.ndarray) -> float:
         """Largest position error of the loop closures [m] (connect, weld position, tie-rod length),

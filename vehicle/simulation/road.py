@@ -24,12 +24,13 @@ from vehicle.simulation import stepping
 from vehicle.simulation.coupling import ForceCoupling
 from vsim_core.shipped import DEFAULT_TYRE
 from vsim_tyres import magic_formula
-from vsim_tyres.road_contact import N_SIGNALS, N_STATE, effective_rolling_radius, mirrored_wheels
+from vsim_tyres.road_contact import N_SIGNALS, N_STATE, SIGNALS, effective_rolling_radius, mirrored_wheels
 from vsim_tyres.tir_file import read_tir
 
 #: Columns of a row of road inputs: the rack, the four drive torques, the four brake torques.
 N_INPUTS = 9
 _NO_INPUTS = np.zeros((0, N_INPUTS))
+_DEFLECTION = SIGNALS.index("deflection_m")
 
 
 class RoadCar:
@@ -57,17 +58,18 @@ class RoadCar:
         #: Lagged slips (κ', tan α') of each wheel and its signals (vsim_tyres.road_contact.SIGNALS).
         self.tyre_state = np.zeros((len(CORNERS), N_STATE))
         self.tyre_signals = np.zeros((len(CORNERS), N_SIGNALS))
+        d = self.data   # views of MuJoCo's memory: the tyres' arguments hold for the car's life
+        self._tyre_args = (self.tyres, self.mirrored, self.wheel_body, d.xipos, d.xmat, d.cvel, d.subtree_com,
+                           m.body_rootid.astype(np.int64), self.tyre_state, d.xfrc_applied, self.tyre_signals)
         self.stepping_s = 0.0
         self._run(0, _NO_INPUTS)
         self.stepping_s = 0.0
 
     def _run(self, n: int, inputs: np.ndarray) -> None:
         m, d = self.model, self.data
-        tyres = (self.tyres, self.mirrored, self.wheel_body, d.xipos, d.xmat, d.cvel, d.subtree_com,
-                 m.body_rootid.astype(np.int64), self.tyre_state, d.xfrc_applied, self.tyre_signals)
         started = time.perf_counter()
         stepping.run_road(n, inputs, m.eq_data, self.rack_eq, self.spin_dof, m.dof_frictionloss, m._address, d._address,
-                          m.opt.timestep, self.coupling.kernel_arrays(), tyres)
+                          m.opt.timestep, self.coupling.kernel_arrays(), self._tyre_args)
         self.stepping_s += time.perf_counter() - started
         b = self.coupling.bushings
         if b.bank is not None:
@@ -94,19 +96,11 @@ class RoadCar:
         d = self.data
         d.qvel[self.chassis_dof] = speed
         for k, dof in enumerate(self.spin_dof):
-            deflection = self.tyre_signals[k, 9]
-            d.qvel[dof] = speed / effective_rolling_radius(self.tyres[k], deflection)
-
-    def body_point(self, point) -> np.ndarray:
-        """World position [m] of a point given in the body's design frame."""
-        m, d = self.model, self.data
-        mujoco.mj_kinematics(m, d)
-        chassis = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "chassis")
-        return d.xpos[chassis] + d.xmat[chassis].reshape(3, 3) @ np.asarray(point, float)
+            d.qvel[dof] = speed / effective_rolling_radius(self.tyres[k], self.tyre_signals[k, _DEFLECTION])
 
     def ride_height(self) -> float:
         """Height of the body's ride-height point above the road [m]."""
-        return float(self.body_point(self.vehicle.body.ride_height_point)[2])
+        return float(self.car.body_point(self.data, self.vehicle.body.ride_height_point)[2])
 
     def energy(self) -> float:
         """Kinetic energy of every body plus the potential energy of gravity and of the joints' and
