@@ -57,6 +57,8 @@ def test_the_car_settles_where_the_rig_statics_and_the_tyres_put_it() -> None:
     share = (x_point - x_rear) / (x_front - x_rear)
     expected = design + share * drop[:2].mean() + (1 - share) * drop[2:].mean()
     assert car.ride_height() == pytest.approx(expected, abs=2e-3)
+    # the vehicle file's loaded radius is its tyre's: the car stands at its design ride height
+    assert car.ride_height() == pytest.approx(design, abs=2e-3)
     assert abs(centres[0, 1] + centres[1, 1]) < 1e-5 and abs(centres[2, 1] + centres[3, 1]) < 1e-5   # symmetric
 
 

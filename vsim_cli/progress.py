@@ -6,7 +6,7 @@ import sys
 import time
 from typing import TextIO
 
-from vehicle.scenarios.schedule import PHASES, Progress
+from vehicle.scenarios.schedule import Progress
 
 
 class ProgressBar:
@@ -28,7 +28,7 @@ class ProgressBar:
         stage = (p.case, p.phase)
         if not self.live:
             if stage != self.last_stage:
-                print(f"case {p.case}/{p.cases} {p.label}: {PHASES[p.phase]}", file=self.stream, flush=True)
+                print(f"case {p.case}/{p.cases} {p.label}: {p.phase_name}", file=self.stream, flush=True)
             self.last_stage = stage
             return
         if now - self.shown_at < self.interval_s and stage == self.last_stage:
@@ -39,7 +39,7 @@ class ProgressBar:
         elapsed = now - self.started
         remaining = f"~{elapsed * (1.0 - fraction) / fraction:.0f} s" if fraction > 0.01 else "?"
         line = (f"\r[{'#' * filled}{'.' * (self.width - filled)}] {100 * fraction:3.0f}%  "
-                f"case {p.case}/{p.cases} {p.label} ({PHASES[p.phase]})  "
+                f"case {p.case}/{p.cases} {p.label} ({p.phase_name})  "
                 f"sim {p.done_s:.1f}/{p.total_s:.1f} s  wall {elapsed:.0f} s, {remaining} left")
         self.stream.write(line + "\x1b[K")
         self.stream.flush()

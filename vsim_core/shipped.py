@@ -35,21 +35,22 @@ SCENARIO_DIR = SHIPPED_ROOT / "scenarios"
 KC_SCENARIO_DIR = SCENARIO_DIR / "kc"
 
 
-def built_in(folder: Path) -> list[str]:
-    """The names of the YAML files shipped in ``folder`` (``kc/pumping`` for a file in a subfolder)."""
-    return sorted(p.relative_to(folder).with_suffix("").as_posix() for p in folder.rglob("*.yaml"))
+def built_in(folder: Path, suffix: str = ".yaml") -> list[str]:
+    """The names of the ``suffix`` files shipped in ``folder`` (``kc/pumping`` for a file in a subfolder)."""
+    return sorted(p.relative_to(folder).with_suffix("").as_posix() for p in folder.rglob(f"*{suffix}"))
 
 
-def resolve(name_or_path: str | Path, folder: Path, what: str, base: Path | None = None) -> Path:
+def resolve(name_or_path: str | Path, folder: Path, what: str, base: Path | None = None,
+            suffix: str = ".yaml") -> Path:
     """``name_or_path`` if it is a file (a relative path taken from ``base``, default the working
-    folder); else the built-in ``folder/<name>.yaml`` of that name; else InputError naming the path
-    and listing the built-in ones (``what``: what one of them is, e.g. ``scenario``)."""
+    folder); else the built-in ``folder/<name><suffix>`` of that name; else InputError naming the
+    path and listing the built-in ones (``what``: what one of them is, e.g. ``scenario``)."""
     path = Path(name_or_path)
     path = base / path if base is not None and not path.is_absolute() else path
     if is_file(path):
         return path
-    named = folder / f"{name_or_path}.yaml"
+    named = folder / f"{name_or_path}{suffix}"
     if path.suffix == "" and is_file(named) and folder.resolve() in named.resolve().parents:
         return named
     raise InputError(f"no such {what} file, and no built-in one of that name; built-in ones: "
-                     f"{', '.join(built_in(folder))}", source=str(path))
+                     f"{', '.join(built_in(folder, suffix))}", source=str(path))

@@ -17,18 +17,19 @@ _SIZES: dict[str, tuple[str, float]] = {
     **{f"{prefix}N{dot}m": ("torque", size) for prefix, size in (("", 1.0), ("da", 10.0), ("k", 1e3))
        for dot in ("·", ".", "")},
     "s": ("time", 1.0), "ms": ("time", 1e-3),
+    "km/h": ("speed", 1.0), "m/s": ("speed", 3.6),
 }
 #: The largest magnitude a measured or commanded value may take, per dimension, in SI: far beyond a
 #: car on a K&C rig or a part on a bushing bench, far below what a unit or typing error gives.
-_PLAUSIBLE_SI = {"length": 10.0, "angle": 2.0 * math.pi, "force": 1e7, "torque": 1e6, "time": 1e6}
+_PLAUSIBLE_SI = {"length": 10.0, "angle": 2.0 * math.pi, "force": 1e7, "torque": 1e6, "time": 1e6, "speed": 100.0}
 #: The SI unit of each dimension.
-SI_UNIT = {"length": "m", "angle": "rad", "force": "N", "torque": "N·m", "time": "s"}
+SI_UNIT = {"length": "m", "angle": "rad", "force": "N", "torque": "N·m", "time": "s", "speed": "m/s"}
 #: Every unit known, in the table's order.
 UNITS = tuple(_SIZES)
 
 
 def dimension(unit: str) -> str:
-    """``length``, ``angle``, ``force``, ``torque`` or ``time``; KeyError for an unknown unit."""
+    """``length``, ``angle``, ``force``, ``torque``, ``time`` or ``speed``; KeyError for an unknown unit."""
     return _SIZES[unit][0]
 
 

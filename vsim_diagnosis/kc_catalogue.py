@@ -26,6 +26,7 @@ from vehicle.model.vehicle_file import with_extensions
 from vsim_core.documents import Document, dump_yaml
 from vsim_core.errors import InputError
 from vsim_core.units import DEG_PER_RAD, MM_PER_M
+from vsim_core.shipped import TYRE_DIR
 from vsim_diagnosis.catalogue import CAUSES, Entry, Parameter, draw_parameters
 
 #: Bushing causes at the K&C level (see the module docstring for self_heating).
@@ -231,6 +232,9 @@ def extended_vehicle_yaml(baseline: VehicleDefinition, hypotheses: list[Hypothes
             law = direction_law(extended, name, direction)
             entries[name]["directions"][direction] = {"model": law.model, "params": _plain(law.values),
                                                       **({"effects": _plain(law.effects)} if law.effects else {})}
+    tyre = baseline.tyre.property_file
+    if tyre is not None and tyre.resolve().parent != TYRE_DIR.resolve():
+        data["tyre"]["property_file"] = str(tyre.resolve())   # the extended file is written elsewhere
     header = "".join(f"# {line}\n" for line in note.splitlines())
     return header + dump_yaml(data, sort_keys=False, allow_unicode=True)
 

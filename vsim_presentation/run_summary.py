@@ -1,4 +1,5 @@
-"""The text summary of a recorded run (`vsim run`): the centre-line gradients and loop widths of
+"""The text summary of a recorded run (`vsim run`): on the road, the ISO 7401 / 4138 metrics of each
+case (:mod:`vsim_analysis.road_metrics`); on the rig, the centre-line gradients and loop widths of
 camber, toe and half-track on each case's last cycle and the named K&C metrics of `vsim kc` per case
 and axle (periodic inputs, :mod:`vsim_analysis.run_metrics`), the toe drift over the final hold
 (rack steps), and the peak deflection of every bushing during the inputs."""
@@ -8,8 +9,23 @@ from __future__ import annotations
 import numpy as np
 
 from vsim_analysis.kc_metrics import BUMP_WINDOW_M, FIT_FRACTION, METRICS
-from vsim_analysis.run_metrics import (case_loop, case_mask, case_relaxation, cases, gradient_unit, loop_axes,
-                                       run_metrics)
+from vsim_analysis.road_metrics import METRICS as ROAD_METRICS
+from vsim_analysis.road_metrics import (
+    RESPONSES,
+    bandwidth_hz,
+    input_phase,
+    is_road,
+    road_metrics,
+)
+from vsim_analysis.run_metrics import (
+    case_loop,
+    case_mask,
+    case_relaxation,
+    cases,
+    gradient_unit,
+    loop_axes,
+    run_metrics,
+)
 from vsim_recordings.run_format import Run
 
 SUMMARY_CORNERS = {"front": "fl", "rear": "rl"}   #: the left wheel of each axle is summarised
@@ -71,8 +87,28 @@ def _drift_table(run: Run) -> list[str]:
     return rows
 
 
+def _road_table(run: Run) -> list[str]:
+    metrics = road_metrics(run)
+    if not metrics:
+        return ["road metrics: no case finished"]
+    labels = {case["case"]: case["label"][:16] for case in cases(run)}
+    known = [(k, unit) for k, unit, _ in ROAD_METRICS] + [(f"second_{k}", unit) for k, unit, _ in ROAD_METRICS]
+    rows = ["road metrics (ISO 7401 / ISO 4138 definitions; `vsim_analysis.road_metrics`):",
+            f"  {'metric':<54} {'unit':<9}" + "".join(f" {labels[k]:>16}" for k in metrics)]
+    for key, unit in known:
+        if any(key in m for m in metrics.values()):
+            rows.append(f"  {key:<54} {unit:<9}" + "".join(f" {m[key]:16.5g}" if key in m else f" {'-':>16}"
+                                                           for m in metrics.values()))
+    if run.metadata.extra["type"] == "sine_steer":
+        for response in RESPONSES:
+            f = bandwidth_hz(metrics, response)
+            rows.append(f"  {response} bandwidth (45 deg phase lag): " + (f"{f:.3f} Hz" if f is not None else
+                                                                          "beyond the frequencies run"))
+    return rows
+
+
 def _peak_table(run: Run) -> list[str]:
-    inputs = run.signals["phase"] == 2
+    inputs = run.signals["phase"] == input_phase(run)
     bushings = sorted({s.group.removeprefix("bushing_") for s in run.specs if s.group.startswith("bushing_")})
     rows = ["peak bushing deflections during the inputs (|x|, |y|, |z| [mm]; |rx|, |ry|, |rz| [deg]):",
             f"  {'bushing':<20}" + "".join(f"{d:>8}" for d in _DIRECTIONS)]
@@ -92,7 +128,9 @@ def summary(run: Run) -> str:
     if extra["duration_scale"] != 1.0:
         lines.append(f"durations scaled by {extra['duration_scale']:g}: rates differ from the scenario's, "
                      f"and so do rate-dependent loops")
-    if extra["x_quantity"] is not None:
+    if is_road(run):
+        lines += _road_table(run)
+    elif extra["x_quantity"] is not None:
         lines += _loop_table(run) + _kc_table(run)
     else:
         lines += _drift_table(run)

@@ -1,5 +1,5 @@
-"""Recording a scenario run: played on the rig (:class:`vehicle.simulation.runner.ScenarioRun`) and
-written sample by sample into one MCAP run file (:func:`run_scenario`), or kept in memory as the
+"""Recording a scenario run: played on the rig (:class:`vehicle.simulation.runner.ScenarioRun`) or on
+the road (:class:`vehicle.simulation.road_runner.RoadRun`) and written sample by sample into one MCAP run file (:func:`run_scenario`), or kept in memory as the
 same :class:`vsim_recordings.run_format.Run` without the body poses (:func:`simulate`).
 
 The file is closed and marked incomplete when the run stops early: divergence, Ctrl-C or any other
@@ -18,13 +18,18 @@ import mujoco
 import numpy as np
 
 from vehicle.model.definition import VehicleDefinition
+from vehicle.model.elements import BuildOptions
 from vehicle.model.vehicle_file import load_vehicle
+from vehicle.scenarios.road_scenario import RoadScenario
 from vehicle.scenarios.scenario import Scenario
 from vehicle.scenarios.schedule import Progress
 from vehicle.simulation.rig import KCRig
+from vehicle.simulation.mounted import MountedCar
+from vehicle.simulation.road_runner import RoadRun
 from vehicle.simulation.runner import ScenarioRun
+from vsim_recordings.road_signals import RoadSignalLayout
 from vsim_recordings.run_format import GeomSpec, Run, RunMetadata, rotation_matrix
-from vsim_recordings.run_signals import SignalLayout, run_metadata
+from vsim_recordings.run_signals import SignalLayout, road_facts, run_metadata
 from vsim_recordings.run_writer import RunWriter
 
 
@@ -55,11 +60,25 @@ def layout_of(rig: KCRig, x_quantity: str | None) -> SignalLayout:
                         [e.name for e in c.dampers])
 
 
-def _metadata(play: ScenarioRun) -> RunMetadata:
-    return run_metadata(play.scenario, play.plan, play.duration_scale, play.dt, play.rig.car.channels)
+def _play(scenario: Scenario | RoadScenario, vehicle: VehicleDefinition, duration_scale: float,
+          progress: Callable[[Progress], None] | None, timestep_s: float = BuildOptions.timestep
+          ) -> tuple[ScenarioRun | RoadRun, MountedCar, SignalLayout | RoadSignalLayout, RunMetadata]:
+    """The run of ``scenario`` on ``vehicle`` (on the rig or on the road, as its type says), its car,
+    the signals it records and its metadata."""
+    if isinstance(scenario, RoadScenario):
+        play = RoadRun(scenario, vehicle, duration_scale, progress, timestep_s)
+        car, c = play.car, play.car.coupling
+        layout = RoadSignalLayout([ch.name for ch in car.car.channels], [e.name for e in c.springs],
+                                  [e.name for e in c.dampers])
+        road = road_facts(car.steering_ratio, car.wheelbase, car.tyre_file)
+    else:
+        play = ScenarioRun(scenario, vehicle, duration_scale, progress, timestep_s)
+        car, layout, road = play.car, layout_of(play.car, scenario.x_quantity), None
+    metadata = run_metadata(scenario, play.plan, duration_scale, play.dt, car.car.channels, road)
+    return play, car, layout, metadata
 
 
-def run_scenario(scenario: Scenario, output: Path, *, bushing_model: str | None = None, overwrite: bool = False,
+def run_scenario(scenario: Scenario | RoadScenario, output: Path, *, bushing_model: str | None = None, overwrite: bool = False,
                  duration_scale: float = 1.0, progress: Callable[[Progress], None] | None = None) -> RunResult:
     """Run every case of ``scenario`` and record them in ``output`` (one MCAP file).
 
@@ -71,13 +90,11 @@ def run_scenario(scenario: Scenario, output: Path, *, bushing_model: str | None 
     if bushing_model is not None:
         scenario = replace(scenario, bushing_model=bushing_model)
     started = time.perf_counter()
-    play = ScenarioRun(scenario, load_vehicle(scenario.vehicle), duration_scale, progress)
-    layout = layout_of(play.rig, scenario.x_quantity)
+    play, car, layout, metadata = _play(scenario, load_vehicle(scenario.vehicle), duration_scale, progress)
     output.parent.mkdir(parents=True, exist_ok=True)
     bodies = play.bodies()
-    metadata = _metadata(play)
     times_ns, rows = [], []
-    with RunWriter(output, signals=layout.specs, bodies=bodies, geometry=geometry_from_model(play.rig.model, bodies),
+    with RunWriter(output, signals=layout.specs, bodies=bodies, geometry=geometry_from_model(car.model, bodies),
                    metadata=metadata, overwrite=overwrite) as writer:
         with closing(play.samples()) as samples:  # leaves the rig's context at once if writing fails
             for s in samples:
@@ -90,29 +107,27 @@ def run_scenario(scenario: Scenario, output: Path, *, bushing_model: str | None 
     return RunResult(output, play.total_s, time.perf_counter() - started, play.stepping_s, run)
 
 
-def simulate(scenario: Scenario, vehicle: VehicleDefinition | None = None, *, duration_scale: float = 1.0,
-             progress: Callable[[Progress], None] | None = None) -> Run:
+def simulate(scenario: Scenario | RoadScenario, vehicle: VehicleDefinition | None = None, *, duration_scale: float = 1.0,
+             progress: Callable[[Progress], None] | None = None, timestep_s: float = BuildOptions.timestep) -> Run:
     """Run every case of ``scenario`` on ``vehicle`` (default: the scenario's file) in memory.
 
     The result is the :class:`Run` that :func:`run_scenario` would record, without the body poses:
     the same signals, units and metadata (``vehicle_yaml`` empty when ``vehicle`` was given, as it
-    need not come from a file).
+    need not come from a file); ``timestep_s`` the car's time step.
     """
-    play = ScenarioRun(scenario, load_vehicle(scenario.vehicle) if vehicle is None else vehicle, duration_scale,
-                       progress)
-    layout = layout_of(play.rig, scenario.x_quantity)
+    play, _, layout, metadata = _play(scenario, load_vehicle(scenario.vehicle) if vehicle is None else vehicle,
+                                      duration_scale, progress, timestep_s)
     times, rows = [], []
     with closing(play.samples()) as samples:
         for s in samples:
             times.append(s.time_s)
             rows.append(layout.values(s))
-    metadata = _metadata(play)
     if vehicle is not None:
         metadata = replace(metadata, vehicle_yaml="", extra={**metadata.extra, "vehicle_file": "(in memory)"})
     return _in_memory(Path("(in memory)"), np.array(times), rows, layout, metadata)
 
 
-def _in_memory(path: Path, t_s: np.ndarray, rows: list[np.ndarray], layout: SignalLayout,
+def _in_memory(path: Path, t_s: np.ndarray, rows: list[np.ndarray], layout: SignalLayout | RoadSignalLayout,
                metadata: RunMetadata) -> Run:
     """A complete :class:`Run` of the samples' ``rows`` (one per time in ``t_s``), without body poses."""
     specs = layout.specs

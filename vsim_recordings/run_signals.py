@@ -13,17 +13,20 @@ bushings-on, input-start and end times) tell the cases apart.
 from __future__ import annotations
 
 from dataclasses import asdict
-from typing import Sequence
+from pathlib import Path
+from typing import Any, Mapping, Sequence
 
 import numpy as np
 
 from vehicle.model.definition import CORNERS, is_rotation
 from vehicle.model.elements import Channel
 from vehicle.scenarios.channels import CORNER_TAGS, INPUT_CHANNELS, input_quantity
+from vehicle.scenarios.road_scenario import RoadScenario
 from vehicle.scenarios.scenario import Scenario
 from vehicle.scenarios.schedule import CaseSchedule
-from vehicle.simulation.outputs import Sample
+from vehicle.simulation.outputs import RoadSample, Sample
 from vsim_core import units
+from vsim_core.files import read_text
 from vsim_core.units import DEG_PER_RAD, MM_PER_M
 from vsim_core.provenance import git_revision, software_version
 from vsim_recordings.run_format import RunMetadata, SignalSpec
@@ -53,11 +56,35 @@ class SignalLayout:
         specs += [SignalSpec(f"pad_fz_{t}", "N", "pads") for t in _TAGS]
         self.input_scale = np.array([units.per_si(INPUT_UNITS[input_quantity(ch)]) for ch in INPUT_CHANNELS])
         specs += [SignalSpec(ch, INPUT_UNITS[input_quantity(ch)], "inputs") for ch in INPUT_CHANNELS]
-        self.springs = list(springs)
-        self.dampers = list(dampers)
-        specs += [SignalSpec(f"{n}_force", "N", "springs") for n in self.springs]
+        self.suspension = SuspensionSignals(bushings, springs, dampers)
+        self.specs = specs + self.suspension.specs
+
+    def values(self, s: Sample) -> np.ndarray:
+        """One sample's values, in the recorded units and the order of :attr:`specs`."""
+        o = s.outputs
+        w = [o.wheels[c] for c in CORNERS]
+        centre = np.array([x.wheel_centre for x in w])
+        return np.concatenate([
+            (centre[:, 2] - s.design_centre_z) * MM_PER_M,
+            [x.camber * DEG_PER_RAD for x in w], [x.toe * DEG_PER_RAD for x in w],
+            [x.half_track * MM_PER_M for x in w], [x.steer * DEG_PER_RAD for x in w],
+            centre.ravel() * MM_PER_M,
+            [x.pad_height * MM_PER_M for x in w], [x.pad_force[2] for x in w],
+            s.inputs * self.input_scale,
+            self.suspension.values(s),
+        ])
+
+
+class SuspensionSignals:
+    """The signals every run of the car records, on the rig or on the road, after its own: each
+    named spring's and damper's force, each bushing direction's (``"<bushing>.<direction>"``)
+    deflection and force (one group per bushing), then case, phase, time since the input started
+    and the loop-closure error."""
+
+    def __init__(self, bushings: Sequence[str] = (), springs: Sequence[str] = (), dampers: Sequence[str] = ()):
+        self.springs, self.dampers, self.bushings = list(springs), list(dampers), list(bushings)
+        specs = [SignalSpec(f"{n}_force", "N", "springs") for n in self.springs]
         specs += [SignalSpec(f"{n}_force", "N", "dampers") for n in self.dampers]
-        self.bushings = list(bushings)
         rotation = np.array([is_rotation(n) for n in self.bushings])
         self.deflection_scale = np.where(rotation, DEG_PER_RAD, MM_PER_M)
         for name, rot in zip(self.bushings, rotation):
@@ -69,35 +96,32 @@ class SignalLayout:
                   SignalSpec("input_time", "s", "run"), SignalSpec("closure_error", "mm", "run")]
         self.specs = specs
 
-    def values(self, s: Sample) -> np.ndarray:
-        """One sample's values, in the recorded units and the order of :attr:`specs`."""
+    def values(self, s: Sample | RoadSample) -> np.ndarray:
+        """Their values at sample ``s``, in the recorded units and the order of :attr:`specs`."""
         o = s.outputs
-        w = [o.wheels[c] for c in CORNERS]
-        centre = np.array([x.wheel_centre for x in w])
         bushing = np.column_stack([o.bushing_deflection * self.deflection_scale, o.bushing_force]).ravel()
-        return np.concatenate([
-            (centre[:, 2] - s.design_centre_z) * MM_PER_M,
-            [x.camber * DEG_PER_RAD for x in w], [x.toe * DEG_PER_RAD for x in w],
-            [x.half_track * MM_PER_M for x in w], [x.steer * DEG_PER_RAD for x in w],
-            centre.ravel() * MM_PER_M,
-            [x.pad_height * MM_PER_M for x in w], [x.pad_force[2] for x in w],
-            s.inputs * self.input_scale,
-            [o.spring_force[n] for n in self.springs], [o.damper_force[n] for n in self.dampers],
-            bushing,
-            [s.case, s.phase, s.input_time_s, o.closure_error * MM_PER_M],
-        ])
+        return np.concatenate([[o.spring_force[n] for n in self.springs], [o.damper_force[n] for n in self.dampers],
+                               bushing, [s.case, s.phase, s.input_time_s, o.closure_error * MM_PER_M]])
 
 
-def run_metadata(scenario: Scenario, plan: list[CaseSchedule], duration_scale: float, dt: float,
-                 channels: Sequence[Channel] | None = None) -> RunMetadata:
+def road_facts(steering_ratio: float, wheelbase_m: float, tyre_file: Path) -> dict[str, Any]:
+    """What a road run's metadata says of its car besides the vehicle file: the kinematic overall
+    steering ratio, the wheelbase [m], and the tyre's property file, path and text."""
+    return {"steering_ratio": steering_ratio, "wheelbase_m": wheelbase_m, "tyre_file": str(tyre_file),
+            "tyre_tir": read_text(tyre_file)}
+
+
+def run_metadata(scenario: Scenario | RoadScenario, plan: list[CaseSchedule], duration_scale: float, dt: float,
+                 channels: Sequence[Channel] | None = None, road: Mapping[str, Any] | None = None) -> RunMetadata:
     """The metadata of a run of ``scenario``: the scenario, the schedule of its cases, and (for a
-    simulated run, its bushing ``channels`` given) the vehicle and bushing parameters; software
-    version and revision."""
+    simulated run, its bushing ``channels`` given) the vehicle and bushing parameters; on the road,
+    the throttle and the facts of the car ``road`` gives (:func:`road_facts`); software version
+    and revision."""
     cases = []
     for k, (case, s) in enumerate(zip(scenario.cases, plan), start=1):
         entry = {"case": k, "label": case.label, "parameters": dict(case.parameters), "cycles": case.cycles,
                  "start_s": s.start_s, "bushings_on_s": s.phase_start_s(1, dt),
-                 "input_start_s": s.phase_start_s(2, dt), "end_s": s.end_s(dt)}
+                 "input_start_s": s.phase_start_s(len(s.steps) - 1, dt), "end_s": s.end_s(dt)}
         w = case.waveform
         if w is not None and not w.sines and len(w.values) > 2 and w.values[-1] == w.values[-2]:
             entry["hold_from_s"] = entry["input_start_s"] + w.times_s[-2] * duration_scale  # the final hold
@@ -105,6 +129,8 @@ def run_metadata(scenario: Scenario, plan: list[CaseSchedule], duration_scale: f
     simulated = channels is not None
     model = {"vehicle_file": str(scenario.vehicle),
              "bushing_model": scenario.bushing_model or "as in the vehicle file"} if simulated else {}
+    if isinstance(scenario, RoadScenario):
+        model |= {"throttle": scenario.throttle, **(road or {})}
     return RunMetadata(
         scenario_yaml=scenario.text,
         vehicle_yaml=scenario.vehicle.read_text() if simulated else "",
@@ -113,8 +139,8 @@ def run_metadata(scenario: Scenario, plan: list[CaseSchedule], duration_scale: f
         software_version=software_version(),
         git_revision=git_revision(),
         extra={"scenario": scenario.name, "type": scenario.type, "description": scenario.description,
-               "scenario_file": str(scenario.path), **model, "axles": list(scenario.axles),
-               "x_quantity": scenario.x_quantity, "duration_scale": duration_scale,
+               "scenario_file": str(scenario.path), **model, "axles": list(getattr(scenario, "axles", ())),
+               "x_quantity": getattr(scenario, "x_quantity", None), "duration_scale": duration_scale,
                "output_rate_hz": scenario.output_rate_hz, "timestep_s": dt,
                "limits": asdict(scenario.limits), "settle": asdict(scenario.settle), "cases": cases},
         source="simulation" if simulated else "rig",

@@ -195,11 +195,12 @@ class BushingDef:
 
 @dataclass(frozen=True)
 class Tyre:
-    """The wheel and tyre: loaded radius and the wheel's mass and inertia."""
+    """The wheel and tyre: loaded radius, the wheel's mass and inertia, the tyre's property file."""
 
-    radius: float                        #: loaded radius [m]
+    radius: float                        #: loaded radius at design [m] (the rig's contact points)
     wheel_mass: float                    #: [kg]
     wheel_inertia: tuple[float, float]   #: about the spin axis and a diameter [kg·m²]
+    property_file: Path | None = None    #: the tyre's .tir file (the road needs one), or None
 
 
 @dataclass(frozen=True)

@@ -118,3 +118,14 @@ def rear_heave(v: VehicleDefinition, travel: float) -> CornerState:
     m = arm(angle)
     toe, camber = wheel_angles(m.rot @ spin)
     return CornerState(travel, {"arm": m}, 0.0, toe, camber, m(hp["wheel_centre"]))
+
+
+def steering_ratio(v: VehicleDefinition, rack_step: float = 1e-4) -> float:
+    """The overall steering ratio at straight ahead (ISO 8855): steering-wheel angle over the mean
+    steer angle of the front wheels, kinematic (rigid bushings, at design height), from a central
+    difference of ``rack_step`` [m] of the rack."""
+    # the right wheel at rack +r is the mirror of the left at −r; the left's toe-in steers it right
+    toe = lambda rack: front_corner(v, 0.0, rack)[0].toe
+    mean_steer_per_m = -(toe(rack_step) - toe(-rack_step)) / (2.0 * rack_step)
+    wheel_per_m = 2.0 * math.pi / v.front.rack_travel_per_rev
+    return abs(wheel_per_m / mean_steer_per_m)

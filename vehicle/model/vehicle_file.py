@@ -27,7 +27,7 @@ from vehicle.model.plausibility import (MAX_BODY_MASS_KG, MAX_CAMBER_DEG, MAX_CO
                                         MAX_TORSION_NM_PER_RAD, check_geometry)
 from vsim_core.documents import Document, Fields, KeyPath, check_number, check_vector, dotted
 from vsim_core.errors import InputError
-from vsim_core.shipped import DEFAULT_VEHICLE, VEHICLE_DIR, resolve
+from vsim_core.shipped import DEFAULT_VEHICLE, TYRE_DIR, VEHICLE_DIR, resolve
 
 #: Source named in the errors of :func:`with_extensions`.
 EXTENSIONS_SOURCE = "with_extensions"
@@ -40,10 +40,10 @@ def load_vehicle(path: str | Path = DEFAULT_VEHICLE) -> VehicleDefinition:
     path = resolve(path, VEHICLE_DIR, "vehicle")
     doc = Document.read(path, "no such vehicle file")
     top = doc.top(_TOP)
-    t = top.fields("tyre", ("radius", "wheel_mass", "wheel_inertia"))
+    t = top.fields("tyre", ("radius", "wheel_mass", "wheel_inertia", "property_file"))
     tyre = Tyre(t.number("radius", positive=True, at_most=MAX_RADIUS_M, unit="m"),
                 t.number("wheel_mass", positive=True, at_most=MAX_PART_MASS_KG, unit="kg"),
-                _inertias(t, "wheel_inertia", 2))
+                _inertias(t, "wheel_inertia", 2), _tyre_file(t, path.parent))
     b = top.fields("body", ("mass", "cg", "inertia", "ride_height_point", "design_ride_height"))
     body = Body(b.number("mass", positive=True, at_most=MAX_BODY_MASS_KG, unit="kg"), _point(b, "cg"),
                 _inertias(b, "inertia", 3), _point(b, "ride_height_point"),
@@ -190,6 +190,16 @@ def _point(f: Fields, key: str) -> Vec3:
 def _angle(f: Fields, key: str, at_most_deg: float) -> float:
     """An alignment angle written in degrees, in radians."""
     return math.radians(f.number(key, at_most=at_most_deg, unit="deg"))
+
+
+def _tyre_file(t: Fields, base: Path) -> Path | None:
+    """The tyre's property file: a path from the vehicle file's folder, or a shipped tyre's name."""
+    if not t.has("property_file"):
+        return None
+    try:
+        return resolve(t.text("property_file"), TYRE_DIR, "tyre property", base=base, suffix=".tir")
+    except InputError as error:
+        raise t.fail("property_file", f"{error.source}: {error.bare}") from None
 
 
 def _inertias(f: Fields, key: str, n: int) -> tuple[float, ...]:

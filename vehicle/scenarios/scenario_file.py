@@ -8,7 +8,6 @@ Values in the file carry their unit in the key name (``amplitude_mm``, ``amplitu
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np
@@ -16,16 +15,17 @@ import numpy as np
 from vehicle.model.definition import BUSHING_MODELS
 from vehicle.scenarios.channels import (AXLES, CORNER_TAGS, FILE_UNITS, INPUT_CHANNELS, csv_columns, file_si,
                                         input_quantity)
-from vehicle.scenarios.scenario import (BISINE_INPUTS, MAX_FREQUENCY_HZ, MAX_INPUT_S, MAX_SETTLE_S, NAME_PATTERN,
-                                        RIG_TIMESTEP_S, SHAPES, SIGNAL_TYPES, TYPES, Case, InputTable, Limits, Scenario,
-                                        Settle, Waveform)
+from vehicle.scenarios.road_scenario import ROAD_TOP_KEYS, ROAD_TYPES, RoadScenario, parse_road_scenario
+from vehicle.scenarios.scenario import (BISINE_INPUTS, MAX_FREQUENCY_HZ, MAX_INPUT_S, MAX_SETTLE_S, SHAPES,
+                                        SIGNAL_TYPES, TYPES, Case, InputTable, Limits, Scenario, Settle, Waveform)
+from vehicle.scenarios.scenario_fields import LIMIT_KEYS, case_fields, limit_values, output_rate, scenario_name, vehicle_file
 from vsim_core import units
 from vsim_core.documents import Document, Fields
 from vsim_core.errors import InputError
 from vsim_core.files import is_file, read_text
-from vsim_core.shipped import DEFAULT_VEHICLE, SCENARIO_DIR, VEHICLE_DIR, resolve
+from vsim_core.shipped import SCENARIO_DIR, resolve
 from vsim_core.tables import read_csv_columns, read_csv_header
-from vsim_core.units import MM, MM_PER_M
+from vsim_core.units import MM
 
 # -- cases ------------------------------------------------------------------------------------------
 #: Keys a case (merged over ``defaults``) may have, per type; ``label`` is always allowed.
@@ -205,65 +205,44 @@ def _axles(top: Fields, kind: str) -> tuple[str, ...]:
     return tuple(a for a in AXLES if a in raw)
 
 
-def _output_rate(top: Fields) -> float:
-    rate = top.number("output_rate_hz", 100.0, positive=True, at_most=1.0 / RIG_TIMESTEP_S, unit="Hz")
-    every = 1.0 / (rate * RIG_TIMESTEP_S)
-    if abs(every - round(every)) > 1e-9:
-        raise top.fail("output_rate_hz", f"expected a whole divisor of {1 / RIG_TIMESTEP_S:g} Hz (the rig's "
-                                         f"{RIG_TIMESTEP_S * 1e3:g} ms step), got {rate}")
-    return rate
-
-
-def load_scenario(path: str | Path) -> Scenario:
-    """Load and validate a scenario file, or a built-in scenario by name (``pumping``, ``kc/roll``);
-    raises :class:`InputError` naming file:line, key and value."""
+def load_scenario(path: str | Path) -> Scenario | RoadScenario:
+    """Load and validate a scenario file (of the rig or the road), or a built-in scenario by name
+    (``pumping``, ``kc/roll``, ``road/step_steer``); raises :class:`InputError` naming file:line,
+    key and value."""
     path = resolve(path, SCENARIO_DIR, "scenario")
     return parse_scenario(read_text(path), path)
 
 
-def parse_scenario(text: str, path: Path, source: str | None = None) -> Scenario:
+def parse_scenario(text: str, path: Path, source: str | None = None) -> Scenario | RoadScenario:
     """The scenario written in ``text``, as if read from the file ``path``: relative paths in it are
     taken from ``path``'s folder, its name defaults to ``path``'s stem. Errors name ``source``
     (default: ``path``), the line, the key and the value."""
     path = Path(path)
     doc = Document(text, source or str(path))
-    top = doc.top(_TOP_KEYS)
-    kind = top.choice("type", TYPES)
-    try:
-        vehicle = resolve(top.text("vehicle", str(DEFAULT_VEHICLE)), VEHICLE_DIR, "vehicle", base=path.parent)
-    except InputError as error:
-        raise top.fail("vehicle", f"{error.source}: {error.bare}") from None
+    top = doc.top(tuple(dict.fromkeys(_TOP_KEYS + ROAD_TOP_KEYS)))
+    kind = top.choice("type", TYPES + ROAD_TYPES)
+    if kind in ROAD_TYPES:
+        return parse_road_scenario(top, kind, path, text)
+    top.check_keys(_TOP_KEYS, " in a rig scenario")
+    vehicle = vehicle_file(top, path)
     axles = _axles(top, kind)
 
     s = Fields.of(doc, ("settle",), top.raw("settle", {}), ("before_bushings_s", "before_input_s"))
     settle = Settle(s.number("before_bushings_s", Settle.before_bushings_s, nonneg=True, at_most=MAX_SETTLE_S, unit="s"),
                     s.number("before_input_s", Settle.before_input_s, nonneg=True, at_most=MAX_SETTLE_S, unit="s"))
-    lim = Fields.of(doc, ("limits",), top.raw("limits", {}), ("translation_mm", "rotation_deg", "closure_error_mm"))
-    limits = Limits(lim.number("translation_mm", Limits.translation_m * MM_PER_M, positive=True) * MM,
-                    math.radians(lim.number("rotation_deg", math.degrees(Limits.rotation_rad), positive=True)),
-                    lim.number("closure_error_mm", Limits.closure_error_m * MM_PER_M, positive=True) * MM)
+    limits = Limits(**limit_values(Fields.of(doc, ("limits",), top.raw("limits", {}), LIMIT_KEYS)))
 
     allowed = _case_keys(kind)
-    defaults = Fields.of(doc, ("defaults",), top.raw("defaults", {}), allowed)
-    raw_cases = top.raw("cases")
-    if not isinstance(raw_cases, list) or not raw_cases:
-        raise top.fail("cases", f"expected a non-empty list of cases, got {raw_cases!r}")
     cases = []
-    for i, item in enumerate(raw_cases):
-        own = Fields.of(doc, ("cases", i), item, allowed)
-        merged = Fields(doc, {**defaults.values, **own.values}, ("cases", i))
-        case = _case(merged, kind, axles, path.parent)
+    for i, fields in case_fields(top, allowed):
+        case = _case(fields, kind, axles, path.parent)
         if not case.duration_s <= MAX_INPUT_S:
             raise doc.error(("cases", i), f"its input lasts {case.duration_s:.6g} s; expected at most {MAX_INPUT_S:g} s "
                                           f"of simulated time per case")
         cases.append(case)
     if kind == "bisine" and len({c.parameters["input"] for c in cases}) > 1:
         raise top.fail("cases", "expected every bi-sine case to drive the same input (put `input` in defaults)")
-    name = top.text("name", path.stem)
-    if not NAME_PATTERN.fullmatch(name):
-        raise top.fail("name", f"expected a plain name (letters, digits, '_', '.', '-'; the run file is "
-                               f"out/<name>.mcap), got {name!r}")
     return Scenario(
-        name=name, description=top.text("description", ""), path=path, text=text, type=kind,
+        name=scenario_name(top, path), description=top.text("description", ""), path=path, text=text, type=kind,
         vehicle=vehicle, bushing_model=top.choice("bushings", BUSHING_MODELS, None), axles=axles,
-        output_rate_hz=_output_rate(top), settle=settle, limits=limits, cases=tuple(cases))
+        output_rate_hz=output_rate(top), settle=settle, limits=limits, cases=tuple(cases))

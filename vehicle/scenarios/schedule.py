@@ -1,26 +1,29 @@
-"""When things happen in a run of a scenario: each case's three phases (settle with the bushings
-linear, settle with their laws on, the input), in whole output intervals, one case after the other
-on one time axis."""
+"""When things happen in a run of a scenario: each case's phases (on the rig: settle with the
+bushings linear, settle with their laws on, the input; on the road the same with a straight run at
+speed before the input), in whole output intervals, one case after the other on one time axis."""
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import astuple, dataclass
 
+from vehicle.scenarios.road_scenario import RoadScenario
 from vehicle.scenarios.scenario import Scenario
 from vsim_core.errors import InputError
 
 #: Largest factor on a scenario's durations (slower runs than that are typing errors).
 MAX_DURATION_SCALE = 100.0
-#: The phases of a case, in order (the ``phase`` signal of a recording is the index).
+#: The phases of a case, in order (the ``phase`` signal of a recording is the index): on the rig
+#: and on the road.
 PHASES = ("settle, bushings linear", "settle, bushing laws on", "input")
+ROAD_PHASES = ("at rest, bushings linear", "at rest, bushing laws on", "straight at speed", "input")
 
 
 @dataclass(frozen=True)
 class CaseSchedule:
     """Step counts of a case's phases and its times in the file [s]."""
 
-    steps: tuple[int, int, int]     #: steps of each phase, multiples of the output interval
+    steps: tuple[int, ...]          #: steps of each phase, multiples of the output interval
     start_s: float                  #: time of its first sample in the file
 
     def phase_start_s(self, phase: int, dt: float) -> float:
@@ -39,12 +42,13 @@ class Progress:
     case: int              #: 1-based
     cases: int
     label: str
-    phase: int             #: index in PHASES
+    phase: int             #: index in PHASES (ROAD_PHASES on the road)
+    phase_name: str        #: the phase's name
     done_s: float          #: simulated time of the whole run so far [s]
     total_s: float         #: simulated time of the whole run [s]
 
 
-def schedule(scenario: Scenario, duration_scale: float, dt: float) -> list[CaseSchedule]:
+def schedule(scenario: Scenario | RoadScenario, duration_scale: float, dt: float) -> list[CaseSchedule]:
     """Phase lengths of every case (settle times and inputs scaled by ``duration_scale``), each
     rounded up to whole output intervals, and each case's start in the file: case k+1's first
     sample follows case k's last one by one output interval. InputError for a scale that is not
@@ -55,13 +59,13 @@ def schedule(scenario: Scenario, duration_scale: float, dt: float) -> list[CaseS
     every = output_interval(scenario, dt)
     out, start = [], 0.0
     for case in scenario.cases:
-        seconds = (scenario.settle.before_bushings_s, scenario.settle.before_input_s, case.duration_s)
+        seconds = (*astuple(scenario.settle), case.duration_s)
         steps = tuple(every * math.ceil(round(s * duration_scale / dt, 6) / every) for s in seconds)
         out.append(CaseSchedule(steps, start))
         start += (sum(steps) + every) * dt
     return out
 
 
-def output_interval(scenario: Scenario, dt: float) -> int:
+def output_interval(scenario: Scenario | RoadScenario, dt: float) -> int:
     """Rig steps of ``dt`` [s] between recorded samples."""
     return max(1, round(1.0 / (scenario.output_rate_hz * dt)))

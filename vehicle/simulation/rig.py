@@ -10,55 +10,37 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import time
-from contextlib import contextmanager
-from typing import Iterator
 
 import mujoco
 import numpy as np
 
-from vehicle.model.builder import CarModel, build
 from vehicle.model.definition import CORNERS, VehicleDefinition
 from vehicle.model.elements import BuildOptions
 from vehicle.model.kinematics import wheel_angles
-from vehicle.model.statics import resolve_preloads
 from vehicle.simulation import stepping
-from vehicle.simulation.coupling import ForceCoupling
+from vehicle.simulation.mounted import MountedCar
 from vehicle.simulation.outputs import RigOutputs, WheelOutputs
 
 _NO_INPUTS = np.zeros((0, 17))
 _INACTIVE = np.zeros(5, dtype=bool)
 _ALL_ACTIVE = np.ones(5, dtype=bool)
-# a plain int: comparing an array with the pybind enum goes element by element through Python (100 µs)
-_EQUALITY_ROW = int(mujoco.mjtConstraint.mjCNSTR_EQUALITY)
 _SIGN = {"front_left": 1.0, "front_right": -1.0, "rear_left": 1.0, "rear_right": -1.0}
 
 
-class KCRig:
+class KCRig(MountedCar):
     """A vehicle on the K&C rig, stepped with its bushing coupling."""
 
     def __init__(self, vehicle: VehicleDefinition, options: BuildOptions = BuildOptions()):
-        options = dataclasses.replace(options, rig=True)
-        self.vehicle = resolve_preloads(vehicle)
-        self.car: CarModel = build(self.vehicle, options)
-        m = self.model = self.car.model
-        self.data = mujoco.MjData(m)
-        self.coupling = ForceCoupling(self.car, self.data)
+        super().__init__(vehicle, dataclasses.replace(options, rig=True))
+        m = self.model
         eq = lambda n: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_EQUALITY, n)
         body = lambda n: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, n)
         self.pad_eq = np.array([eq(self.car.corners[c]["pad_drive"]) for c in CORNERS])
-        self.rack_eq = eq("rack_drive")
-        self.wheel_body = np.array([body(self.car.corners[c]["wheel"]) for c in CORNERS])
         self.pad_qpos = m.jnt_qposadr[[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, self.car.corners[c]["pad_z"])
                                        for c in CORNERS]]
         self.carriage_body = np.array([body(f"carriage_{c}") for c in CORNERS])
         self.centre_site = np.array([mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, self.car.corners[c]["centre_site"])
                                      for c in CORNERS])
-        self.closure_eq = np.array([eq(n) for n in self.car.closures])
-        self.closure_rows = np.array([3 if m.eq_type[i] != mujoco.mjtEq.mjEQ_TENDON else 1 for i in self.closure_eq])
-        #: Wall time spent in the compiled stepping loop so far [s] (the end-to-end benchmark's reference),
-        #: without the first, empty call here, which compiles the loop or loads it from numba's cache.
-        self.stepping_s = 0.0
         self._run(0, _NO_INPUTS, _INACTIVE)
         self.stepping_s = 0.0
 
@@ -92,20 +74,6 @@ class KCRig:
         self.set_pads([0.0] * 4)
         self.set_rack(0.0)
 
-    @contextmanager
-    def bushing_laws_off(self) -> Iterator[None]:
-        """Within the block every bushing direction is linear, with the stiffness and damping held
-        in its joint (the reference tangent); on leaving, the laws are back, from their virgin state
-        (the thesis settles the car this way before switching the bushing models on)."""
-        # The coupling skips a bank it does not have and then reports the joint forces of every channel.
-        forces = self.coupling.bushings
-        laws, forces.bank = forces.bank, None
-        try:
-            yield
-        finally:
-            forces.bank = laws
-            self.coupling.reset()
-
     # -- running -----------------------------------------------------------------------------
     def step(self, n: int = 1) -> None:
         """Advance ``n`` time steps with the inputs held (compiled loop, the coupling called before each step)."""
@@ -122,13 +90,9 @@ class KCRig:
     def _run(self, n: int, inputs: np.ndarray, active: np.ndarray) -> None:
         """``n`` compiled steps (vehicle.simulation.stepping.run) with ``inputs`` and ``active`` as it documents."""
         m, d = self.model, self.data
-        started = time.perf_counter()
-        stepping.run(n, inputs, active, m.eq_data, self.pad_eq, self.rack_eq, d.xfrc_applied, self.carriage_body,
-                     self.wheel_body, m._address, d._address, m.opt.timestep, *self.coupling.kernel_arrays())
-        self.stepping_s += time.perf_counter() - started
-        b = self.coupling.bushings
-        if b.bank is not None:
-            b.bank_force = b.bank.force
+        self._timed(stepping.run, n, inputs, active, m.eq_data, self.pad_eq, self.rack_eq, d.xfrc_applied,
+                    self.carriage_body, self.wheel_body, m._address, d._address, m.opt.timestep,
+                    *self.coupling.kernel_arrays())
 
     def settle(self, duration: float = 1.0) -> None:
         """Run ``duration`` [s] with the inputs held."""
@@ -164,29 +128,6 @@ class KCRig:
         return out
 
     # -- outputs -----------------------------------------------------------------------------
-    def _eq_first_rows(self) -> np.ndarray:
-        """Index in ``efc_*`` of the first row of every equality, -1 where inactive (an equality's
-        rows are consecutive)."""
-        d = self.data
-        rows = np.flatnonzero(d.efc_type[: d.nefc] == _EQUALITY_ROW)
-        first = np.full(self.model.neq, -1)
-        eq, at = np.unique(d.efc_id[rows], return_index=True)
-        first[eq] = rows[at]
-        return first
-
-    def ride_height(self) -> float:
-        """Height of the body's ride-height point above the ground (pads at zero) [m]."""
-        return float(self.car.body_point(self.data, self.vehicle.body.ride_height_point)[2])
-
-    def _closure_error(self, first_rows: np.ndarray) -> float:
-        """Largest position error of the loop closures [m] (connect, weld position, tie-rod length),
-        from the equalities' first rows (:meth:`_eq_first_rows`)."""
-        d = self.data
-        rows = first_rows[self.closure_eq][:, None] + np.arange(3)
-        used = np.arange(3) < self.closure_rows[:, None]  # 3 position rows, 1 for a tendon length
-        pos = np.where(used, d.efc_pos[np.minimum(rows, d.nefc - 1)], 0.0)
-        return float(np.sqrt((pos * pos).sum(axis=1)).max())
-
     def measure(self) -> RigOutputs:
         """The rig's outputs at the current state."""
         m, d = self.model, self.data
@@ -205,10 +146,4 @@ class KCRig:
             wheels[corner] = WheelOutputs(camber, toe, math.atan2(heading[1], heading[0]), abs(centre[1]), centre,
                                           force, float(d.qpos[self.pad_qpos[k]]),
                                           float(d.xfrc_applied[self.wheel_body[k], 5]))
-        c = self.coupling
-        return RigOutputs(
-            time=float(d.time), wheels=wheels, bushing_names=tuple(ch.name for ch in self.car.channels),
-            bushing_deflection=c.bushings.deflections(), bushing_force=c.bushings.forces(),
-            spring_force=dict(zip((e.name for e in c.springs), c.spring_forces().tolist())),
-            damper_force=dict(zip((e.name for e in c.dampers), c.damper_forces().tolist())),
-            closure_error=self._closure_error(first_rows))
+        return RigOutputs(wheels=wheels, **self.suspension_outputs(first_rows))

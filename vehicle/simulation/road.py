@@ -2,108 +2,172 @@
 
 The body is free; the wheels spin on their hinges and stand on the road through their tyres
 (:mod:`vsim_tyres.road_contact`, computed every step in the compiled loop with the bushings, see
-:func:`vehicle.simulation.stepping.run_road`); the rack is driven (the steering) and each wheel
-takes a drive torque and a brake (the spin joint's dry friction). Inputs per step: rack position
-[m], four drive torques [N·m] (order of ``CORNERS``, positive driving), four brake torques [N·m].
+:func:`vehicle.simulation.stepping.run_road`); the steering wheel drives the rack through the car's
+``front.steering.rack_travel_per_rev``; a driver holds the speed with a PI controller of the front
+wheels' drive torque (front-wheel drive), or holds its last torque (a fixed throttle); each wheel
+also takes an extra drive torque and a brake (the spin joint's dry friction). Inputs per step
+(:data:`N_INPUTS` columns): rack [m], target speed [m/s] (NaN: the throttle held), four drive
+torques [N·m] (order of ``CORNERS``, positive driving), four brake torques [N·m].
+
+Outputs (:meth:`RoadCar.measure`) follow ISO 8855: the body's motion in the intermediate axis
+system (x forward and y left in the road's plane, turned by the yaw angle), at the body's centre of
+mass; wheel angles relative to the body as on the rig (toe-in, camber top-out, steer to the left
+positive).
 """
 
 from __future__ import annotations
 
 import dataclasses
-import time
+import math
 from pathlib import Path
 
 import mujoco
 import numpy as np
 
-from vehicle.model.builder import CarModel, build
 from vehicle.model.definition import CORNERS, VehicleDefinition
 from vehicle.model.elements import BuildOptions
-from vehicle.model.statics import resolve_preloads
+from vehicle.model.kinematics import steering_ratio, wheel_angles
 from vehicle.simulation import stepping
-from vehicle.simulation.coupling import ForceCoupling
-from vsim_core.shipped import DEFAULT_TYRE
+from vehicle.simulation.mounted import MountedCar
+from vehicle.simulation.outputs import RoadOutputs, RoadWheel
+from vsim_core.errors import InputError
 from vsim_tyres import magic_formula
 from vsim_tyres.road_contact import N_SIGNALS, N_STATE, SIGNALS, effective_rolling_radius, mirrored_wheels
 from vsim_tyres.tir_file import read_tir
 
-#: Columns of a row of road inputs: the rack, the four drive torques, the four brake torques.
-N_INPUTS = 9
+#: Columns of a row of road inputs: the rack, the target speed, four drive torques, four brake torques.
+N_INPUTS = 10
 _NO_INPUTS = np.zeros((0, N_INPUTS))
 _DEFLECTION = SIGNALS.index("deflection_m")
+_SIDE = {"left": 1.0, "right": -1.0}
+#: The driver's speed loop: natural frequency [Hz] and damping ratio of the car's speed under the PI
+#: controller (slow beside the handling, which it must not steer; fast beside the speed ramps).
+SPEED_LOOP_HZ, SPEED_LOOP_DAMPING = 0.5, 1.0
 
 
-class RoadCar:
-    """A vehicle on a flat road, stepped with its bushing coupling and its tyres."""
+class RoadCar(MountedCar):
+    """A vehicle on a flat road with a driver, stepped with its bushing coupling and its tyres."""
 
-    def __init__(self, vehicle: VehicleDefinition, tyre_file: str | Path = DEFAULT_TYRE,
+    def __init__(self, vehicle: VehicleDefinition, tyre_file: str | Path | None = None,
                  options: BuildOptions = BuildOptions()):
-        options = dataclasses.replace(options, rig=False, clamped=False, road=True)
-        self.vehicle = resolve_preloads(vehicle)
-        self.car: CarModel = build(self.vehicle, options)
-        m = self.model = self.car.model
-        m.opt.enableflags |= mujoco.mjtEnableBit.mjENBL_ENERGY
-        self.data = mujoco.MjData(m)
-        self.coupling = ForceCoupling(self.car, self.data)
+        """``tyre_file``: the .tir of all four tyres (default: the vehicle file's ``tyre.property_file``).
+        InputError naming the vehicle file when neither names one."""
+        tyre_file = tyre_file or vehicle.tyre.property_file
+        if tyre_file is None:
+            raise InputError("the car on the road needs a tyre: give tyre.property_file (a .tir file)",
+                             source=str(vehicle.path), key="tyre.property_file")
         tir = read_tir(tyre_file)
+        super().__init__(vehicle, dataclasses.replace(options, rig=False, clamped=False, road=True))
+        m, d = self.model, self.data
+        m.opt.enableflags |= mujoco.mjtEnableBit.mjENBL_ENERGY
+        self.tyre_file = Path(tyre_file)
         self.tyres = np.repeat(np.array([magic_formula.coefficients(tir)], dtype=magic_formula.DTYPE), len(CORNERS))
         self.mirrored = mirrored_wheels(tir.text("MODEL", "TYRESIDE", default="LEFT"),
                                         tuple(c.split("_")[1] for c in CORNERS))
-        body = lambda n: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, n)
-        self.wheel_body = np.array([body(self.car.corners[c]["wheel"]) for c in CORNERS])
         spin = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, f"spin_{c}") for c in CORNERS]
         self.spin_dof = m.jnt_dofadr[spin].astype(np.int64)
-        self.chassis_dof = m.jnt_dofadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, "chassis_free")]
-        self.rack_eq = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_EQUALITY, "rack_drive")
+        self.chassis = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "chassis")
+        self.chassis_dof = int(m.jnt_dofadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, "chassis_free")])
         #: Lagged slips (κ', tan α') of each wheel and its signals (vsim_tyres.road_contact.SIGNALS).
         self.tyre_state = np.zeros((len(CORNERS), N_STATE))
         self.tyre_signals = np.zeros((len(CORNERS), N_SIGNALS))
-        d = self.data   # views of MuJoCo's memory: the tyres' arguments hold for the car's life
+        # the steering wheel turned left steers left: the rack moves towards the steering arms' side
+        hp = self.vehicle.front.hardpoints
+        ahead = 1.0 if hp["tie_rod_outer"][0] > hp["wheel_centre"][0] else -1.0
+        #: Rack travel per radian of steering-wheel angle [m/rad], signed so that + steers left.
+        self.rack_per_rad = ahead * self.vehicle.front.rack_travel_per_rev / (2.0 * math.pi)
+        #: The overall steering ratio at straight ahead (kinematic) and the wheelbase [m].
+        self.steering_ratio = steering_ratio(self.vehicle)
+        self.wheelbase = float(hp["wheel_centre"][0] - self.vehicle.rear.hardpoints["wheel_centre"][0])
+        mass = float(m.body_mass.sum())
+        w = 2.0 * math.pi * SPEED_LOOP_HZ
+        #: Integral of the speed error [m] and the drive force [N] of the driver's controller.
+        self.driver_state = np.zeros(2)
+        front = np.array([c.startswith("front") for c in CORNERS], dtype=float)
+        d = self.data   # views of MuJoCo's memory: the loop's arguments hold for the car's life
+        self._driver = (d.qvel, d.xmat, self.chassis_dof, self.chassis, front / front.sum(),
+                        np.array([2.0 * SPEED_LOOP_DAMPING * w * mass, w * w * mass, self.vehicle.tyre.radius]),
+                        self.driver_state)
         self._tyre_args = (self.tyres, self.mirrored, self.wheel_body, d.xipos, d.xmat, d.cvel, d.subtree_com,
                            m.body_rootid.astype(np.int64), self.tyre_state, d.xfrc_applied, self.tyre_signals)
-        self.stepping_s = 0.0
+        self._sides = [_SIDE[c.split("_")[1]] for c in CORNERS]
+        self._design_z = [getattr(self.vehicle, c.split("_")[0]).hardpoints["wheel_centre"][2] for c in CORNERS]
         self._run(0, _NO_INPUTS)
         self.stepping_s = 0.0
 
     def _run(self, n: int, inputs: np.ndarray) -> None:
         m, d = self.model, self.data
-        started = time.perf_counter()
-        stepping.run_road(n, inputs, m.eq_data, self.rack_eq, self.spin_dof, m.dof_frictionloss, m._address, d._address,
-                          m.opt.timestep, self.coupling.kernel_arrays(), self._tyre_args)
-        self.stepping_s += time.perf_counter() - started
-        b = self.coupling.bushings
-        if b.bank is not None:
-            b.bank_force = b.bank.force
+        self._timed(stepping.run_road, n, inputs, m.eq_data, self.rack_eq, self.spin_dof, m.dof_frictionloss,
+                    m._address, d._address, m.opt.timestep, self.coupling.kernel_arrays(), self._tyre_args,
+                    self._driver)
 
     def step(self, n: int = 1) -> None:
-        """Advance ``n`` time steps with the rack, drive and brakes held."""
+        """Advance ``n`` time steps with the rack, drive and brakes held (the speed controller idle)."""
         self._run(n, _NO_INPUTS)
 
     def play(self, inputs: np.ndarray) -> None:
-        """Advance one step per row of ``inputs`` (rack [m], four drive torques, four brake torques
-        [N·m]), each row set before its step."""
+        """Advance one step per row of ``inputs`` (:data:`N_INPUTS` columns, see the module), each row
+        set before its step."""
         inputs = np.ascontiguousarray(inputs, dtype=float)
         if inputs.ndim != 2 or inputs.shape[1] != N_INPUTS:  # the compiled loop does not check
             raise ValueError(f"expected road inputs of shape (steps, {N_INPUTS}), got {inputs.shape}")
         self._run(len(inputs), inputs)
+
+    def drive_inputs(self, steering_wheel_rad: np.ndarray, speed_mps: np.ndarray) -> np.ndarray:
+        """Rows of inputs for steering-wheel angles [rad] (+ to the left) and target speeds [m/s] (NaN:
+        the throttle held), without extra torques or brakes."""
+        u = np.zeros((len(steering_wheel_rad), N_INPUTS))
+        u[:, 0] = self.rack_per_rad * np.asarray(steering_wheel_rad, float)
+        u[:, 1] = speed_mps
+        return u
 
     def set_brakes(self, torque: float) -> None:
         """Hold every wheel with a brake of ``torque`` [N·m] (0 releases them)."""
         self.model.dof_frictionloss[self.spin_dof] = torque
 
     def set_speed(self, speed: float) -> None:
-        """Move the whole car forward at ``speed`` [m/s] (the wheels rolling at it, without slip)."""
+        """Move the whole car forward at ``speed`` [m/s] (the wheels rolling at it, without slip), the
+        driver's controller from rest."""
         d = self.data
         d.qvel[self.chassis_dof] = speed
         for k, dof in enumerate(self.spin_dof):
             d.qvel[dof] = speed / effective_rolling_radius(self.tyres[k], self.tyre_signals[k, _DEFLECTION])
-
-    def ride_height(self) -> float:
-        """Height of the body's ride-height point above the road [m]."""
-        return float(self.car.body_point(self.data, self.vehicle.body.ride_height_point)[2])
+        self.driver_state[:] = 0.0
 
     def energy(self) -> float:
         """Kinetic energy of every body plus the potential energy of gravity and of the joints' and
         tendons' springs [J] (MuJoCo's; the tyres' and the bushing laws' explicit parts not included)."""
         mujoco.mj_forward(self.model, self.data)
         return float(self.data.energy.sum())
+
+    def measure(self) -> RoadOutputs:
+        """The car's outputs at the current state (ISO 8855, see the module)."""
+        m, d = self.model, self.data
+        mujoco.mj_forward(m, d)
+        mujoco.mj_rnePostConstraint(m, d)   # the bodies' accelerations (cacc)
+        rot = d.xmat[self.chassis].reshape(3, 3)
+        yaw = math.atan2(rot[1, 0], rot[0, 0])
+        pitch = -math.asin(max(-1.0, min(1.0, rot[2, 0])))
+        roll = math.atan2(rot[2, 1], rot[2, 2])
+        motion, acceleration = np.zeros(6), np.zeros(6)   # (rotational, linear), world axes, at the centre of mass
+        mujoco.mj_objectVelocity(m, d, mujoco.mjtObj.mjOBJ_BODY, self.chassis, motion, 0)
+        mujoco.mj_objectAcceleration(m, d, mujoco.mjtObj.mjOBJ_BODY, self.chassis, acceleration, 0)
+        omega, velocity = motion[:3], motion[3:]
+        accel = acceleration[3:] + m.opt.gravity   # MuJoCo's accelerations carry −g (an accelerometer's reading)
+        c, s = math.cos(yaw), math.sin(yaw)
+        vx, vy = c * velocity[0] + s * velocity[1], -s * velocity[0] + c * velocity[1]
+        wheels = {}
+        for k, corner in enumerate(CORNERS):
+            side = self._sides[k]
+            spin_left = rot.T @ d.xmat[self.wheel_body[k]].reshape(3, 3)[:, 1]
+            toe, camber = wheel_angles(side * spin_left, side)
+            centre = rot.T @ (d.xipos[self.wheel_body[k]] - d.xpos[self.chassis])
+            wheels[corner] = RoadWheel(camber, toe, math.atan2(-spin_left[0], spin_left[1]),
+                                       float(centre[2] - self._design_z[k]), self.tyre_signals[k].copy())
+        return RoadOutputs(
+            position=(float(d.xipos[self.chassis, 0]), float(d.xipos[self.chassis, 1])),
+            yaw=yaw, roll=roll, pitch=pitch, speed=vx, lateral_speed=vy, yaw_rate=float(omega[2]),
+            longitudinal_acceleration=c * accel[0] + s * accel[1], lateral_acceleration=-s * accel[0] + c * accel[1],
+            sideslip=math.atan2(vy, vx) if vx > 0.0 else 0.0,
+            rack=float(m.eq_data[self.rack_eq, 0]), drive_force=float(self.driver_state[1]), wheels=wheels,
+            **self.suspension_outputs(self._eq_first_rows()))

@@ -16,7 +16,7 @@ a recording keeps it.
 from __future__ import annotations
 
 import functools
-from typing import Callable, Iterator
+from typing import Any, Callable, Iterator
 
 import mujoco
 import numpy as np
@@ -24,8 +24,9 @@ import numpy as np
 from vehicle.model.definition import CORNERS, VehicleDefinition, is_rotation
 from vehicle.model.elements import BuildOptions
 from vehicle.scenarios.channels import INPUT_CHANNELS
+from vehicle.scenarios.road_scenario import RoadScenario
 from vehicle.scenarios.scenario import Case, Scenario
-from vehicle.scenarios.schedule import CaseSchedule, Progress, output_interval, schedule
+from vehicle.scenarios.schedule import PHASES, CaseSchedule, Progress, output_interval, schedule
 from vehicle.simulation.outputs import RigOutputs, Sample
 from vehicle.simulation.rig import KCRig
 from vsim_core.units import DEG_PER_RAD, MM_PER_M
@@ -74,33 +75,43 @@ def _deflection_limits(names: tuple[str, ...], rotation_rad: float, translation_
     return rotation, np.where(rotation, rotation_rad, translation_m)
 
 
-class ScenarioRun:
-    """The cases of a scenario played one after the other on ``vehicle``, each on a fresh rig.
+class PlayedScenario:
+    """What every play of a scenario shares, on the rig or on the road: the schedule of its cases,
+    the first case's car (``mount(vehicle, options)``), the simulated time and the time spent in
+    the compiled stepping loop. ``duration_scale`` multiplies every duration (settle phases,
+    periods, holds) for quick runs; ``progress`` is called after every sample with a :class:`Progress`;
+    ``timestep_s`` is the car's time step (its convergence is measured in tools/benchmarks)."""
 
-    ``duration_scale`` multiplies every duration (settle phases, periods, holds) for quick runs;
-    ``progress`` is called after every sample with a :class:`Progress`.
-    """
-
-    def __init__(self, scenario: Scenario, vehicle: VehicleDefinition, duration_scale: float = 1.0,
-                 progress: Callable[[Progress], None] | None = None):
+    def __init__(self, scenario: Scenario | RoadScenario, vehicle: VehicleDefinition, duration_scale: float,
+                 progress: Callable[[Progress], None] | None, mount: Callable[[VehicleDefinition, BuildOptions], Any],
+                 timestep_s: float = BuildOptions.timestep):
         self.scenario, self.vehicle, self.duration_scale = scenario, vehicle, duration_scale
         self.progress = progress
-        self.options = BuildOptions(bushing_model=scenario.bushing_model)
+        self.options = BuildOptions(bushing_model=scenario.bushing_model, timestep=timestep_s)
         self.dt = self.options.timestep
         self.plan = schedule(scenario, duration_scale, self.dt)   # checks the scale before the build
-        self.rig = KCRig(vehicle, self.options)
+        #: The first case's car (each later case builds its own).
+        self.car = mount(vehicle, self.options)
         self.total_s = self.plan[-1].end_s(self.dt)
-        #: Wall time the cases spent in the compiled stepping loop [s] (their rigs' ``stepping_s``).
+        #: Wall time the cases spent in the compiled stepping loop [s] (their cars' ``stepping_s``).
         self.stepping_s = 0.0
 
     def bodies(self) -> list[str]:
         """Names of the model's bodies whose poses the samples carry (the world excepted)."""
-        m = self.rig.model
+        m = self.car.model
         return [mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, i) for i in range(1, m.nbody)]
+
+
+class ScenarioRun(PlayedScenario):
+    """The cases of a scenario played one after the other on ``vehicle``, each on a fresh rig."""
+
+    def __init__(self, scenario: Scenario, vehicle: VehicleDefinition, duration_scale: float = 1.0,
+                 progress: Callable[[Progress], None] | None = None, timestep_s: float = BuildOptions.timestep):
+        super().__init__(scenario, vehicle, duration_scale, progress, KCRig, timestep_s)
 
     def samples(self) -> Iterator[Sample]:
         """Every sample of every case, in time order."""
-        rig, cases = self.rig, self.scenario.cases
+        rig, cases = self.car, self.scenario.cases
         for k, (case, when) in enumerate(zip(cases, self.plan), start=1):
             if k > 1:
                 rig = KCRig(self.vehicle, self.options)
@@ -129,7 +140,7 @@ class ScenarioRun:
                          d.xquat[bodies])
             check_divergence(rig, o, scenario, t, name)
             if self.progress is not None:
-                self.progress(Progress(number, len(scenario.cases), case.label, phase, t, self.total_s))
+                self.progress(Progress(number, len(scenario.cases), case.label, phase, PHASES[phase], t, self.total_s))
 
         def hold(phase: int) -> Iterator[Sample]:
             nonlocal step

@@ -14,6 +14,7 @@ them in place.
 from __future__ import annotations
 
 import ctypes
+import math
 from pathlib import Path
 
 import mujoco
@@ -145,22 +146,35 @@ def run(*args) -> None:
 
 @nb.njit(cache=True)
 def _run_road(mj_step1, mj_step2, n, inputs, eq_data, rack_eq, spin_dof, frictionloss, m_addr, d_addr, h, coupling,
-              tyres):
+              tyres, driver):
     """Advance the car on the road ``n`` steps, row i of ``inputs`` set before step i (none if it has
-    no rows): the rack [m], the four wheels' drive torques [N·m] (order of CORNERS, positive
-    driving, reacting on the knuckle) and brake torques [N·m] (the spin joints' dry friction: it
-    holds a wheel still up to that torque). Each step: the coupling's forces, ``mj_step1`` (positions and
-    velocities), the tyres' wrenches from them (``tyres`` = the arguments of
-    :func:`vsim_tyres.road_contact.tyre_wrenches` after ``h``), ``mj_step2``: MuJoCo's split step,
-    bit-identical to ``mj_step``, so that the tyres see this step's state and not the last one's."""
+    no rows): the rack [m]; the target speed [m/s] of the driver's speed controller, or NaN to hold
+    its last drive force (a fixed throttle); four extra drive torques [N·m] (order of CORNERS,
+    positive driving, reacting on the knuckle) and four brake torques [N·m] (the spin joints' dry
+    friction: it holds a wheel still up to that torque). Each step: the coupling's forces, the
+    driver, ``mj_step1`` (positions and velocities), the tyres' wrenches from them (``tyres`` = the
+    arguments of :func:`vsim_tyres.road_contact.tyre_wrenches` after ``h``), ``mj_step2``: MuJoCo's
+    split step, bit-identical to ``mj_step``, so that the tyres see this step's state and not the
+    last one's.
+
+    ``driver`` = (qvel, xmat, chassis dof, chassis body, each wheel's share of the drive force,
+    (gain [N·s/m], integral gain [N/m], wheel radius [m]), state (integral of the speed error [m],
+    drive force [N])): a PI controller of the body's forward speed."""
     qfrc = coupling[2]
+    qvel, xmat, dof, body, share, gains, state = driver
     for i in range(n):
         coupling_step(h, *coupling)
         if inputs.shape[0]:
-            eq_data[rack_eq, 0] = inputs[i, 0]
+            u = inputs[i]
+            eq_data[rack_eq, 0] = u[0]
+            if not math.isnan(u[1]):
+                forward = qvel[dof] * xmat[body, 0] + qvel[dof + 1] * xmat[body, 3] + qvel[dof + 2] * xmat[body, 6]
+                error = u[1] - forward
+                state[0] += error * h
+                state[1] = gains[0] * error + gains[1] * state[0]
             for c in range(4):
-                qfrc[spin_dof[c]] += inputs[i, 1 + c]
-                frictionloss[spin_dof[c]] = inputs[i, 5 + c]
+                qfrc[spin_dof[c]] += u[2 + c] + share[c] * state[1] * gains[2]
+                frictionloss[spin_dof[c]] = u[6 + c]
         mj_step1(m_addr, d_addr)
         tyre_wrenches(tyres[0], tyres[1], h, *tyres[2:])
         mj_step2(m_addr, d_addr)

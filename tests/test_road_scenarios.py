@@ -1,0 +1,194 @@
+"""Road scenarios (issue 26): their files validated like the rig's, and the car driven through them
+on its tyres, checked against physics: the steady state of a turn (a_y = V·r), left and right as
+mirror images, the step's steady gain equal to the steady-state circle's at the same lateral
+acceleration, a car that spins stopped with its recording kept, and reruns equal bit for bit."""
+
+from __future__ import annotations
+
+import csv
+import math
+import textwrap
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from vehicle.model.kinematics import steering_ratio
+from vehicle.model.vehicle_file import load_vehicle
+from vehicle.scenarios.road_scenario import ROAD_TYPES, RoadScenario
+from vehicle.scenarios.scenario_file import load_scenario
+from vehicle.simulation.rig import KCRig
+from vehicle.simulation.runner import DivergenceError
+from vsim_analysis.road_metrics import G, road_metrics
+from vsim_cli.main import main as vsim
+from vsim_core.errors import InputError
+from vsim_core.shipped import DEFAULT_VEHICLE, SCENARIO_DIR
+from vsim_recordings.recorder import run_scenario, simulate
+from vsim_recordings.run_reader import load_run
+
+SHORT = """\
+    type: step_steer
+    settle: {at_rest_s: 0.5, bushings_on_s: 0.2, straight_s: 1.0}
+    output_rate_hz: 200
+    defaults: {speed_kmh: 80, hold_s: 2.5, rise_time_s: 0.1}
+    cases:
+      - {label: left, steering_wheel_deg: 38}
+      - {label: right, steering_wheel_deg: -38}
+"""
+
+
+def scenario(tmp_path: Path, text: str) -> RoadScenario:
+    path = tmp_path / "road.yaml"
+    path.write_text(textwrap.dedent(text))
+    return load_scenario(path)
+
+
+@pytest.mark.parametrize("name", ROAD_TYPES)
+def test_every_shipped_road_scenario_validates(name: str) -> None:
+    s = load_scenario(f"road/{name}")
+    assert isinstance(s, RoadScenario) and s.type == name and s.vehicle.resolve() == DEFAULT_VEHICLE.resolve()
+    for case in s.cases:
+        t = np.linspace(0.0, case.duration_s, 200)
+        assert case.steering(t)[0] == 0.0 and np.all(np.isfinite(case.speed(t)))
+    assert (SCENARIO_DIR / "road" / f"{name}.yaml").is_file()
+
+
+@pytest.mark.parametrize("change, line, message", [
+    ("rise_time_s: 0.1", "rise_time_s: 0.2", r":4: defaults\.rise_time_s: expected a steering ramp of at most 0\.15 s \(ISO 7401\), got 0\.2"),
+    ("speed_kmh: 80", "speed_kmh: 400", r":4: defaults\.speed_kmh: expected at most 250 km/h in magnitude, got 400"),
+    ("steering_wheel_deg: 38}", "steering_wheel_deg: 0}", r":6: cases\[0\]\.steering_wheel_deg: expected a non-zero number, got 0"),
+    ("output_rate_hz: 200", "output_rate_hz: 300", r":3: output_rate_hz: expected a whole divisor of 1000 Hz"),
+    ("output_rate_hz: 200", "axles: [front]", r":3: axles: unknown key 'axles' in a road scenario"),
+    ("settle: {at_rest_s: 0.5", "settle: {at_rest_s: 90", r":2: settle\.at_rest_s: expected at most 60 s"),
+])
+def test_bad_road_scenarios_name_line_key_and_value(tmp_path: Path, change: str, line: str, message: str) -> None:
+    with pytest.raises(InputError, match=message):
+        scenario(tmp_path, SHORT.replace(change, line))
+
+
+def test_road_and_rig_keys_stay_apart_and_circle_methods_are_checked(tmp_path: Path) -> None:
+    with pytest.raises(InputError, match=r"throttle: unknown key 'throttle' in a rig scenario"):
+        scenario(tmp_path, "type: rack_step\nthrottle: fixed\ncases: [{rack_mm: 5, hold_s: 1}]\n")
+    circle = "type: steady_state_circular\n{}cases: [{{method: {}, speed_kmh: 50, steering_wheel_deg: 40, duration_s: 5{}}}]\n"
+    with pytest.raises(InputError, match=r"end_speed_kmh: a constant_speed circle keeps its speed"):
+        scenario(tmp_path, circle.format("", "constant_speed", ", end_speed_kmh: 60"))
+    with pytest.raises(InputError, match=r"cases\[0\]: its speed changes during the input; a fixed throttle"):
+        scenario(tmp_path, circle.format("throttle: fixed\n", "constant_steering", ", end_speed_kmh: 60"))
+    with pytest.raises(InputError, match=r"cycles: expected at least 3 cycles"):
+        scenario(tmp_path, "type: sine_steer\ncases: [{speed_kmh: 80, amplitude_deg: 10, frequency_hz: 1, cycles: 2}]\n")
+    rising = scenario(tmp_path, circle.format("", "constant_steering", ", end_speed_kmh: 60"))
+    assert rising.cases[0].speed(np.array([0.0, 100.0])) == pytest.approx([50 / 3.6, 60 / 3.6])
+
+
+def test_a_vehicle_file_names_its_tyre_or_the_road_says_it_needs_one(tmp_path: Path) -> None:
+    text = DEFAULT_VEHICLE.read_text()
+    bad = tmp_path / "car.yaml"
+    bad.write_text(text.replace("property_file: 195_65R15", "property_file: nosuch.tir"))
+    with pytest.raises(InputError, match=r"car\.yaml:\d+: tyre\.property_file: .*nosuch\.tir: no such tyre property file"):
+        load_vehicle(bad)
+
+
+def test_the_steering_wheel_turns_the_wheels_by_the_kinematic_ratio() -> None:
+    vehicle = load_vehicle(DEFAULT_VEHICLE)
+    rig = KCRig(vehicle)
+    rig.settle(0.5)
+    rack = 1e-3
+    before = rig.measure().wheels
+    rig.set_rack(rack)
+    rig.settle(0.5)
+    after = rig.measure().wheels
+    mean = 0.5 * sum(after[c].steer - before[c].steer for c in ("front_left", "front_right"))
+    wheel = 2 * math.pi * rack / vehicle.front.rack_travel_per_rev
+    # the rig's pads carry no aligning torque: the wheels steer as the rigid linkage says
+    assert wheel / mean == pytest.approx(steering_ratio(vehicle), rel=0.02)
+
+
+@pytest.fixture(scope="module")
+def step_run(tmp_path_factory: pytest.TempPathFactory):
+    s = scenario(tmp_path_factory.mktemp("road"), SHORT)
+    return s, simulate(s)
+
+
+def test_left_and_right_step_steers_are_mirror_images(step_run) -> None:
+    _, run = step_run
+    m = road_metrics(run)
+    left, right = m[1], m[2]
+    for key, value in left.items():
+        mirrored = -1.0 if key.startswith(("steady_lateral", "steady_sideslip", "steady_roll")) else 1.0
+        # equal up to round-off: 10 µs on times, 0.001 % on overshoots, 1e-4 relative on the rest
+        tolerance = {"abs": 1e-5} if key.endswith("_s") else {"abs": 1e-3} if key.endswith("_pct") else {"rel": 1e-4}
+        assert right[key] == pytest.approx(mirrored * value, **tolerance), key
+    assert 3.5 < left["steady_lateral_acceleration_mps2"] < 4.5        # the ISO 7401 level the file aims at
+    assert 0.05 < left["yaw_rate_response_time_s"] < left["lateral_acceleration_response_time_s"] < 0.6
+    assert left["steady_roll_deg"] > 0.0 and left["steady_sideslip_deg"] < 0.0   # a left turn rolls right side down
+
+
+def test_in_a_steady_turn_the_lateral_acceleration_is_speed_times_yaw_rate(step_run) -> None:
+    _, run = step_run
+    s = run.signals
+    for case in run.metadata.extra["cases"]:
+        steady = (run.t_s > case["end_s"] - 0.5) & (run.t_s <= case["end_s"])
+        v_r = s["speed"][steady] / 3.6 * np.radians(s["yaw_rate"][steady])
+        np.testing.assert_allclose(s["lateral_acceleration"][steady], v_r, rtol=5e-3)
+        # the fixed throttle keeps the speed within a few per cent through the step
+        during = (run.t_s >= case["input_start_s"]) & (run.t_s <= case["end_s"])
+        assert np.abs(s["speed"][during] / 80.0 - 1.0).max() < 0.03
+
+
+def test_a_rerun_gives_the_same_bits(step_run) -> None:
+    s, run = step_run
+    again = simulate(s, load_vehicle(s.vehicle))
+    for name, values in run.signals.items():
+        np.testing.assert_array_equal(values, again.signals[name], err_msg=name)
+
+
+def test_the_step_gain_and_the_circle_agree_at_the_same_lateral_acceleration(tmp_path: Path, step_run) -> None:
+    circle = scenario(tmp_path, """\
+        type: steady_state_circular
+        settle: {at_rest_s: 0.5, bushings_on_s: 0.2, straight_s: 1.0}
+        output_rate_hz: 50
+        cases: [{method: constant_speed, speed_kmh: 80, steering_wheel_deg: 60, duration_s: 12}]
+    """)
+    run = simulate(circle)
+    m = road_metrics(run)[1]
+    s = run.signals
+    inputs = run.t_s >= run.metadata.extra["cases"][0]["input_start_s"]
+    ay, sw = s["lateral_acceleration"][inputs], s["steering_wheel"][inputs]
+    step = road_metrics(step_run[1])[1]
+    target = step["steady_lateral_acceleration_mps2"]
+    # the steering-wheel angle the quasi-steady circle needs for the step's steady a_y is the step's
+    assert np.interp(target, ay, sw) == pytest.approx(target / step["lateral_acceleration_gain_mps2_per_deg"], rel=0.02)
+    assert m["understeer_gradient_deg_per_g"] > 0.5                  # front-heavy, front-driven: it understeers
+    # the gradients are the slopes of the recorded signals (deg per g)
+    linear = (ay > 0.5) & (ay < 4.0)
+    assert m["roll_gradient_deg_per_g"] == pytest.approx(G * np.polyfit(ay[linear], s["roll"][inputs][linear], 1)[0])
+
+
+def test_a_car_that_spins_stops_and_keeps_its_recording(tmp_path: Path) -> None:
+    # the front-driven car ploughs rather than spins: a tight sideslip limit stands for the spin
+    s = scenario(tmp_path, SHORT.replace("steering_wheel_deg: 38}", "steering_wheel_deg: 300}")
+                 + "    limits: {sideslip_deg: 2}\n")
+    out = tmp_path / "spin.mcap"
+    with pytest.raises(DivergenceError, match=r"case 1 'left'\): body sideslip -?2\.\d deg beyond the limit 2 deg"):
+        run_scenario(s, out)
+    run = load_run(out)
+    assert not run.complete and "diverged" in run.reason
+    assert run.t_s[-1] > run.metadata.extra["cases"][0]["input_start_s"]   # it got into the manoeuvre
+    assert np.all(np.isfinite(run.signals["yaw_rate"]))
+
+
+def test_bushings_on_road_compares_the_cars_and_writes_its_report(tmp_path: Path) -> None:
+    path = tmp_path / "one.yaml"
+    path.write_text(textwrap.dedent(SHORT).replace("      - {label: right, steering_wheel_deg: -38}\n", ""))
+    out = tmp_path / "report"
+    assert vsim(["bushings-on-road", str(path), "-o", str(out)]) == 0
+    rows = list(csv.DictReader(open(out / "metrics.csv")))
+    value = {(r["variant"], r["metric"]): float(r["value"]) for r in rows}
+    assert {r["variant"] for r in rows} == {"bushings linear", "bushings as in the vehicle file", "bushings stvs"}
+    for r in rows:
+        if r["variant"] == "bushings linear":
+            assert float(r["difference"]) == 0.0
+    # the STVS laws relax under the turn's load: the front toe lags behind the linear car's
+    lag = lambda variant: value[(variant, "front_toe_lag_s")]
+    assert lag("bushings stvs") > lag("bushings linear") + 0.005
+    assert (out / "case_1.png").stat().st_size > 10_000
