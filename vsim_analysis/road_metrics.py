@@ -75,7 +75,7 @@ METRICS = (
 
 def is_road(run: Run) -> bool:
     """Whether ``run`` is a run of a road scenario."""
-    return run.metadata.extra["type"] in ROAD_TYPES
+    return run.metadata.extra.get("type") in ROAD_TYPES
 
 
 def input_phase(run: Run) -> int:

@@ -19,6 +19,7 @@ import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
 
+from vsim_analysis.road_metrics import is_road
 from vsim_recordings.run_format import GeomSpec, Run, rotation_matrix
 
 TIMELINE = "sim_time"
@@ -96,7 +97,10 @@ def blueprint(run: Run) -> rrb.Blueprint:
     for x_name, y_name in run.pairs():
         view = rrb.Spatial2DView(origin=_pair_path(x_name, y_name), name=f"{run.label(y_name)} vs {run.label(x_name)}")
         pair_groups.setdefault(run.groups[y_name], []).append(view)
-    columns: list[rrb.Container | rrb.View] = [rrb.Spatial3DView(origin="car", name="car")]
+    # on the road the car leaves the scene's first frame: the eye follows the body, behind and above it
+    eye = (rrb.EyeControls3D(tracking_entity="car/chassis", position=[-8.0, -6.0, 4.0], look_target=[-1.3, 0.0, 0.4])
+           if is_road(run) and "chassis" in run.body_names else None)
+    columns: list[rrb.Container | rrb.View] = [rrb.Spatial3DView(origin="car", name="car", eye_controls=eye)]
     if series:
         columns.append(rrb.Tabs(*series))
     if pair_groups:
