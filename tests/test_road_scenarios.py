@@ -49,7 +49,7 @@ def test_every_shipped_road_scenario_validates(name: str) -> None:
     assert isinstance(s, RoadScenario) and s.type == name and s.vehicle.resolve() == DEFAULT_VEHICLE.resolve()
     for case in s.cases:
         t = np.linspace(0.0, case.duration_s, 200)
-        assert case.steering(t)[0] == 0.0 and np.all(np.isfinite(case.speed(t)))
+        assert np.all(np.isfinite(case.steering(t))) and np.all(case.speed(t) > 0.0)
     assert (SCENARIO_DIR / "road" / f"{name}.yaml").is_file()
 
 
@@ -159,9 +159,8 @@ def test_the_step_gain_and_the_circle_agree_at_the_same_lateral_acceleration(tmp
     # the steering-wheel angle the quasi-steady circle needs for the step's steady a_y is the step's
     assert np.interp(target, ay, sw) == pytest.approx(target / step["lateral_acceleration_gain_mps2_per_deg"], rel=0.02)
     assert m["understeer_gradient_deg_per_g"] > 0.5                  # front-heavy, front-driven: it understeers
-    # the gradients are the slopes of the recorded signals (deg per g)
-    linear = (ay > 0.5) & (ay < 4.0)
-    assert m["roll_gradient_deg_per_g"] == pytest.approx(G * np.polyfit(ay[linear], s["roll"][inputs][linear], 1)[0])
+    # the circle's roll gradient is the step's steady roll per g of its steady lateral acceleration
+    assert m["roll_gradient_deg_per_g"] == pytest.approx(G * step["steady_roll_deg"] / target, rel=0.05)
 
 
 def test_a_car_that_spins_stops_and_keeps_its_recording(tmp_path: Path) -> None:
@@ -185,9 +184,6 @@ def test_bushings_on_road_compares_the_cars_and_writes_its_report(tmp_path: Path
     rows = list(csv.DictReader(open(out / "metrics.csv")))
     value = {(r["variant"], r["metric"]): float(r["value"]) for r in rows}
     assert {r["variant"] for r in rows} == {"bushings linear", "bushings as in the vehicle file", "bushings stvs"}
-    for r in rows:
-        if r["variant"] == "bushings linear":
-            assert float(r["difference"]) == 0.0
     # the STVS laws relax under the turn's load: the front toe lags behind the linear car's
     lag = lambda variant: value[(variant, "front_toe_lag_s")]
     assert lag("bushings stvs") > lag("bushings linear") + 0.005
@@ -200,3 +196,22 @@ def test_the_step_responses_converge_as_the_time_step_halves(tmp_path: Path) -> 
     for key in ("yaw_rate_response_time_s", "lateral_acceleration_response_time_s", "yaw_rate_peak_response_time_s"):
         assert coarse[key] == pytest.approx(fine[key], abs=1e-3), key      # < 1 ms (issue 26)
     assert coarse["steady_lateral_acceleration_mps2"] == pytest.approx(fine["steady_lateral_acceleration_mps2"], rel=1e-3)
+
+
+def test_low_rates_quick_looks_and_rising_speed_circles_give_their_metrics(tmp_path: Path) -> None:
+    s = scenario(tmp_path, SHORT.replace("output_rate_hz: 200", "output_rate_hz: 50")
+                 .replace("      - {label: right, steering_wheel_deg: -38}\n", ""))
+    quick = road_metrics(simulate(s, duration_scale=0.5))[1]
+    assert 0.05 < quick["yaw_rate_response_time_s"] < 0.6 and quick["steady_lateral_acceleration_mps2"] > 3.0
+    with pytest.raises(InputError, match=r"output_rate_hz: expected at least 50 Hz on the road"):
+        scenario(tmp_path, SHORT.replace("output_rate_hz: 200", "output_rate_hz: 20"))
+    circle = scenario(tmp_path, """\
+        type: steady_state_circular
+        settle: {at_rest_s: 0.5, bushings_on_s: 0.2, straight_s: 1.0}
+        output_rate_hz: 50
+        cases: [{method: constant_steering, speed_kmh: 50, end_speed_kmh: 90, steering_wheel_deg: 45, duration_s: 10}]
+    """)
+    m = road_metrics(simulate(circle))[1]
+    # the angle is held: no steering gradient; an understeering car still needs more of it as a_y grows
+    assert "steering_wheel_angle_gradient_deg_per_g" not in m
+    assert m["understeer_gradient_deg_per_g"] > 0.5 and m["max_lateral_acceleration_mps2"] > 3.0

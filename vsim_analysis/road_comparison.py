@@ -34,14 +34,16 @@ class Variant:
 def variant_plan(scenario: RoadScenario, extended: Sequence[Path] = ()
                  ) -> list[tuple[str, RoadScenario, VehicleDefinition]]:
     """The cars to compare: (label, scenario, vehicle) with the bushings linear first (the
-    reference), then as defined, every direction STVS (unless that is how they are defined), then
-    each vehicle file of ``extended`` with its own bushings."""
+    reference), then as defined and every direction STVS (each unless it is one of those before),
+    then each vehicle file of ``extended`` (once, labelled by its path) with its own bushings."""
     base = load_vehicle(scenario.vehicle)
     defined = f"bushings {scenario.bushing_model}" if scenario.bushing_model else "bushings as in the vehicle file"
-    plan = [("bushings linear", replace(scenario, bushing_model="linear"), base), (defined, scenario, base)]
+    plan = [("bushings linear", replace(scenario, bushing_model="linear"), base)]
+    if scenario.bushing_model != "linear":
+        plan.append((defined, scenario, base))
     if scenario.bushing_model != "stvs":
         plan.append(("bushings stvs", replace(scenario, bushing_model="stvs"), base))
-    plan += [(path.name, replace(scenario, bushing_model=None), load_vehicle(path)) for path in extended]
+    plan += [(str(path), replace(scenario, bushing_model=None), load_vehicle(path)) for path in dict.fromkeys(extended)]
     return plan
 
 

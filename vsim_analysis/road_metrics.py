@@ -29,7 +29,7 @@ from typing import Any, Mapping
 import numpy as np
 from scipy.signal import butter, filtfilt
 
-from vehicle.scenarios.road_scenario import DEFAULT_RISE_TIME_S, ROAD_TYPES
+from vehicle.scenarios.road_scenario import CIRCLE_STEER_IN_S, DEFAULT_RISE_TIME_S, ROAD_TYPES
 from vehicle.scenarios.schedule import PHASES, ROAD_PHASES
 from vsim_recordings.run_format import Run
 
@@ -108,15 +108,22 @@ def step_response(t: np.ndarray, x: np.ndarray, y: np.ndarray, steady_from: floa
     t90 = _crossing(t[after], sign_y * y[after], 0.9 * abs(steady))
     if t90 is None:
         return None
-    t_peak, peak = _extreme(t, sign_y * y * after)
-    return {"response_time_s": t90 - t50, "peak_response_time_s": t_peak - t50,
-            "overshoot_pct": 100.0 * (sign_y * peak / steady - 1.0), "gain": steady / step, "steady": steady}
+    out = {"response_time_s": t90 - t50, "gain": steady / step, "steady": steady, "overshoot_pct": 0.0}
+    peak = _first_peak(t, sign_y * y, t90)
+    if peak is not None and peak[1] > abs(steady):
+        out |= {"peak_response_time_s": peak[0] - t50, "overshoot_pct": 100.0 * (peak[1] / abs(steady) - 1.0)}
+    return out
 
 
-def _extreme(t: np.ndarray, y: np.ndarray) -> tuple[float, float]:
-    """Time and value of the largest sample of ``y``, refined by the parabola through it and its
-    neighbours (uniform sampling), so that neither moves by whole sample intervals."""
-    k = int(np.argmax(y))
+def _first_peak(t: np.ndarray, y: np.ndarray, after_s: float) -> tuple[float, float] | None:
+    """Time and value of the first local maximum of ``y`` after ``after_s``, refined by the parabola
+    through it and its neighbours (uniform sampling) so that neither moves by whole sample
+    intervals; None when ``y`` only rises."""
+    start = int(np.searchsorted(t, after_s))
+    falls = np.flatnonzero(np.diff(y[start:]) < 0.0)
+    if not falls.size:
+        return None
+    k = start + int(falls[0])
     if 0 < k < len(y) - 1:
         a, b, c = y[k - 1], y[k], y[k + 1]
         curvature = a - 2.0 * b + c
@@ -160,7 +167,7 @@ def _steps(run: Run, case: Mapping[str, Any]) -> list[tuple[float, float]]:
 def low_pass(y: np.ndarray, rate_hz: float) -> np.ndarray:
     """``y`` sampled at ``rate_hz`` filtered by :data:`RESPONSE_FILTER_HZ`'s zero-phase low-pass."""
     b, a = butter(2, min(RESPONSE_FILTER_HZ, 0.4 * rate_hz), fs=rate_hz)
-    return filtfilt(b, a, y)
+    return filtfilt(b, a, y, padlen=min(3 * len(a), len(y) - 1)) if len(y) > 1 else y
 
 
 def _step_metrics(run: Run, start: float, end: float) -> dict[str, float]:
@@ -195,8 +202,8 @@ def _step_metrics(run: Run, start: float, end: float) -> dict[str, float]:
 
 def _sine_metrics(run: Run, case: Mapping[str, Any]) -> dict[str, float]:
     f = case["parameters"]["frequency_hz"] / run.metadata.extra["duration_scale"]
-    start = case["input_start_s"] + 1.0 / f     # after the first cycle
-    mask = _window(run, start, case["end_s"])
+    start = case["input_start_s"] + 1.0 / f     # after the first cycle, whole cycles only
+    mask = _window(run, start, case["input_start_s"] + case["cycles"] / f)
     t = run.t_s[mask] - case["input_start_s"]
     x = first_harmonic(t, run.signals["steering_wheel"][mask], f)
     out = {"frequency_hz": f}
@@ -210,7 +217,10 @@ def _sine_metrics(run: Run, case: Mapping[str, Any]) -> dict[str, float]:
 
 def _circle_metrics(run: Run, case: Mapping[str, Any]) -> dict[str, float]:
     extra = run.metadata.extra
-    mask = _window(run, case["input_start_s"], case["end_s"])
+    constant_steering = case["parameters"]["method"] == "constant_steering"
+    # a constant-steering circle turns its wheel in first: its quasi-steady states come after
+    start = case["input_start_s"] + (2.0 * CIRCLE_STEER_IN_S * extra["duration_scale"] if constant_steering else 0.0)
+    mask = _window(run, start, case["end_s"])
     s = {k: run.signals[k][mask] for k in ("lateral_acceleration", "steering_wheel", "yaw_rate", "speed", "roll",
                                           "sideslip")}
     ay = s["lateral_acceleration"]
@@ -219,9 +229,12 @@ def _circle_metrics(run: Run, case: Mapping[str, Any]) -> dict[str, float]:
     curvature = np.radians(s["yaw_rate"]) / speed                           # 1/R = r/V [1/m]
     understeer = s["steering_wheel"] / extra["steering_ratio"] - np.degrees(extra["wheelbase_m"] * curvature)
     g = lambda y: G * _slope(ay[linear], y[linear])
-    return {"steering_wheel_angle_gradient_deg_per_g": g(s["steering_wheel"]), "understeer_gradient_deg_per_g": g(understeer),
-            "roll_gradient_deg_per_g": g(s["roll"]), "sideslip_gradient_deg_per_g": g(s["sideslip"]),
-            "max_lateral_acceleration_mps2": float(np.max(np.abs(ay))) if ay.size else float("nan")}
+    out = {"understeer_gradient_deg_per_g": g(understeer), "roll_gradient_deg_per_g": g(s["roll"]),
+           "sideslip_gradient_deg_per_g": g(s["sideslip"]),
+           "max_lateral_acceleration_mps2": float(np.max(np.abs(ay))) if ay.size else float("nan")}
+    if not constant_steering:   # the angle held has no gradient
+        out["steering_wheel_angle_gradient_deg_per_g"] = g(s["steering_wheel"])
+    return out
 
 
 def road_metrics(run: Run) -> dict[int, dict[str, float]]:
@@ -247,8 +260,11 @@ def road_metrics(run: Run) -> dict[int, dict[str, float]]:
 
 def bandwidth_hz(metrics: Mapping[int, Mapping[str, float]], response: str = "yaw_rate") -> float | None:
     """The lowest frequency at which ``response``'s phase lag reaches 45° over sine cases'
-    ``metrics`` (linear between their frequencies), or None when it does not within them."""
+    ``metrics`` (of one speed and amplitude; linear between their frequencies); 0 when it lags
+    more already at the lowest, None when it does not within them."""
     rows = sorted((m["frequency_hz"], m[f"{response}_phase_deg"]) for m in metrics.values() if "frequency_hz" in m)
+    if rows and rows[0][1] <= -45.0:
+        return 0.0
     for (f0, p0), (f1, p1) in zip(rows, rows[1:]):
         if p0 > -45.0 >= p1:
             return f0 + (-45.0 - p0) * (f1 - f0) / (p1 - p0)

@@ -99,11 +99,16 @@ def _road_table(run: Run) -> list[str]:
         if any(key in m for m in metrics.values()):
             rows.append(f"  {key:<54} {unit:<9}" + "".join(f" {m[key]:16.5g}" if key in m else f" {'-':>16}"
                                                            for m in metrics.values()))
+    sines = [c["parameters"] for c in cases(run)]
     if run.metadata.extra["type"] == "sine_steer":
+        if len({(p["speed_kmh"], p["amplitude_deg"]) for p in sines}) > 1:
+            rows.append("  bandwidth: none (the cases differ in speed or amplitude)")
+            return rows
         for response in RESPONSES:
             f = bandwidth_hz(metrics, response)
-            rows.append(f"  {response} bandwidth (45 deg phase lag): " + (f"{f:.3f} Hz" if f is not None else
-                                                                          "beyond the frequencies run"))
+            where = ("beyond the frequencies run" if f is None else "below the lowest frequency run" if f == 0.0
+                     else f"{f:.3f} Hz")
+            rows.append(f"  {response} bandwidth (45 deg phase lag): {where}")
     return rows
 
 

@@ -52,6 +52,8 @@ MAX_SPEED_KMH = 250.0
 MAX_STEERING_DEG, MAX_SINE_HZ = 720.0, 5.0
 #: ISO 7401's longest steering ramp [s] and the ramp when a file does not say.
 MAX_RISE_TIME_S, DEFAULT_RISE_TIME_S = 0.15, 0.1
+#: Lowest output rate of a road run [Hz]: the step responses are low-pass filtered at 10 Hz.
+MIN_OUTPUT_RATE_HZ = 50.0
 #: Time the steering takes to reach its angle before a constant-steering circle speeds up [s].
 CIRCLE_STEER_IN_S = 1.0
 
@@ -150,8 +152,11 @@ def _case(f: Fields, kind: str) -> RoadCase:
     if kind == "step_steer":
         steering = _steps(_rise(f), [(_angle(f, "steering_wheel_deg"), hold("hold_s"))])
     elif kind == "double_step_steer":
-        first = _angle(f, "first_deg")
-        steering = _steps(_rise(f), [(first, hold("rest_s")), (first + _angle(f, "second_deg"), hold("hold_s"))])
+        first, second = _angle(f, "first_deg"), _angle(f, "second_deg")
+        if abs(first + second) > MAX_STEERING_DEG * DEG:
+            raise f.fail("second_deg", f"the two steps add up to {math.degrees(first + second):g} deg; expected at "
+                                       f"most {MAX_STEERING_DEG:g} deg in magnitude")
+        steering = _steps(_rise(f), [(first, hold("rest_s")), (first + second, hold("hold_s"))])
     elif kind == "sine_steer":
         frequency = f.number("frequency_hz", positive=True, at_most=MAX_SINE_HZ, unit="Hz")
         cycles = int(f.number("cycles", 5, positive=True, integer=True, at_most=MAX_INPUT_S * frequency))
@@ -174,6 +179,14 @@ def _case(f: Fields, kind: str) -> RoadCase:
             ramp = (0.0, 2.0 * CIRCLE_STEER_IN_S, 2.0 * CIRCLE_STEER_IN_S + duration)
             return RoadCase(label, params, speed, steering, Waveform(ramp, (speed, speed, end)))
     return RoadCase(label, params, speed, steering, Waveform((0.0, steering.duration_s), (speed, speed)), cycles)
+
+
+def _road_rate(top: Fields) -> float:
+    rate = output_rate(top)
+    if rate < MIN_OUTPUT_RATE_HZ:
+        raise top.fail("output_rate_hz", f"expected at least {MIN_OUTPUT_RATE_HZ:g} Hz on the road (the responses "
+                                         f"are filtered at 10 Hz and timed to the millisecond), got {rate:g}")
+    return rate
 
 
 def parse_road_scenario(top: Fields, kind: str, path: Path, text: str) -> RoadScenario:
@@ -204,7 +217,7 @@ def parse_road_scenario(top: Fields, kind: str, path: Path, text: str) -> RoadSc
     return RoadScenario(
         name=scenario_name(top, path), description=top.text("description", ""), path=path, text=text, type=kind,
         vehicle=vehicle_file(top, path), bushing_model=top.choice("bushings", BUSHING_MODELS, None),
-        output_rate_hz=output_rate(top), throttle=throttle, settle=settle, limits=limits, cases=tuple(cases))
+        output_rate_hz=_road_rate(top), throttle=throttle, settle=settle, limits=limits, cases=tuple(cases))
 
 
 def steering_and_speed(case: RoadCase, t_s: np.ndarray, throttle: str) -> tuple[np.ndarray, np.ndarray]:

@@ -83,8 +83,8 @@ class RoadOutputs(SuspensionOutputs):
     yaw_rate: float                          #: [rad/s], to the left positive
     longitudinal_acceleration: float         #: [m/s²], in the road's plane
     lateral_acceleration: float              #: [m/s²], in the road's plane, to the left positive
-    sideslip: float                          #: atan(lateral / forward speed) [rad]
-    rack: float                              #: rack displacement [m], to the left positive
+    sideslip: float                          #: atan2(lateral, forward speed) [rad] (0 below 0.5 m/s)
+    rack: float                              #: rack displacement from design [m], to the left positive
     drive_force: float                       #: the driver's drive force [N]
     wheels: dict[str, RoadWheel]
 

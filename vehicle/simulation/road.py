@@ -43,6 +43,8 @@ _SIDE = {"left": 1.0, "right": -1.0}
 #: The driver's speed loop: natural frequency [Hz] and damping ratio of the car's speed under the PI
 #: controller (slow beside the handling, which it must not steer; fast beside the speed ramps).
 SPEED_LOOP_HZ, SPEED_LOOP_DAMPING = 0.5, 1.0
+#: Below this speed [m/s] the body's sideslip is reported as 0 (at rest its direction is noise).
+SIDESLIP_MIN_SPEED_MPS = 0.5
 
 
 class RoadCar(MountedCar):
@@ -67,6 +69,7 @@ class RoadCar(MountedCar):
         spin = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, f"spin_{c}") for c in CORNERS]
         self.spin_dof = m.jnt_dofadr[spin].astype(np.int64)
         self.chassis = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "chassis")
+        self.rack_qpos = int(m.jnt_qposadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, "rack")])
         self.chassis_dof = int(m.jnt_dofadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, "chassis_free")])
         #: Lagged slips (κ', tan α') of each wheel and its signals (vsim_tyres.road_contact.SIGNALS).
         self.tyre_state = np.zeros((len(CORNERS), N_STATE))
@@ -176,6 +179,6 @@ class RoadCar(MountedCar):
             position=(float(d.xipos[self.chassis, 0]), float(d.xipos[self.chassis, 1])),
             yaw=yaw, roll=roll, pitch=pitch, speed=vx, lateral_speed=vy, yaw_rate=float(omega[2]),
             longitudinal_acceleration=c * accel[0] + s * accel[1], lateral_acceleration=-s * accel[0] + c * accel[1],
-            sideslip=math.atan2(vy, vx) if vx > 0.0 else 0.0,
-            rack=float(m.eq_data[self.rack_eq, 0]), drive_force=float(self.driver_state[1]), wheels=wheels,
+            sideslip=math.atan2(vy, vx) if math.hypot(vx, vy) > SIDESLIP_MIN_SPEED_MPS else 0.0,
+            rack=float(d.qpos[self.rack_qpos]), drive_force=float(self.driver_state[1]), wheels=wheels,
             **self.suspension_outputs(self._eq_first_rows()))
