@@ -13,18 +13,22 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from vehicle.model.elements import BuildOptions
 from vehicle.model.kinematics import steering_ratio
 from vehicle.model.vehicle_file import load_vehicle
 from vehicle.scenarios.road_scenario import ROAD_TYPES, RoadScenario
 from vehicle.scenarios.scenario_file import load_scenario
 from vehicle.simulation.rig import KCRig
+from vehicle.simulation.road import RoadCar
 from vehicle.simulation.runner import DivergenceError
+from vsim_analysis.kc_test import vehicle_kc
 from vsim_analysis.road_metrics import G, road_metrics
 from vsim_cli.main import main as vsim
 from vsim_core.errors import InputError
 from vsim_core.shipped import DEFAULT_VEHICLE, SCENARIO_DIR
 from vsim_recordings.recorder import run_scenario, simulate
 from vsim_recordings.run_reader import load_run
+from vsim_tyres import magic_formula as mf
 
 SHORT = """\
     type: step_steer
@@ -142,14 +146,18 @@ def test_a_rerun_gives_the_same_bits(step_run) -> None:
         np.testing.assert_array_equal(values, again.signals[name], err_msg=name)
 
 
-def test_the_step_gain_and_the_circle_agree_at_the_same_lateral_acceleration(tmp_path: Path, step_run) -> None:
-    circle = scenario(tmp_path, """\
+@pytest.fixture(scope="module")
+def circle_run(tmp_path_factory: pytest.TempPathFactory):
+    return simulate(scenario(tmp_path_factory.mktemp("circle"), """\
         type: steady_state_circular
         settle: {at_rest_s: 0.5, bushings_on_s: 0.2, straight_s: 1.0}
         output_rate_hz: 50
         cases: [{method: constant_speed, speed_kmh: 80, steering_wheel_deg: 60, duration_s: 12}]
-    """)
-    run = simulate(circle)
+    """))
+
+
+def test_the_step_gain_and_the_circle_agree_at_the_same_lateral_acceleration(step_run, circle_run) -> None:
+    run = circle_run
     m = road_metrics(run)[1]
     s = run.signals
     inputs = run.t_s >= run.metadata.extra["cases"][0]["input_start_s"]
@@ -215,3 +223,48 @@ def test_low_rates_quick_looks_and_rising_speed_circles_give_their_metrics(tmp_p
     # the angle is held: no steering gradient; an understeering car still needs more of it as a_y grows
     assert "steering_wheel_angle_gradient_deg_per_g" not in m
     assert m["understeer_gradient_deg_per_g"] > 0.5 and m["max_lateral_acceleration_mps2"] > 3.0
+
+
+def test_the_understeer_gradient_is_the_bicycle_models_with_the_rigs_compliances(circle_run) -> None:
+    """The linear understeer budget (bicycle model): the axles' slip angles from the tyres'
+    cornering stiffnesses at their static loads, less the camber thrust of the wheels' lean, and
+    the compliance, roll and aligning-torque steer the K&C rig measures, give the road car's
+    understeer gradient at small lateral acceleration within 10 % (the rest: combined slip and the
+    drive force, the steering arms' small angles)."""
+    run = circle_run
+    extra, s = run.metadata.extra, run.signals
+    c = extra["cases"][0]
+    inputs = (run.t_s >= c["input_start_s"]) & (run.t_s <= c["end_s"])
+    ay = s["lateral_acceleration"][inputs]
+    low = (ay > 0.2) & (ay < 1.0)                                     # the linear limit
+    curvature = np.radians(s["yaw_rate"][inputs]) / (s["speed"][inputs] / 3.6)
+    understeer = s["steering_wheel"][inputs] / extra["steering_ratio"] - np.degrees(extra["wheelbase_m"] * curvature)
+    simulated = G * np.polyfit(ay[low], understeer[low], 1)[0]
+    roll_per_ay = np.polyfit(ay[low], s["roll"][inputs][low], 1)[0]    # deg per m/s², the car's own
+
+    vehicle = load_vehicle(DEFAULT_VEHICLE)
+    kc = vehicle_kc(vehicle, BuildOptions())
+    car = RoadCar(vehicle)
+    car.set_brakes(500.0)
+    car.step(3000)
+    fz, gamma = car.tyre_signals[:, 0], car.tyre_signals[:, 7]
+    tyre = car.tyres[0]
+    fy = lambda f, a, g: float(mf.evaluate(tyre, f, 0.0, a, g, 22.2)["Fy"])
+    mz = lambda f, a, g: float(mf.evaluate(tyre, f, 0.0, a, g, 22.2)["Mz"])
+    budget = 0.0     # deg per m/s² of lateral acceleration
+    for axle, w, sign in (("front", 0, 1.0), ("rear", 2, -1.0)):
+        f, g = fz[w], gamma[w]
+        cornering = 2.0 * abs(fy(f, 1e-4, g) - fy(f, -1e-4, g)) / 2e-4          # per axle [N/rad]
+        camber = abs(fy(f, 0.0, g + 1e-4) - fy(f, 0.0, g - 1e-4)) / 2e-4         # per wheel [N/rad]
+        trail = abs((mz(f, 0.01, g) - mz(f, -0.01, g)) / (fy(f, 0.01, g) - fy(f, -0.01, g)))
+        force = (fz[w] + fz[w + 1]) / G                                          # axle Fy per m/s² [N]
+        k = kc[axle]
+        # both wheels lean out of the turn with the roll and the lateral force: their camber thrust
+        # points outward and the slip must make up for it
+        lean = np.radians(k["roll_camber_deg_per_deg"] * roll_per_ay + k["lateral_force_compliance_camber_deg_per_kn"]
+                          * force / 2e3)
+        slip = np.degrees((force + 2.0 * camber * lean) / cornering)
+        steer = (k["lateral_force_compliance_steer_deg_per_kn"] * force / 2e3 + k["roll_steer_deg_per_deg"] * roll_per_ay
+                 - k["aligning_torque_compliance_steer_deg_per_knm"] * trail * force / 2e3)
+        budget += sign * (slip - steer)
+    assert simulated == pytest.approx(G * budget, rel=0.10)
