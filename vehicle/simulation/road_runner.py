@@ -8,8 +8,9 @@ straight with the speed held; 3, the input: the steering wheel and the driver's 
 scenario says. The car runs in the world's x direction at the start of phase 2.
 
 A run stops with :class:`~vehicle.simulation.runner.DivergenceError` when the suspension leaves
-its valid range (as on the rig), the body's sideslip exceeds the scenario's limit (the car spun)
-or a wheel stays off the ground longer than allowed; the sample that shows it is yielded first.
+its valid range (as on the rig) or, once at speed, when the body's sideslip exceeds the
+scenario's limit (the car spun) or a wheel stays off the ground longer than allowed; the sample
+that shows it is yielded first.
 """
 
 from __future__ import annotations
