@@ -5,11 +5,13 @@ response time, a second-order system's overshoot, the first harmonic's gain and 
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
 
-from vsim_analysis.road_metrics import bandwidth_hz, first_harmonic, step_response
+from vsim_analysis.road_metrics import bandwidth_hz, first_harmonic, road_metrics, step_response
+from vsim_recordings.run_format import Run, RunMetadata
 
 
 @pytest.mark.parametrize("tau, rise", [(0.05, 0.1), (0.2, 0.01), (0.13, 0.15)])
@@ -25,7 +27,7 @@ def test_a_first_order_lag_responds_in_tau_ln10_after_half_the_ramp(tau: float, 
     t90 = t[np.argmax(y / (k * a) >= 0.9)]
     assert r["gain"] == pytest.approx(k, rel=1e-5)   # the lag has died out to e^{-2.3/τ}
     assert r["response_time_s"] == pytest.approx(t90 - t50, abs=1.1e-3)
-    assert r["overshoot_pct"] == pytest.approx(0.0, abs=1e-3)     # a first-order lag does not overshoot
+    assert r["overshoot_pct"] == 0.0 and "peak_response_time_s" not in r    # a first-order lag does not overshoot
     if rise < 0.1 * tau:
         assert r["response_time_s"] == pytest.approx(tau * math.log(10.0), rel=0.05)
 
@@ -57,3 +59,36 @@ def test_the_first_harmonic_and_the_bandwidth_of_a_first_order_lag() -> None:
     # 45° of lag at ω τ = 1; linear interpolation between 1.5 and 2 Hz of atan is within 2 %
     assert bandwidth_hz(metrics) == pytest.approx(1.0 / (2 * math.pi * tau), rel=0.02)
     assert bandwidth_hz({0: metrics[0]}) is None
+
+
+def test_a_recorded_step_of_first_order_responses_gives_their_iso_metrics() -> None:
+    """road_metrics on a recording whose responses are exact first-order lags of the steering ramp
+    (no overshoot: no peak response time), with a vibration above the handling band that the
+    zero-phase filter removes."""
+    rate, start, rise, hold, tau = 200.0, 1.0, 0.1, 3.0, 0.08
+    t = np.arange(0.0, start + rise + hold + 1e-9, 1.0 / rate)
+    s = np.clip((t - start) / rise, 0.0, 1.0)
+    steering = 30.0 * s
+    # exact lag of the ramp: y' = (s − y)/τ, integrated finely then sampled
+    fine = np.arange(0.0, t[-1] + 1e-9, 1e-5)
+    lag = np.zeros_like(fine)
+    ramp = np.clip((fine - start) / rise, 0.0, 1.0)
+    for i in range(1, len(fine)):
+        lag[i] = lag[i - 1] + (ramp[i - 1] - lag[i - 1]) * (1e-5 / tau)
+    y = np.interp(t, fine, lag)
+    signals = {"steering_wheel": steering, "yaw_rate": 10.0 * y + 0.2 * np.sin(2 * math.pi * 40.0 * t),
+               "lateral_acceleration": 4.0 * y, "sideslip": -0.2 * y, "roll": 1.7 * y,
+               "toe_fl": 0.2 - 0.05 * y, "toe_fr": 0.2 - 0.05 * y}
+    case = {"case": 1, "label": "left", "parameters": {"speed_kmh": 80.0, "steering_wheel_deg": 30.0},
+            "start_s": 0.0, "input_start_s": start, "end_s": float(t[-1]), "cycles": 1}
+    extra = {"type": "step_steer", "duration_scale": 1.0, "output_rate_hz": rate, "cases": [case]}
+    run = Run(path=Path("synthetic"), t_s=t, signals=signals, units={}, groups={}, specs=[], body_names=[],
+              body_pos=np.empty((len(t), 0, 3)), body_quat_wxyz=np.empty((len(t), 0, 4)), geometry=[],
+              metadata=RunMetadata(extra=extra), complete=True, reason="")
+    m = road_metrics(run)[1]
+    t90 = fine[np.argmax(lag >= 0.9)] - (start + rise / 2)
+    for name in ("yaw_rate", "lateral_acceleration"):
+        assert m[f"{name}_response_time_s"] == pytest.approx(t90, abs=1e-3)
+        assert m[f"{name}_overshoot_pct"] == 0.0 and f"{name}_peak_response_time_s" not in m
+    assert m["yaw_rate_gain_per_s"] == pytest.approx(10.0 / 30.0, rel=1e-3)
+    assert m["steady_roll_deg"] == pytest.approx(1.7, rel=1e-3) and m["front_toe_lag_s"] == pytest.approx(t90, abs=1e-3)

@@ -8,7 +8,8 @@ ISO 7401 for the step and sinusoidal steering inputs, ISO 4138 for steady-state 
   the means over the last second of the hold (the last quarter of a shorter hold); **gains** are
   steady values per degree of steering-wheel angle. A step on top of another is measured from the
   values just before it. The responses are low-pass filtered first, zero phase (2nd-order
-  Butterworth forwards and backwards at :data:`RESPONSE_FILTER_HZ`): the instantaneous
+  Butterworth forwards and backwards at :data:`RESPONSE_FILTER_HZ`, from :data:`FILTER_LEAD_S`
+  before the step); an overshoot below :data:`MIN_OVERSHOOT` does not count. The instantaneous
   acceleration of the body carries the suspension's and tyres' vibrations, which would move a
   90 % crossing by milliseconds without moving the handling response.
 * Sine (``sine_steer``): the responses' first harmonic at the input frequency over the cycles after
@@ -42,6 +43,12 @@ LINEAR_RANGE_MPS2 = (0.5, 4.0)
 #: Cut-off of the zero-phase low-pass filter of the step responses [Hz] (the handling band is below
 #: 5 Hz; at most 0.4 × the output rate).
 RESPONSE_FILTER_HZ = 10.0
+#: Smallest overshoot counted (a fraction of the steady value): below it, a response that settles
+#: with numerical ripples has no peak.
+MIN_OVERSHOOT = 1e-3
+#: Time before a step over which its responses are filtered too [s], so that the filter's start-up
+#: lies well before the step.
+FILTER_LEAD_S = 0.5
 #: Length of the window of steady values at the end of a hold [s].
 STEADY_WINDOW_S = 1.0
 
@@ -110,7 +117,7 @@ def step_response(t: np.ndarray, x: np.ndarray, y: np.ndarray, steady_from: floa
         return None
     out = {"response_time_s": t90 - t50, "gain": steady / step, "steady": steady, "overshoot_pct": 0.0}
     peak = _first_peak(t, sign_y * y, t90)
-    if peak is not None and peak[1] > abs(steady):
+    if peak is not None and peak[1] > abs(steady) * (1.0 + MIN_OVERSHOOT):
         out |= {"peak_response_time_s": peak[0] - t50, "overshoot_pct": 100.0 * (peak[1] / abs(steady) - 1.0)}
     return out
 
@@ -170,23 +177,34 @@ def low_pass(y: np.ndarray, rate_hz: float) -> np.ndarray:
     return filtfilt(b, a, y, padlen=min(3 * len(a), len(y) - 1)) if len(y) > 1 else y
 
 
-def _step_metrics(run: Run, start: float, end: float) -> dict[str, float]:
-    # the values just before the step are its zero: a second step is measured on top of the first
-    before = max(int(np.searchsorted(run.t_s, start - 1e-9)) - 1, 0)
+def _step_metrics(run: Run, start: float, end: float, case_start: float) -> dict[str, float]:
+    # responses are filtered from FILTER_LEAD_S before the step (within its case) and measured from
+    # their mean there: a second step is measured on top of the first
+    lead = _window(run, max(start - FILTER_LEAD_S, case_start), end)
+    before = max(int(np.searchsorted(run.t_s, start - 1e-9)) - 1, int(np.argmax(lead)))
     mask = _window(run, start, end)
     mask[before] = True
+    settled = lead & (run.t_s < start - 1e-9)
+    settled[before] = True
+    inside = mask[lead]
     t = run.t_s[mask]
     steady_from = max(t[-1] - STEADY_WINDOW_S, t[0] + 0.75 * (t[-1] - t[0]))
     rate = run.metadata.extra["output_rate_hz"]
-    zero = lambda y: (lambda f: f - f[0])(low_pass(y[mask], rate))     # a response, filtered
+
+    def zero(y: np.ndarray) -> np.ndarray:
+        """The response ``y`` over the step, filtered, from its mean before the step (unfiltered:
+        the zero-phase filter already feels the step there)."""
+        return low_pass(y[lead], rate)[inside] - float(np.mean(y[settled]))
+
     x = run.signals["steering_wheel"][mask] - run.signals["steering_wheel"][before]
     out: dict[str, float] = {}
     for name in RESPONSES:
         r = step_response(t, x, zero(run.signals[name]), steady_from)
         if r is None:
             continue
-        out |= {f"{name}_response_time_s": r["response_time_s"], f"{name}_peak_response_time_s": r["peak_response_time_s"],
-                f"{name}_overshoot_pct": r["overshoot_pct"]}
+        out |= {f"{name}_response_time_s": r["response_time_s"], f"{name}_overshoot_pct": r["overshoot_pct"]}
+        if "peak_response_time_s" in r:     # none without an overshoot
+            out[f"{name}_peak_response_time_s"] = r["peak_response_time_s"]
         out[f"{name}_gain_per_s" if name == "yaw_rate" else f"{name}_gain_mps2_per_deg"] = r["gain"]
     steady = t >= steady_from
     for name, key in (("lateral_acceleration", "steady_lateral_acceleration_mps2"), ("sideslip", "steady_sideslip_deg"),
@@ -249,7 +267,8 @@ def road_metrics(run: Run) -> dict[int, dict[str, float]]:
         if kind in ("step_steer", "double_step_steer"):
             metrics: dict[str, float] = {}
             for k, (start, end) in enumerate(_steps(run, case)):
-                metrics |= {("second_" if k else "") + key: v for key, v in _step_metrics(run, start, end).items()}
+                metrics |= {("second_" if k else "") + key: v
+                            for key, v in _step_metrics(run, start, end, case["start_s"]).items()}
         elif kind == "sine_steer":
             metrics = _sine_metrics(run, case)
         else:
