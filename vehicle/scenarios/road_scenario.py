@@ -167,9 +167,9 @@ def _case(f: Fields, kind: str) -> RoadCase:
     else:
         method = f.choice("method", METHODS)
         duration = hold("duration_s")
-        unused = "end_speed_kmh" if method == "constant_speed" else None
-        if unused and f.has(unused):
-            raise f.fail(unused, f"a {method} circle keeps its speed; give end_speed_kmh only with constant_steering")
+        if method == "constant_speed" and f.has("end_speed_kmh"):
+            raise f.fail("end_speed_kmh", "a constant_speed circle keeps its speed; give end_speed_kmh only with "
+                                          "constant_steering")
         angle = _angle(f, "steering_wheel_deg")
         if method == "constant_speed":
             steering = Waveform((0.0, duration), (0.0, angle))
