@@ -36,8 +36,8 @@ SHORT = """\
     output_rate_hz: 200
     defaults: {speed_kmh: 80, hold_s: 2.5, rise_time_s: 0.1}
     cases:
-      - {label: left, steering_wheel_deg: 38}
-      - {label: right, steering_wheel_deg: -38}
+      - {label: left, steering_wheel_deg: 34}
+      - {label: right, steering_wheel_deg: -34}
 """
 
 
@@ -60,7 +60,7 @@ def test_every_shipped_road_scenario_validates(name: str) -> None:
 @pytest.mark.parametrize("change, line, message", [
     ("rise_time_s: 0.1", "rise_time_s: 0.2", r":4: defaults\.rise_time_s: expected a steering ramp of at most 0\.15 s \(ISO 7401\), got 0\.2"),
     ("speed_kmh: 80", "speed_kmh: 400", r":4: defaults\.speed_kmh: expected at most 250 km/h in magnitude, got 400"),
-    ("steering_wheel_deg: 38}", "steering_wheel_deg: 0}", r":6: cases\[0\]\.steering_wheel_deg: expected a non-zero number, got 0"),
+    ("steering_wheel_deg: 34}", "steering_wheel_deg: 0}", r":6: cases\[0\]\.steering_wheel_deg: expected a non-zero number, got 0"),
     ("output_rate_hz: 200", "output_rate_hz: 300", r":3: output_rate_hz: expected a whole divisor of 1000 Hz"),
     ("output_rate_hz: 200", "axles: [front]", r":3: axles: unknown key 'axles' in a road scenario"),
     ("settle: {at_rest_s: 0.5", "settle: {at_rest_s: 90", r":2: settle\.at_rest_s: expected at most 60 s"),
@@ -173,7 +173,7 @@ def test_the_step_gain_and_the_circle_agree_at_the_same_lateral_acceleration(ste
 
 def test_a_car_that_spins_stops_and_keeps_its_recording(tmp_path: Path) -> None:
     # the front-driven car ploughs rather than spins: a tight sideslip limit stands for the spin
-    s = scenario(tmp_path, SHORT.replace("steering_wheel_deg: 38}", "steering_wheel_deg: 300}")
+    s = scenario(tmp_path, SHORT.replace("steering_wheel_deg: 34}", "steering_wheel_deg: 120}")
                  + "    limits: {sideslip_deg: 2}\n")
     out = tmp_path / "spin.mcap"
     with pytest.raises(DivergenceError, match=r"case 1 'left'\): body sideslip -?2\.\d deg beyond the limit 2 deg"):
@@ -186,7 +186,7 @@ def test_a_car_that_spins_stops_and_keeps_its_recording(tmp_path: Path) -> None:
 
 def test_bushings_on_road_compares_the_cars_and_writes_its_report(tmp_path: Path) -> None:
     path = tmp_path / "one.yaml"
-    path.write_text(textwrap.dedent(SHORT).replace("      - {label: right, steering_wheel_deg: -38}\n", ""))
+    path.write_text(textwrap.dedent(SHORT).replace("      - {label: right, steering_wheel_deg: -34}\n", ""))
     out = tmp_path / "report"
     assert vsim(["bushings-on-road", str(path), "-o", str(out)]) == 0
     rows = list(csv.DictReader(open(out / "metrics.csv")))
@@ -199,7 +199,7 @@ def test_bushings_on_road_compares_the_cars_and_writes_its_report(tmp_path: Path
 
 
 def test_the_step_responses_converge_as_the_time_step_halves(tmp_path: Path) -> None:
-    s = scenario(tmp_path, SHORT.replace("      - {label: right, steering_wheel_deg: -38}\n", ""))
+    s = scenario(tmp_path, SHORT.replace("      - {label: right, steering_wheel_deg: -34}\n", ""))
     coarse, fine = (road_metrics(simulate(s, timestep_s=h))[1] for h in (1e-3, 5e-4))
     for key in ("yaw_rate_response_time_s", "lateral_acceleration_response_time_s", "yaw_rate_peak_response_time_s"):
         assert coarse[key] == pytest.approx(fine[key], abs=1e-3), key      # < 1 ms (issue 26)
@@ -208,7 +208,7 @@ def test_the_step_responses_converge_as_the_time_step_halves(tmp_path: Path) -> 
 
 def test_low_rates_quick_looks_and_rising_speed_circles_give_their_metrics(tmp_path: Path) -> None:
     s = scenario(tmp_path, SHORT.replace("output_rate_hz: 200", "output_rate_hz: 50")
-                 .replace("      - {label: right, steering_wheel_deg: -38}\n", ""))
+                 .replace("      - {label: right, steering_wheel_deg: -34}\n", ""))
     quick = road_metrics(simulate(s, duration_scale=0.5))[1]
     assert 0.05 < quick["yaw_rate_response_time_s"] < 0.6 and quick["steady_lateral_acceleration_mps2"] > 3.0
     with pytest.raises(InputError, match=r"output_rate_hz: expected at least 50 Hz on the road"):

@@ -5,7 +5,7 @@ accuracy when the time step halves.
 
 * ``rtf_road_stvs``, ``rtf_rig_stvs``: simulated time / wall time of the compiled stepping, every
   bushing direction STVS (36 channels), 4 s per run, best of three, road and rig alternating in
-  one process: the car at 80 km/h in a steady 38° turn on its four transient MF 6.1 tyres, and
+  one process: the car at 80 km/h in a steady 34° turn on its four transient MF 6.1 tyres, and
   the same car on the K&C rig holding its pads; ``ratio_road_to_rig``: their step-time ratio;
 * ``end_to_end_rtf``: simulated time / wall time of ``road/step_steer`` played and kept in memory
   (every sample measured, as ``vsim run`` does, without the file), STVS everywhere;
@@ -37,7 +37,7 @@ from vsim_recordings.recorder import simulate
 
 SECONDS = 4.0
 SPEED = 80 / 3.6
-STEER = math.radians(38.0)
+STEER = math.radians(34.0)
 
 
 def road_seconds(car: RoadCar, n: int) -> float:
