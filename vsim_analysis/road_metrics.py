@@ -210,9 +210,9 @@ def _step_metrics(run: Run, start: float, end: float, case_start: float) -> dict
     for name, key in (("lateral_acceleration", "steady_lateral_acceleration_mps2"), ("sideslip", "steady_sideslip_deg"),
                       ("roll", "steady_roll_deg")):
         out[key] = float(np.mean(run.signals[name][mask][steady]))
-    toe = zero(_front_toe(run))
-    out["steady_front_toe_deg"] = float(np.mean(_front_toe(run)[mask][steady]))
-    lag = step_response(t, x, toe, steady_from)
+    toe = _front_toe(run)
+    out["steady_front_toe_deg"] = float(np.mean(toe[mask][steady]))
+    lag = step_response(t, x, zero(toe), steady_from)
     if lag is not None:
         out["front_toe_lag_s"] = lag["response_time_s"]
     return out

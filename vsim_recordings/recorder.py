@@ -23,7 +23,6 @@ from vehicle.model.vehicle_file import load_vehicle
 from vehicle.scenarios.road_scenario import RoadScenario
 from vehicle.scenarios.scenario import Scenario
 from vehicle.scenarios.schedule import Progress
-from vehicle.simulation.rig import KCRig
 from vehicle.simulation.mounted import MountedCar
 from vehicle.simulation.road_runner import RoadRun
 from vehicle.simulation.runner import ScenarioRun
@@ -53,29 +52,26 @@ def default_output(scenario: Scenario) -> Path:
     return Path("out") / f"{scenario.name}.mcap"
 
 
-def layout_of(rig: KCRig, x_quantity: str | None) -> SignalLayout:
-    """The signals a run on ``rig`` records."""
-    c = rig.coupling
-    return SignalLayout(x_quantity, [ch.name for ch in rig.car.channels], [e.name for e in c.springs],
-                        [e.name for e in c.dampers])
+def _suspension(car: MountedCar) -> tuple[list[str], list[str], list[str]]:
+    """The names of ``car``'s bushing directions, springs and dampers, as the layouts take them."""
+    c = car.coupling
+    return [ch.name for ch in car.car.channels], [e.name for e in c.springs], [e.name for e in c.dampers]
 
 
 def _play(scenario: Scenario | RoadScenario, vehicle: VehicleDefinition, duration_scale: float,
           progress: Callable[[Progress], None] | None, timestep_s: float = BuildOptions.timestep
-          ) -> tuple[ScenarioRun | RoadRun, MountedCar, SignalLayout | RoadSignalLayout, RunMetadata]:
-    """The run of ``scenario`` on ``vehicle`` (on the rig or on the road, as its type says), its car,
-    the signals it records and its metadata."""
+          ) -> tuple[ScenarioRun | RoadRun, SignalLayout | RoadSignalLayout, RunMetadata]:
+    """The run of ``scenario`` on ``vehicle`` (on the rig or on the road, as its type says), the
+    signals it records and its metadata."""
     if isinstance(scenario, RoadScenario):
         play = RoadRun(scenario, vehicle, duration_scale, progress, timestep_s)
-        car, c = play.car, play.car.coupling
-        layout = RoadSignalLayout([ch.name for ch in car.car.channels], [e.name for e in c.springs],
-                                  [e.name for e in c.dampers])
-        road = road_facts(car.steering_ratio, car.wheelbase, car.tyre_file)
+        layout = RoadSignalLayout(*_suspension(play.car))
+        road = road_facts(play.car.steering_ratio, play.car.wheelbase, play.car.tyre_file)
     else:
         play = ScenarioRun(scenario, vehicle, duration_scale, progress, timestep_s)
-        car, layout, road = play.car, layout_of(play.car, scenario.x_quantity), None
-    metadata = run_metadata(scenario, play.plan, duration_scale, play.dt, car.car.channels, road)
-    return play, car, layout, metadata
+        layout, road = SignalLayout(scenario.x_quantity, *_suspension(play.car)), None
+    metadata = run_metadata(scenario, play.plan, duration_scale, play.dt, play.car.car.channels, road)
+    return play, layout, metadata
 
 
 def run_scenario(scenario: Scenario | RoadScenario, output: Path, *, bushing_model: str | None = None, overwrite: bool = False,
@@ -90,11 +86,11 @@ def run_scenario(scenario: Scenario | RoadScenario, output: Path, *, bushing_mod
     if bushing_model is not None:
         scenario = replace(scenario, bushing_model=bushing_model)
     started = time.perf_counter()
-    play, car, layout, metadata = _play(scenario, load_vehicle(scenario.vehicle), duration_scale, progress)
+    play, layout, metadata = _play(scenario, load_vehicle(scenario.vehicle), duration_scale, progress)
     output.parent.mkdir(parents=True, exist_ok=True)
     bodies = play.bodies()
     times_ns, rows = [], []
-    with RunWriter(output, signals=layout.specs, bodies=bodies, geometry=geometry_from_model(car.model, bodies),
+    with RunWriter(output, signals=layout.specs, bodies=bodies, geometry=geometry_from_model(play.car.model, bodies),
                    metadata=metadata, overwrite=overwrite) as writer:
         with closing(play.samples()) as samples:  # leaves the rig's context at once if writing fails
             for s in samples:
@@ -115,8 +111,8 @@ def simulate(scenario: Scenario | RoadScenario, vehicle: VehicleDefinition | Non
     the same signals, units and metadata (``vehicle_yaml`` empty when ``vehicle`` was given, as it
     need not come from a file); ``timestep_s`` the car's time step.
     """
-    play, _, layout, metadata = _play(scenario, load_vehicle(scenario.vehicle) if vehicle is None else vehicle,
-                                      duration_scale, progress, timestep_s)
+    play, layout, metadata = _play(scenario, load_vehicle(scenario.vehicle) if vehicle is None else vehicle,
+                                   duration_scale, progress, timestep_s)
     times, rows = [], []
     with closing(play.samples()) as samples:
         for s in samples:

@@ -29,6 +29,8 @@ REAR_MASSES = ("arm", "hub")
 #: The car's sides (+1 left, −1 right for mirroring) and its corners.
 SIDES = (("left", 1.0), ("right", -1.0))
 CORNERS = ("front_left", "front_right", "rear_left", "rear_right")
+#: +1 for a left corner, −1 for a right one (a right part is the mirror image of the left: y → −y).
+SIDE_SIGN = {c: 1.0 if c.endswith("left") else -1.0 for c in CORNERS}
 #: Models ``--bushings`` may put on every bushing direction (:meth:`DirectionDef.channel`).
 BUSHING_MODELS = ("linear", "sts", "rt", "stvs")
 #: Bushing directions: translations along, then rotations about, the bushing's own x, y, z axes.

@@ -51,6 +51,14 @@ def wheel_angles(spin_out: np.ndarray, sign: float = 1.0) -> tuple[float, float]
     return toe, camber
 
 
+def wheel_orientation(spin_left: np.ndarray, sign: float) -> tuple[float, float, float]:
+    """(toe-in, camber, steer) [rad] of a wheel from its spin axis pointing to the vehicle's left,
+    in the frame the angles are taken in; ``sign`` +1 for a left wheel, −1 for a right one. Steer
+    is the yaw of the heading ``spin_left × z``, to the left positive."""
+    toe, camber = wheel_angles(sign * spin_left, sign)
+    return toe, camber, math.atan2(-spin_left[0], spin_left[1])
+
+
 @dataclass(frozen=True)
 class CornerState:
     """Pose of a corner's parts for one wheel travel."""

@@ -9,14 +9,13 @@ outward, steer angle positive to the left, half-track = |y| of the wheel centre.
 from __future__ import annotations
 
 import dataclasses
-import math
 
 import mujoco
 import numpy as np
 
-from vehicle.model.definition import CORNERS, VehicleDefinition
+from vehicle.model.definition import CORNERS, SIDE_SIGN, VehicleDefinition
 from vehicle.model.elements import BuildOptions
-from vehicle.model.kinematics import wheel_angles
+from vehicle.model.kinematics import wheel_orientation
 from vehicle.simulation import stepping
 from vehicle.simulation.mounted import MountedCar
 from vehicle.simulation.outputs import RigOutputs, WheelOutputs
@@ -24,7 +23,6 @@ from vehicle.simulation.outputs import RigOutputs, WheelOutputs
 _NO_INPUTS = np.zeros((0, 17))
 _INACTIVE = np.zeros(5, dtype=bool)
 _ALL_ACTIVE = np.ones(5, dtype=bool)
-_SIGN = {"front_left": 1.0, "front_right": -1.0, "rear_left": 1.0, "rear_right": -1.0}
 
 
 class KCRig(MountedCar):
@@ -136,14 +134,11 @@ class KCRig(MountedCar):
         fz = d.efc_force[first_rows[self.pad_eq]]
         wheels = {}
         for k, corner in enumerate(CORNERS):
-            sign = _SIGN[corner]
-            rot = d.xmat[self.wheel_body[k]].reshape(3, 3)
-            spin_left = rot[:, 1]
-            toe, camber = wheel_angles(sign * spin_left, sign)
-            heading = (spin_left[1], -spin_left[0])  # spin_left × z, in plan
+            spin_left = d.xmat[self.wheel_body[k]].reshape(3, 3)[:, 1]
+            toe, camber, steer = wheel_orientation(spin_left, SIDE_SIGN[corner])
             centre = d.site_xpos[self.centre_site[k]].copy()
             force = np.array([d.xfrc_applied[self.carriage_body[k], 0], d.xfrc_applied[self.carriage_body[k], 1], fz[k]])
-            wheels[corner] = WheelOutputs(camber, toe, math.atan2(heading[1], heading[0]), abs(centre[1]), centre,
+            wheels[corner] = WheelOutputs(camber, toe, steer, abs(centre[1]), centre,
                                           force, float(d.qpos[self.pad_qpos[k]]),
                                           float(d.xfrc_applied[self.wheel_body[k], 5]))
         return RigOutputs(wheels=wheels, **self.suspension_outputs(first_rows))

@@ -24,9 +24,9 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from vehicle.model.definition import CORNERS, VehicleDefinition
+from vehicle.model.definition import CORNERS, SIDE_SIGN, VehicleDefinition
 from vehicle.model.elements import BuildOptions
-from vehicle.model.kinematics import steering_ratio, wheel_angles
+from vehicle.model.kinematics import steering_ratio, wheel_orientation
 from vehicle.simulation import stepping
 from vehicle.simulation.mounted import MountedCar
 from vehicle.simulation.outputs import RoadOutputs, RoadWheel
@@ -39,7 +39,6 @@ from vsim_tyres.tir_file import read_tir
 N_INPUTS = 10
 _NO_INPUTS = np.zeros((0, N_INPUTS))
 _DEFLECTION = SIGNALS.index("deflection_m")
-_SIDE = {"left": 1.0, "right": -1.0}
 #: The driver's speed loop: natural frequency [Hz] and damping ratio of the car's speed under the PI
 #: controller (slow beside the handling, which it must not steer; fast beside the speed ramps).
 SPEED_LOOP_HZ, SPEED_LOOP_DAMPING = 0.5, 1.0
@@ -100,7 +99,6 @@ class RoadCar(MountedCar):
                         self.driver_state)
         self._tyre_args = (self.tyres, self.mirrored, self.wheel_body, d.xipos, d.xmat, d.cvel, d.subtree_com,
                            m.body_rootid.astype(np.int64), self.tyre_state, d.xfrc_applied, self.tyre_signals)
-        self._sides = [_SIDE[c.split("_")[1]] for c in CORNERS]
         self._design_z = [getattr(self.vehicle, c.split("_")[0]).hardpoints["wheel_centre"][2] for c in CORNERS]
         self._run(0, _NO_INPUTS)
         self.stepping_s = 0.0
@@ -169,12 +167,11 @@ class RoadCar(MountedCar):
         vx, vy = c * velocity[0] + s * velocity[1], -s * velocity[0] + c * velocity[1]
         wheels = {}
         for k, corner in enumerate(CORNERS):
-            side = self._sides[k]
-            spin_left = rot.T @ d.xmat[self.wheel_body[k]].reshape(3, 3)[:, 1]
-            toe, camber = wheel_angles(side * spin_left, side)
+            spin_left = rot.T @ d.xmat[self.wheel_body[k]].reshape(3, 3)[:, 1]   # in the body's frame
+            toe, camber, steer = wheel_orientation(spin_left, SIDE_SIGN[corner])
             centre = rot.T @ (d.xipos[self.wheel_body[k]] - d.xpos[self.chassis])
-            wheels[corner] = RoadWheel(camber, toe, math.atan2(-spin_left[0], spin_left[1]),
-                                       float(centre[2] - self._design_z[k]), self.tyre_signals[k].copy())
+            wheels[corner] = RoadWheel(camber, toe, steer, float(centre[2] - self._design_z[k]),
+                                       self.tyre_signals[k].copy())
         return RoadOutputs(
             position=(float(d.xipos[self.chassis, 0]), float(d.xipos[self.chassis, 1])),
             yaw=yaw, roll=roll, pitch=pitch, speed=vx, lateral_speed=vy, yaw_rate=float(omega[2]),

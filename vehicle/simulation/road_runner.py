@@ -52,20 +52,11 @@ def check_road(car: RoadCar, o: RoadOutputs, scenario: RoadScenario, time_s: flo
 class RoadRun(PlayedScenario):
     """The cases of a road scenario played one after the other on ``vehicle``, each on a fresh car."""
 
+    phases = ROAD_PHASES
+
     def __init__(self, scenario: RoadScenario, vehicle: VehicleDefinition, duration_scale: float = 1.0,
                  progress: Callable[[Progress], None] | None = None, timestep_s: float = BuildOptions.timestep):
         super().__init__(scenario, vehicle, duration_scale, progress, lambda v, o: RoadCar(v, options=o), timestep_s)
-
-    def samples(self) -> Iterator[RoadSample]:
-        """Every sample of every case, in time order."""
-        car = self.car
-        for k, (case, when) in enumerate(zip(self.scenario.cases, self.plan), start=1):
-            if k > 1:
-                car = RoadCar(self.vehicle, options=self.options)
-            try:
-                yield from self._case(car, case, k, when)
-            finally:
-                self.stepping_s += car.stepping_s
 
     def _case(self, car: RoadCar, case: RoadCase, number: int, when: CaseSchedule) -> Iterator[RoadSample]:
         """The samples of one case from a fresh car, one every output interval."""
@@ -86,9 +77,7 @@ class RoadRun(PlayedScenario):
                 check_road(car, o, scenario, t, name, lifted, every * dt)
             else:
                 check_divergence(car, o, scenario, t, name)
-            if self.progress is not None:
-                self.progress(Progress(number, len(scenario.cases), case.label, phase, ROAD_PHASES[phase], t,
-                                       self.total_s))
+            self._report(number, case.label, phase, t)
 
         def hold(phase: int, speed: float) -> Iterator[RoadSample]:
             nonlocal step

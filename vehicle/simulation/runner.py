@@ -82,11 +82,14 @@ class PlayedScenario:
     periods, holds) for quick runs; ``progress`` is called after every sample with a :class:`Progress`;
     ``timestep_s`` is the car's time step (its convergence is measured in tools/benchmarks)."""
 
+    #: Names of a case's phases (the ``phase`` signal is the index).
+    phases: tuple[str, ...] = PHASES
+
     def __init__(self, scenario: Scenario | RoadScenario, vehicle: VehicleDefinition, duration_scale: float,
                  progress: Callable[[Progress], None] | None, mount: Callable[[VehicleDefinition, BuildOptions], Any],
                  timestep_s: float = BuildOptions.timestep):
         self.scenario, self.vehicle, self.duration_scale = scenario, vehicle, duration_scale
-        self.progress = progress
+        self.progress, self._mount = progress, mount
         self.options = BuildOptions(bushing_model=scenario.bushing_model, timestep=timestep_s)
         self.dt = self.options.timestep
         self.plan = schedule(scenario, duration_scale, self.dt)   # checks the scale before the build
@@ -101,6 +104,23 @@ class PlayedScenario:
         m = self.car.model
         return [mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, i) for i in range(1, m.nbody)]
 
+    def samples(self) -> Iterator[Any]:
+        """Every sample of every case, in time order, each case on a fresh car (the subclass's ``_case``)."""
+        car = self.car
+        for k, (case, when) in enumerate(zip(self.scenario.cases, self.plan), start=1):
+            if k > 1:
+                car = self._mount(self.vehicle, self.options)
+            try:
+                yield from self._case(car, case, k, when)
+            finally:
+                self.stepping_s += car.stepping_s
+
+    def _report(self, number: int, label: str, phase: int, time_s: float) -> None:
+        """Tell ``progress`` (if any) where the run is."""
+        if self.progress is not None:
+            self.progress(Progress(number, len(self.scenario.cases), label, phase, self.phases[phase], time_s,
+                                   self.total_s))
+
 
 class ScenarioRun(PlayedScenario):
     """The cases of a scenario played one after the other on ``vehicle``, each on a fresh rig."""
@@ -108,17 +128,6 @@ class ScenarioRun(PlayedScenario):
     def __init__(self, scenario: Scenario, vehicle: VehicleDefinition, duration_scale: float = 1.0,
                  progress: Callable[[Progress], None] | None = None, timestep_s: float = BuildOptions.timestep):
         super().__init__(scenario, vehicle, duration_scale, progress, KCRig, timestep_s)
-
-    def samples(self) -> Iterator[Sample]:
-        """Every sample of every case, in time order."""
-        rig, cases = self.car, self.scenario.cases
-        for k, (case, when) in enumerate(zip(cases, self.plan), start=1):
-            if k > 1:
-                rig = KCRig(self.vehicle, self.options)
-            try:
-                yield from self._case(rig, case, k, when)
-            finally:
-                self.stepping_s += rig.stepping_s
 
     def _case(self, rig: KCRig, case: Case, number: int, when: CaseSchedule) -> Iterator[Sample]:
         """The samples of one case from a fresh rig, one every output interval."""
@@ -139,8 +148,7 @@ class ScenarioRun(PlayedScenario):
             yield Sample(t, number, phase, (step - input_start) * dt, inputs, o, design_z, d.xpos[bodies],
                          d.xquat[bodies])
             check_divergence(rig, o, scenario, t, name)
-            if self.progress is not None:
-                self.progress(Progress(number, len(scenario.cases), case.label, phase, PHASES[phase], t, self.total_s))
+            self._report(number, case.label, phase, t)
 
         def hold(phase: int) -> Iterator[Sample]:
             nonlocal step
