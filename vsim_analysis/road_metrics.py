@@ -30,8 +30,7 @@ from typing import Any, Mapping
 import numpy as np
 from scipy.signal import butter, filtfilt
 
-from vehicle.scenarios.road_scenario import CIRCLE_STEER_IN_S, DEFAULT_RISE_TIME_S, ROAD_TYPES
-from vehicle.scenarios.schedule import PHASES, ROAD_PHASES
+from vehicle.scenarios.road_scenario import CIRCLE_STEER_IN_S, DEFAULT_RISE_TIME_S
 from vsim_recordings.run_format import Run
 
 #: Standard gravity [m/s²] (the g of deg/g).
@@ -78,16 +77,6 @@ METRICS = (
     ("sideslip_gradient_deg_per_g", "deg/g", "ISO 4138: dβ/da_y"),
     ("max_lateral_acceleration_mps2", "m/s²", "largest |a_y| reached"),
 )
-
-
-def is_road(run: Run) -> bool:
-    """Whether ``run`` is a run of a road scenario."""
-    return run.metadata.extra.get("type") in ROAD_TYPES
-
-
-def input_phase(run: Run) -> int:
-    """The value of the ``phase`` signal during the inputs (the last of the run's phases)."""
-    return len(ROAD_PHASES if is_road(run) else PHASES) - 1
 
 
 def _crossing(t: np.ndarray, y: np.ndarray, level: float) -> float | None:

@@ -24,7 +24,9 @@ from typing import Any, Mapping
 import numpy as np
 
 from vehicle.scenarios.channels import CORNER_TAGS
+from vehicle.scenarios.road_scenario import ROAD_TYPES
 from vehicle.scenarios.scenario import SIGNAL_TYPES
+from vehicle.scenarios.schedule import PHASES, ROAD_PHASES
 from vsim_analysis.kc_metrics import BUMP_WINDOW_M, FIT_FRACTION, Leg, bump_loop_widths, fit_window, triangle_metrics
 from vsim_analysis.loops import (Branches, centre_slope, common_range, dynamic_stiffness, loop_area, loop_width,
                                  relaxation_amplitude)
@@ -64,12 +66,23 @@ def input_kind(run: Run) -> str:
     return extra["type"]
 
 
+def is_road(run: Run) -> bool:
+    """Whether ``run`` is a run of a road scenario."""
+    return run.metadata.extra.get("type") in ROAD_TYPES
+
+
+def input_phase(run: Run) -> int:
+    """The value of the ``phase`` signal during the inputs (the last of the run's phases)."""
+    return len(ROAD_PHASES if is_road(run) else PHASES) - 1
+
+
 def case_mask(run: Run, case: Mapping[str, Any], last_cycle: bool = False) -> np.ndarray:
     """Samples of ``case``'s input phase, or of its last cycle."""
     start, end = case["input_start_s"], case["end_s"]
     if last_cycle:
         start += (end - start) * (case["cycles"] - 1) / case["cycles"]
-    return (run.signals["case"] == case["case"]) & (run.signals["phase"] == 2) & (run.t_s >= start - _EPS_S)
+    return ((run.signals["case"] == case["case"]) & (run.signals["phase"] == input_phase(run))
+            & (run.t_s >= start - _EPS_S))
 
 
 def loop_axes(run: Run, tag: str) -> tuple[str, str] | None:

@@ -19,7 +19,7 @@ import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
 
-from vsim_analysis.road_metrics import is_road
+from vsim_analysis.run_metrics import is_road
 from vsim_recordings.run_format import GeomSpec, Run, rotation_matrix
 
 TIMELINE = "sim_time"

@@ -10,22 +10,9 @@ import numpy as np
 
 from vsim_analysis.kc_metrics import BUMP_WINDOW_M, FIT_FRACTION, METRICS
 from vsim_analysis.road_metrics import METRICS as ROAD_METRICS
-from vsim_analysis.road_metrics import (
-    RESPONSES,
-    bandwidth_hz,
-    input_phase,
-    is_road,
-    road_metrics,
-)
-from vsim_analysis.run_metrics import (
-    case_loop,
-    case_mask,
-    case_relaxation,
-    cases,
-    gradient_unit,
-    loop_axes,
-    run_metrics,
-)
+from vsim_analysis.road_metrics import RESPONSES, bandwidth_hz, road_metrics
+from vsim_analysis.run_metrics import (case_loop, case_mask, case_relaxation, cases, gradient_unit, input_phase, is_road,
+                                       loop_axes, run_metrics)
 from vsim_recordings.run_format import Run
 
 SUMMARY_CORNERS = {"front": "fl", "rear": "rl"}   #: the left wheel of each axle is summarised
