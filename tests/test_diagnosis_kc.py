@@ -27,11 +27,14 @@ from vehicle.scenarios.scenario_file import load_scenario
 from vsim_core.errors import InputError
 from vsim_diagnosis.kc_catalogue import (OBSERVABLE, Hypothesis, draw, extended_vehicle, extended_vehicle_yaml,
                                          locations, parameters)
-from vsim_diagnosis.kc_diagnosis import Candidate, Layout, Test, _nominal, _Scorer, fit
+from vsim_cluster.executor import SerialExecutor
+from vsim_core.shipped import DEFAULT_VEHICLE
+from vsim_diagnosis.kc_diagnosis import Candidate, Layout, Test, _nominal, _Scorer, diagnose_kc, fit
 from vsim_diagnosis.verdict import split
 from vsim_diagnosis.virtual_kc_rig import DEFAULT_SCENARIOS, measure_kc, parse_kc_truth
-from vsim_presentation.kc_report import _parameters
+from vsim_presentation.kc_report import _parameters, summary
 from vsim_recordings.recorder import run_scenario, simulate
+from vsim_recordings.kc_dataset import read_kc_dataset
 from vsim_recordings.run_reader import load_run
 
 KC_CAUSES = sorted(c for c in OBSERVABLE if c != "backlash")
@@ -268,8 +271,12 @@ def test_report_of_a_one_scenario_dataset(tmp_path):
     _, measured = measure_truth(tmp_path, h, 2, duration_scale=0.1,
                                 scenarios=[str(root / "scenarios" / "kc" / "lateral_force.yaml")])
     report = tmp_path / "report"
-    result = diagnose_fresh(measured, "-o", str(report))
+    result = diagnose_fresh(measured, "-o", str(report))   # on a local Dask cluster of 2 workers
     check(result, h)
+    # the same verdict, every number of it, serially in this process
+    serial = diagnose_kc(read_kc_dataset(measured), load_vehicle(DEFAULT_VEHICLE), executor=SerialExecutor())
+    assert ({k: v for k, v in json.loads(json.dumps(summary(serial))).items() if k != "wall_s"}
+            == {k: v for k, v in result.items() if k != "wall_s"})
     assert json.loads((report / "diagnosis.json").read_text())["cause"] == "mullins"
     text = (report / "report.md").read_text()
     assert text.count("![") == 3 and all((report / name).stat().st_size > 0 for name in

@@ -1,5 +1,5 @@
 """No input breaks the tool (issue 25): inputs drawn by hypothesis from the shipped files of every
-input class (scenario, vehicle, bushing parameter set, bench programme, rig CSV + META, bench
+input class (scenario, sweep, vehicle, bushing parameter set, bench programme, rig CSV + META, bench
 dataset, MCAP run), mutated in structure (values out of range, of the wrong type, non-finite or in
 the wrong unit; keys removed, added, repeated; aliases) and in bytes (undecodable, truncated, cut
 or flipped), are each loaded and taken as far as the command's own checks go: vehicles built into
@@ -9,7 +9,7 @@ anything else, a hang (each case has :data:`CASE_TIMEOUT_S`) or a silent accepta
 refused (non-finite or beyond 1e300, a repeated key, an alias bomb, undecodable bytes) fails.
 
 The cases are drawn from a fixed seed (reruns try the same cases; ``VSIM_FUZZ_SEED`` draws others)
-and their number per class is :data:`EXAMPLES` (1250 in all, README "Hostile input").
+and their number per class is :data:`EXAMPLES` (1350 in all, README "Hostile input").
 """
 
 from __future__ import annotations
@@ -42,17 +42,18 @@ from vehicle.scenarios.scenario import RIG_TIMESTEP_S
 from vehicle.scenarios.scenario_file import load_scenario
 from vehicle.scenarios.schedule import schedule
 from vsim_core.errors import InputError
-from vsim_core.shipped import BENCH_DIR, DEFAULT_VEHICLE, PARAMETER_SET_DIR, SCENARIO_DIR
+from vsim_core.shipped import BENCH_DIR, DEFAULT_VEHICLE, PARAMETER_SET_DIR, SCENARIO_DIR, SWEEP_DIR
 from vsim_recordings.bench_dataset import read_bench_dataset
 from vsim_recordings.csv_import import import_csv
 from vsim_recordings.run_reader import load_run
+from vsim_sweeps.sweep_file import load_sweep
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "data" / "examples" / "kc_import"
 BENCH_DATA = ROOT / "data" / "rig" / "bench"
 #: Cases drawn per input class.
 EXAMPLES = {"scenario": 250, "vehicle": 200, "parameter_set": 150, "bench": 150, "rig_csv": 150,
-            "bench_dataset": 150, "mcap": 200}
+            "bench_dataset": 150, "mcap": 200, "sweep": 100}
 CASE_TIMEOUT_S = 60.0
 #: The largest resident memory the worker may reach over the fuzz run [bytes].
 MAX_RSS_BYTES = 6 << 30
@@ -219,7 +220,8 @@ def folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 # -- the input classes -----------------------------------------------------------------------------
-SCENARIOS = [p for p in sorted(SCENARIO_DIR.rglob("*.yaml"))]
+SCENARIOS = [p for p in sorted(SCENARIO_DIR.rglob("*.yaml")) if SWEEP_DIR not in p.parents]
+SWEEPS = sorted(SWEEP_DIR.glob("*.yaml"))
 
 
 @fuzz("scenario")
@@ -229,6 +231,14 @@ def test_scenarios(folder: Path, case: tuple[str, bool], scale: float) -> None:
     text, must_refuse = case
     path = write(folder / "scenario.yaml", text)
     check("scenario", outcome(lambda: schedule(load_scenario(path), scale, RIG_TIMESTEP_S)), must_refuse, text)
+
+
+@fuzz("sweep")
+@given(st.sampled_from(SWEEPS).flatmap(lambda p: mutated({**_yaml(p), "vehicle": str(DEFAULT_VEHICLE)})))
+def test_sweeps(folder: Path, case: tuple[str, bool]) -> None:
+    text, must_refuse = case
+    path = write(folder / "sweep.yaml", text)
+    check("sweep", outcome(lambda: load_sweep(path).runs), must_refuse, text)
 
 
 @fuzz("vehicle")

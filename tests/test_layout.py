@@ -15,6 +15,7 @@ ROOT = Path(__file__).resolve().parents[1]
 #: The packages, lowest first: a package may import only packages of an earlier row (or itself).
 LAYERS = (
     ("vsim_core",),                          # foundation
+    ("vsim_cluster",),                       # where runs execute (Dask)
     ("bushings",),                           # bushing laws
     ("bushings.bench",),                     # the bushing test bench
     ("vsim_tyres",),                         # tyre property files and laws
@@ -23,6 +24,7 @@ LAYERS = (
     ("vehicle.simulation",),                 # running it
     ("vsim_recordings",),                    # recorded runs and measured data
     ("vsim_analysis",),                      # metrics and comparison
+    ("vsim_sweeps",),                        # sweeps over vehicle parameters
     ("vsim_diagnosis",),                     # causes, virtual rigs, diagnoses
     ("vsim_presentation",),                  # plots, replay, tables, reports
     ("vsim_cli",),                           # the command line

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from vsim_analysis.road_metrics import bandwidth_hz, first_harmonic, road_metrics, step_response
+from vsim_analysis.road_metrics import TYPE_METRICS, bandwidth_hz, first_harmonic, road_metrics, step_response
 from vsim_recordings.run_format import Run, RunMetadata
 
 
@@ -86,6 +86,7 @@ def test_a_recorded_step_of_first_order_responses_gives_their_iso_metrics() -> N
               body_pos=np.empty((len(t), 0, 3)), body_quat_wxyz=np.empty((len(t), 0, 4)), geometry=[],
               metadata=RunMetadata(extra=extra), complete=True, reason="")
     m = road_metrics(run)[1]
+    assert set(m) <= set(TYPE_METRICS["step_steer"])   # what a sweep may ask of a step steer
     t90 = fine[np.argmax(lag >= 0.9)] - (start + rise / 2)
     for name in ("yaw_rate", "lateral_acceleration"):
         assert m[f"{name}_response_time_s"] == pytest.approx(t90, abs=1e-3)

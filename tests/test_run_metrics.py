@@ -22,7 +22,7 @@ from vehicle.scenarios.channels import CORNER_TAGS
 from vehicle.scenarios.scenario_file import load_scenario
 from vehicle.simulation.kc_triangles import design_contact_base
 from vehicle.simulation.rig import KCRig
-from vsim_analysis.kc_metrics import BUMP_WINDOW_M
+from vsim_analysis.kc_metrics import BUMP_WINDOW_M, TEST_METRICS
 from vsim_analysis.kc_test import kc_metrics
 from vsim_analysis.run_metrics import case_loop, case_metrics, cases, contact_base_m, run_metrics
 from vsim_core.errors import InputError
@@ -78,6 +78,7 @@ def test_recorded_run_gives_the_kc_metrics_of_vsim_kc(runs, kc_values, kind: str
     metrics = case_metrics(run, cases(run)[0])
     assert set(metrics) == {"front", "rear"}
     for axle, values in metrics.items():
+        assert set(values) == set(TEST_METRICS[test])   # what a sweep may ask of this test
         gradients = {k: v for k, v in values.items() if "loop_width" not in k}
         assert gradients, (kind, values)
         for key, value in gradients.items():

@@ -41,6 +41,17 @@ METRICS = (
     ("camber_loop_width_max_deg", "deg", "largest camber loop width over ±20 mm of bump"),
 )
 
+#: The metrics (keys of :data:`METRICS`) each test gives for an axle, the bump test's loop widths included.
+TEST_METRICS = {
+    "bump": ("bump_steer_deg_per_m", "bump_camber_deg_per_m", "toe_loop_width_deg", "toe_loop_width_max_deg",
+             "camber_loop_width_deg", "camber_loop_width_max_deg"),
+    "roll": ("roll_steer_deg_per_deg", "roll_camber_deg_per_deg"),
+    "lateral": ("lateral_force_compliance_steer_deg_per_kn", "lateral_force_compliance_camber_deg_per_kn",
+                "lateral_compliance_mm_per_kn"),
+    "longitudinal": ("longitudinal_compliance_steer_deg_per_kn",),
+    "aligning": ("aligning_torque_compliance_steer_deg_per_knm",),
+}
+
 
 #: One leg of a triangle: ``leg(quantity, corner)`` is that quantity's samples on the leg (SI;
 #: quantities of :data:`vsim_analysis.kc_test.WHEEL_QUANTITIES`, corners of

@@ -51,8 +51,8 @@ FILTER_LEAD_S = 0.5
 #: Length of the window of steady values at the end of a hold [s].
 STEADY_WINDOW_S = 1.0
 
-#: (metric, unit, meaning) of every road metric, for tables and the command line.
-METRICS = (
+#: (metric, unit, meaning) of the metrics of a step steer, of a sine steer and of a circle.
+STEP_METRICS = (
     ("yaw_rate_response_time_s", "s", "ISO 7401: 50 % steering to 90 % of the steady yaw rate"),
     ("yaw_rate_peak_response_time_s", "s", "ISO 7401: 50 % steering to the yaw rate's extreme"),
     ("yaw_rate_overshoot_pct", "%", "ISO 7401: yaw rate's extreme beyond its steady value"),
@@ -66,17 +66,28 @@ METRICS = (
     ("steady_roll_deg", "deg", "steady roll after the step (right side down +)"),
     ("steady_front_toe_deg", "deg", "steady mean toe-in of the front wheels relative to the body"),
     ("front_toe_lag_s", "s", "50 % steering to 90 % of the front toe change (relaxation)"),
+)
+SINE_METRICS = (
     ("frequency_hz", "Hz", "sine: input frequency"),
     ("yaw_rate_gain_at_frequency_per_s", "1/s", "sine: yaw-rate amplitude per steering-wheel amplitude"),
     ("yaw_rate_phase_deg", "deg", "sine: yaw rate's phase to the steering (lag negative)"),
     ("lateral_acceleration_gain_at_frequency_mps2_per_deg", "m/s²/deg", "sine: ay amplitude per steering amplitude"),
     ("lateral_acceleration_phase_deg", "deg", "sine: ay's phase to the steering (lag negative)"),
+)
+CIRCLE_METRICS = (
     ("steering_wheel_angle_gradient_deg_per_g", "deg/g", "ISO 4138: dδ_H/da_y"),
     ("understeer_gradient_deg_per_g", "deg/g", "ISO 4138: d(δ_H/i_s − L/R)/da_y"),
     ("roll_gradient_deg_per_g", "deg/g", "ISO 4138: dφ/da_y"),
     ("sideslip_gradient_deg_per_g", "deg/g", "ISO 4138: dβ/da_y"),
     ("max_lateral_acceleration_mps2", "m/s²", "largest |a_y| reached"),
 )
+#: Every road metric, for tables and the command line.
+METRICS = STEP_METRICS + SINE_METRICS + CIRCLE_METRICS
+#: The metrics each road scenario type can give (a double step's second step: prefix ``second_``).
+TYPE_METRICS = {"step_steer": tuple(m[0] for m in STEP_METRICS),
+                "double_step_steer": tuple(p + m[0] for p in ("", "second_") for m in STEP_METRICS),
+                "sine_steer": tuple(m[0] for m in SINE_METRICS),
+                "steady_state_circular": tuple(m[0] for m in CIRCLE_METRICS)}
 
 
 def _crossing(t: np.ndarray, y: np.ndarray, level: float) -> float | None:

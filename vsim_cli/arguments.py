@@ -37,3 +37,20 @@ def positive_scale(text: str) -> float:
     if not (math.isfinite(value) and value > 0.0):
         raise argparse.ArgumentTypeError(f"expected a finite number > 0, got {text!r}")
     return value
+
+
+def add_scheduler_options(parser: argparse.ArgumentParser, scope: str = "") -> None:
+    """``--scheduler`` and ``--workers``: where a command's runs execute (:mod:`vsim_cluster.executor`)."""
+    parser.add_argument("--scheduler", metavar="ADDRESS",
+                        help=f"{scope}the runs on a running Dask scheduler (tcp://HOST:8786), 'local' (a cluster on "
+                             f"this machine for the command) or 'serial' (this process); default: $VSIM_SCHEDULER, "
+                             f"else local")
+    parser.add_argument("--workers", type=positive_count, metavar="N",
+                        help="worker processes of a local cluster (default: one per core)")
+
+
+def positive_count(text: str) -> int:
+    """A whole number >= 1 (``--workers``)."""
+    if not text.strip().isdigit() or int(text) < 1:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}")
+    return int(text)

@@ -7,7 +7,7 @@ import json
 import sys
 from pathlib import Path
 
-from vsim_cli.arguments import output_folder
+from vsim_cli.arguments import add_scheduler_options, output_folder
 from vsim_core.errors import InputError
 
 
@@ -50,12 +50,15 @@ def _bench(args: argparse.Namespace, progress):
 def _kc(args: argparse.Namespace, progress):
     from vehicle.model.vehicle_file import load_vehicle
     from vsim_core.shipped import DEFAULT_VEHICLE
+    from vsim_cluster.executor import executor
     from vsim_diagnosis.kc_diagnosis import diagnose_kc
     from vsim_presentation.kc_report import summary, verdict_sentence, write_report
     from vsim_recordings.kc_dataset import read_kc_dataset
 
     vehicle = load_vehicle(args.vehicle or DEFAULT_VEHICLE)
-    result = diagnose_kc(read_kc_dataset(args.rigdir), vehicle, progress=progress)
+    data = read_kc_dataset(args.rigdir)
+    with executor(args.scheduler, args.workers) as ex:
+        result = diagnose_kc(data, vehicle, executor=ex, progress=progress)
     written = write_report(result, vehicle, args.output, str(args.rigdir)) if args.output is not None else []
     return result, written, verdict_sentence, summary
 
@@ -75,4 +78,5 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("-o", "--output", type=output_folder, metavar="REPORT_DIR",
                    help="write report.md, PNGs, diagnosis.json and extended_model.yaml here")
     p.add_argument("--json", action="store_true", help="print the verdict as one JSON object")
+    add_scheduler_options(p, "K&C datasets: ")
     p.set_defaults(func=_diagnose)

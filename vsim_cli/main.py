@@ -12,7 +12,7 @@ import sys
 from types import ModuleType
 
 from vsim_cli import (bushing_fit, bushing_run, bushings_on_road, compare, diagnose, kc, model_export, plot, rig_import,
-                      rig_measure, run, view)
+                      rig_measure, run, sweep, view)
 from vsim_cli.interrupts import handle_sigterm, status
 from vsim_core.errors import InputError
 
@@ -25,8 +25,8 @@ GROUPS: dict[str, tuple[str, str, tuple[ModuleType, ...]]] = {
             "Measured K&C rig data (data/README.md).", (rig_import, rig_measure)),
 }
 #: Commands and groups in the order of ``vsim --help``.
-ORDER: tuple[ModuleType | str, ...] = ("bushing", view, plot, "model", kc, run, bushings_on_road, diagnose, "rig",
-                                        compare)
+ORDER: tuple[ModuleType | str, ...] = ("bushing", view, plot, "model", kc, run, bushings_on_road, sweep, diagnose,
+                                        "rig", compare)
 
 
 def build_parser() -> argparse.ArgumentParser:

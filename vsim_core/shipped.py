@@ -33,11 +33,15 @@ DEFAULT_TYRE = TYRE_DIR / "195_65R15.tir"
 #: Rig scenarios (``scenarios/``) and the K&C campaign of the virtual rig (``scenarios/kc/``).
 SCENARIO_DIR = SHIPPED_ROOT / "scenarios"
 KC_SCENARIO_DIR = SCENARIO_DIR / "kc"
+#: Sweep files (``scenarios/sweeps/``): they name scenarios, they are not scenarios.
+SWEEP_DIR = SCENARIO_DIR / "sweeps"
 
 
 def built_in(folder: Path, suffix: str = ".yaml") -> list[str]:
-    """The names of the ``suffix`` files shipped in ``folder`` (``kc/pumping`` for a file in a subfolder)."""
-    return sorted(p.relative_to(folder).with_suffix("").as_posix() for p in folder.rglob(f"*{suffix}"))
+    """The names of the ``suffix`` files shipped in ``folder`` (``kc/pumping`` for a file in a
+    subfolder; the sweeps are not among the scenarios)."""
+    return sorted(p.relative_to(folder).with_suffix("").as_posix() for p in folder.rglob(f"*{suffix}")
+                  if folder == SWEEP_DIR or SWEEP_DIR not in p.parents)
 
 
 def resolve(name_or_path: str | Path, folder: Path, what: str, base: Path | None = None,

@@ -28,10 +28,8 @@ The verdict follows :func:`vsim_diagnosis.verdict.decide` with the noise as the 
 from __future__ import annotations
 
 import math
-import multiprocessing
-import os
 import time
-from concurrent.futures import ProcessPoolExecutor
+from contextlib import nullcontext
 from dataclasses import dataclass, field, replace
 from typing import Callable, Sequence
 
@@ -39,6 +37,7 @@ import numpy as np
 
 from vehicle.model.definition import VehicleDefinition
 from vehicle.scenarios.scenario import Scenario
+from vsim_cluster.executor import Executor, TaskFailed, executor as open_executor
 from vsim_diagnosis.kc_catalogue import (BUSHING_CAUSES, VEHICLE_CAUSES, Hypothesis, extended_vehicle, locations,
                                          parameters)
 from vsim_diagnosis.verdict import Outcome, decide, split
@@ -61,12 +60,14 @@ class Job:
     scenario: Scenario
     vehicle: VehicleDefinition
     duration_scale: float
+    channels: tuple[str, ...]     #: the compared channels it gives back (what a remote worker sends)
 
 
-def _run_job(job: Job) -> dict[str, np.ndarray]:
+def run_job(job: Job) -> dict[str, np.ndarray]:
+    """The compared channels of ``job``'s run over its input phase (a task of the executor)."""
     run = simulate(replace(job.scenario, bushing_model=None), job.vehicle, duration_scale=job.duration_scale)
     on = run.signals["phase"] == 2
-    return {name: values[on] for name, values in run.signals.items()}
+    return {name: run.signals[name][on] for name in job.channels}
 
 
 @dataclass(frozen=True)
@@ -103,7 +104,7 @@ class Layout:
                 n = int(on.sum())
                 measured.append(np.column_stack([run.signals[ch][on] for ch in channels]))
                 recording.append(np.full(n, k))
-                job = Job(replace(t.scenario, cases=[case]), vehicle, scale)
+                job = Job(replace(t.scenario, cases=[case]), vehicle, scale, tuple(channels))
                 tests.append(Test(f"{t.name} case {c} ({case.label})", job, np.arange(start, start + n)))
                 start += n
         test = np.concatenate([np.full(len(t.rows), i) for i, t in enumerate(tests)])
@@ -289,9 +290,12 @@ def hypotheses(vehicle: VehicleDefinition) -> list[Hypothesis]:
     return out
 
 
-def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, workers: int | None = None,
+def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, executor: Executor | None = None,
                 progress: Callable[[str], None] | None = None) -> KCDiagnosis:
-    """Diagnose a K&C dataset against a baseline vehicle (see the module docstring)."""
+    """Diagnose a K&C dataset against a baseline vehicle (see the module docstring); the vehicle runs
+    go to ``executor`` (default: :func:`vsim_cluster.executor.executor`'s, a local Dask cluster
+    unless ``VSIM_SCHEDULER`` names another). Every run is a pure function of its job: the verdict
+    is the same bits on any executor."""
     started = time.perf_counter()
     say = progress or (lambda _: None)
     layout = Layout.of(data, vehicle)
@@ -299,15 +303,18 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, workers: int | N
     heldout = split(len(layout.tests))
     training = [i for i in every if not heldout[i]]
     candidates = hypotheses(vehicle)
-    with ProcessPoolExecutor(max_workers=workers or min(2, os.cpu_count() or 1),
-                             mp_context=multiprocessing.get_context("fork")) as pool:
+    with nullcontext(executor) if executor is not None else open_executor() as pool:
         def rows(vehicles: list[VehicleDefinition], tests: Sequence[int]) -> list[np.ndarray]:
             """The compared rows of each vehicle on ``tests`` (NaN elsewhere), the runs in parallel."""
-            n, flat = len(tests), []
-            for result in pool.map(_run_job, [j for v in vehicles for j in layout.jobs(v, tests)]):
-                flat.append(result)
-                if len(vehicles) > 1 and len(flat) % n == 0:
-                    say(f"  vehicle {len(flat) // n}/{len(vehicles)} run")
+            n = len(tests)
+            flat: list[dict[str, np.ndarray]] = [{}] * (n * len(vehicles))
+            for done, o in enumerate(pool.each(run_job, [j for v in vehicles for j in layout.jobs(v, tests)]), 1):
+                if o.error:
+                    raise TaskFailed(f"vehicle {o.index // n + 1} of {len(vehicles)} on "
+                                     f"{layout.tests[tests[o.index % n]].name}: {o.error}")
+                flat[o.index] = o.result
+                if len(vehicles) > 1 and done % n == 0:
+                    say(f"  {done}/{len(flat)} runs done on {pool.description}")
             return [layout.stack(flat[i * n:(i + 1) * n], tests) for i in range(len(vehicles))]
 
         say(f"baseline {vehicle.name} on {len(data.tests)} recordings, {len(layout.tests)} tests "

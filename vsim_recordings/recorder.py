@@ -70,13 +70,15 @@ def _play(scenario: Scenario | RoadScenario, vehicle: VehicleDefinition, duratio
     else:
         play = ScenarioRun(scenario, vehicle, duration_scale, progress, timestep_s)
         layout, road = SignalLayout(scenario.x_quantity, *_suspension(play.car)), None
-    metadata = run_metadata(scenario, play.plan, duration_scale, play.dt, play.car.car.channels, road)
+    metadata = run_metadata(scenario, play.plan, duration_scale, play.dt, play.car.car.channels, road, vehicle.text)
     return play, layout, metadata
 
 
 def run_scenario(scenario: Scenario | RoadScenario, output: Path, *, bushing_model: str | None = None, overwrite: bool = False,
-                 duration_scale: float = 1.0, progress: Callable[[Progress], None] | None = None) -> RunResult:
-    """Run every case of ``scenario`` and record them in ``output`` (one MCAP file).
+                 duration_scale: float = 1.0, progress: Callable[[Progress], None] | None = None,
+                 vehicle: VehicleDefinition | None = None) -> RunResult:
+    """Run every case of ``scenario`` on ``vehicle`` (default: the scenario's file) and record them in
+    ``output`` (one MCAP file).
 
     ``bushing_model`` overrides the scenario's choice; ``duration_scale`` multiplies every duration
     (settle phases, periods, holds) for quick runs. Raises InputError if ``output`` exists and not
@@ -86,7 +88,8 @@ def run_scenario(scenario: Scenario | RoadScenario, output: Path, *, bushing_mod
     if bushing_model is not None:
         scenario = replace(scenario, bushing_model=bushing_model)
     started = time.perf_counter()
-    play, layout, metadata = _play(scenario, load_vehicle(scenario.vehicle), duration_scale, progress)
+    play, layout, metadata = _play(scenario, load_vehicle(scenario.vehicle) if vehicle is None else vehicle,
+                                   duration_scale, progress)
     output.parent.mkdir(parents=True, exist_ok=True)
     bodies = play.bodies()
     times_ns, rows = [], []
@@ -108,8 +111,8 @@ def simulate(scenario: Scenario | RoadScenario, vehicle: VehicleDefinition | Non
     """Run every case of ``scenario`` on ``vehicle`` (default: the scenario's file) in memory.
 
     The result is the :class:`Run` that :func:`run_scenario` would record, without the body poses:
-    the same signals, units and metadata (``vehicle_yaml`` empty when ``vehicle`` was given, as it
-    need not come from a file); ``timestep_s`` the car's time step.
+    the same signals, units and metadata (``vehicle_yaml`` the definition's text, empty for one
+    changed in code); ``timestep_s`` the car's time step.
     """
     play, layout, metadata = _play(scenario, load_vehicle(scenario.vehicle) if vehicle is None else vehicle,
                                    duration_scale, progress, timestep_s)
@@ -119,7 +122,7 @@ def simulate(scenario: Scenario | RoadScenario, vehicle: VehicleDefinition | Non
             times.append(s.time_s)
             rows.append(layout.values(s))
     if vehicle is not None:
-        metadata = replace(metadata, vehicle_yaml="", extra={**metadata.extra, "vehicle_file": "(in memory)"})
+        metadata = replace(metadata, extra={**metadata.extra, "vehicle_file": "(in memory)"})
     return _in_memory(Path("(in memory)"), np.array(times), rows, layout, metadata)
 
 

@@ -112,9 +112,11 @@ def road_facts(steering_ratio: float, wheelbase_m: float, tyre_file: Path) -> di
 
 
 def run_metadata(scenario: Scenario | RoadScenario, plan: list[CaseSchedule], duration_scale: float, dt: float,
-                 channels: Sequence[Channel] | None = None, road: Mapping[str, Any] | None = None) -> RunMetadata:
+                 channels: Sequence[Channel] | None = None, road: Mapping[str, Any] | None = None,
+                 vehicle_yaml: str = "") -> RunMetadata:
     """The metadata of a run of ``scenario``: the scenario, the schedule of its cases, and (for a
-    simulated run, its bushing ``channels`` given) the vehicle and bushing parameters; on the road,
+    simulated run, its bushing ``channels`` given) the vehicle file's text ``vehicle_yaml`` and the
+    bushing parameters; on the road,
     the throttle and the facts of the car ``road`` gives (:func:`road_facts`); software version
     and revision."""
     cases = []
@@ -133,7 +135,7 @@ def run_metadata(scenario: Scenario | RoadScenario, plan: list[CaseSchedule], du
         model |= {"throttle": scenario.throttle, **(road or {})}
     return RunMetadata(
         scenario_yaml=scenario.text,
-        vehicle_yaml=scenario.vehicle.read_text() if simulated else "",
+        vehicle_yaml=vehicle_yaml if simulated else "",
         bushing_parameters={ch.name: {**asdict(ch.params), "effects": asdict(ch.effects)}
                             for ch in channels} if simulated else {},
         software_version=software_version(),

@@ -262,6 +262,7 @@ class VehicleDefinition:
     front: FrontAxle
     rear: RearAxle
     bushings: tuple[BushingDef, ...]
+    text: str = ""                        #: the vehicle file's text ("" when changed in code)
 
     def point(self, ref: str) -> np.ndarray:
         """A left-side hardpoint by its dotted name (``front.strut_top``) [m]."""

@@ -38,7 +38,16 @@ def load_vehicle(path: str | Path = DEFAULT_VEHICLE) -> VehicleDefinition:
     """Load and validate a vehicle file, or a built-in vehicle by name (``c_segment``); raises
     :class:`InputError` naming file:line, key and value."""
     path = resolve(path, VEHICLE_DIR, "vehicle")
-    doc = Document.read(path, "no such vehicle file")
+    return parse_vehicle(Document.read(path, "no such vehicle file").text, path)
+
+
+def parse_vehicle(text: str, path: Path, source: str | None = None) -> VehicleDefinition:
+    """Validate the text of a vehicle file; ``path`` is where it stands (the tyre file's folder),
+    ``source`` what errors name (default: ``path``; another source's errors name no line, the text
+    being made rather than the user's). The definition keeps the text."""
+    doc = Document(text, source or str(path))
+    if source is not None:
+        doc.lines.clear()
     top = doc.top(_TOP)
     t = top.fields("tyre", ("radius", "wheel_mass", "wheel_inertia", "property_file"))
     tyre = Tyre(t.number("radius", positive=True, at_most=MAX_RADIUS_M, unit="m"),
@@ -90,7 +99,7 @@ def load_vehicle(path: str | Path = DEFAULT_VEHICLE) -> VehicleDefinition:
     name = top.raw("name")
     if not isinstance(name, str):
         raise top.fail("name", f"expected a name, got {name!r}")
-    vehicle = VehicleDefinition(name, top.text("description", ""), path, tyre, body, front, rear, bushings)
+    vehicle = VehicleDefinition(name, top.text("description", ""), path, tyre, body, front, rear, bushings, text)
     check_geometry(vehicle, doc)
     return vehicle
 
@@ -154,7 +163,7 @@ def with_extensions(v: VehicleDefinition, *, strut_friction: float | Mapping[str
         b = bushing(name, ("coupling", name))
         bushings[name] = replace(b, coupling=_coupling(ext.fields("coupling", tuple(given["coupling"])), name,
                                                        b.directions))
-    return replace(v, front=front, rear=rear, bushings=tuple(bushings.values()))
+    return replace(v, front=front, rear=rear, bushings=tuple(bushings.values()), text="")
 
 
 # -- the readers of the parts of a file --------------------------------------------------------------

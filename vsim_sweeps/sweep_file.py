@@ -1,0 +1,186 @@
+"""Reading a sweep file (format: scenarios/sweeps/README.md): the base vehicle, the scenarios, the
+parameters varied by their place in the vehicle file, the design and the metrics collected.
+
+Everything a sweep could trip on later is checked here, before any run: each parameter's place
+holds a number of the vehicle file (bushing parameters through their sets), its bounds are in
+order, the vehicle builds with every parameter at each bound, the design gives at least one run,
+and each metric is given by at least one of the scenarios. Errors name the sweep file, line, key
+and value.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from vehicle.model.file_overrides import PlaceError, file_value, vehicle_with
+from vehicle.scenarios.road_scenario import RoadScenario
+from vehicle.scenarios.scenario import Scenario
+from vehicle.scenarios.scenario_file import parse_scenario
+from vsim_analysis.kc_metrics import TEST_METRICS
+from vsim_analysis.road_metrics import TYPE_METRICS
+from vsim_analysis.run_metrics import KC_TESTS
+from vsim_core.documents import Document, Fields
+from vsim_core.errors import InputError
+from vsim_core.files import read_text
+from vsim_core.shipped import DEFAULT_VEHICLE, SCENARIO_DIR, SWEEP_DIR, VEHICLE_DIR, resolve
+from vsim_sweeps.designs import Design, run_count
+
+_TOP = ("name", "description", "vehicle", "scenarios", "duration_scale", "parameters", "design", "metrics", "record")
+#: Shortest and longest duration scale of a sweep's runs.
+DURATION_SCALE_RANGE = (0.01, 10.0)
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """A number of the vehicle file that the sweep varies, between two bounds in the file's units."""
+
+    place: str           #: dotted place in the vehicle file (:mod:`vehicle.model.file_overrides`)
+    low: float
+    high: float
+
+
+@dataclass(frozen=True)
+class SourceFile:
+    """A file a run reads, as text, so that a worker anywhere runs the same inputs."""
+
+    path: str
+    text: str
+
+
+@dataclass(frozen=True)
+class MetricColumn:
+    """One column of the sweep's table: a metric of one case of one scenario."""
+
+    name: str            #: ``<scenario>.c<case>.<metric>``
+    scenario: int        #: index in :attr:`Sweep.scenarios`
+    case: int            #: 1-based
+    axle: str | None     #: K&C metrics: the axle; road metrics: None
+    metric: str
+
+
+@dataclass(frozen=True)
+class Sweep:
+    """A validated sweep file."""
+
+    name: str
+    description: str
+    path: Path
+    text: str
+    vehicle: SourceFile
+    scenarios: tuple[SourceFile, ...]
+    duration_scale: float
+    parameters: tuple[Parameter, ...]
+    design: Design
+    metrics: tuple[str, ...]
+    columns: tuple[MetricColumn, ...]
+    record: bool
+
+    @property
+    def runs(self) -> int:
+        """How many runs the design makes."""
+        return run_count(self.design, len(self.parameters))
+
+
+def _parameters(top: Fields, vehicle: SourceFile) -> tuple[Parameter, ...]:
+    raw = top.raw("parameters")
+    if not isinstance(raw, dict) or not raw:
+        raise top.fail("parameters", f"expected a mapping of vehicle-file places to bounds "
+                                     f"({{front.spring.rate: {{min: 25000, max: 31000}}}}), got {raw!r:.80}")
+    data = Document(vehicle.text, vehicle.path).data
+    p = top.fields("parameters", tuple(raw))
+    out = []
+    for place in raw:
+        b = p.fields(place, ("min", "max", "min_factor", "max_factor"))
+        try:
+            base = file_value(data, str(place))
+        except PlaceError as exc:
+            raise p.fail(place, f"not a number of the vehicle file {vehicle.path}: {exc}") from None
+        relative = b.has("min_factor") or b.has("max_factor")
+        if relative and (b.has("min") or b.has("max")):
+            raise p.fail(place, "give min and max (the file's units) or min_factor and max_factor, not both")
+        if relative:
+            if base is None:
+                try:   # a key the file leaves out: one the format knows (then to its default), or a typo
+                    vehicle_with(vehicle.text, Path(vehicle.path), {place: 1.0}, p.doc.where(p.path(place)))
+                except InputError as exc:
+                    raise p.fail(place, f"not a number of the vehicle file {vehicle.path}: {exc.bare}") from None
+                raise p.fail(place, "the vehicle file leaves it to its default: give min and max, not factors")
+            low, high = (b.number(k, positive=True) * base for k in ("min_factor", "max_factor"))
+            if base < 0:
+                low, high = high, low
+        else:
+            low, high = b.number("min"), b.number("max")
+        if not low < high:
+            raise p.fail(place, f"expected min < max, got {low!r} and {high!r}")
+        for value in (low, high):
+            try:
+                vehicle_with(vehicle.text, Path(vehicle.path), {place: value}, p.doc.where(p.path(place)))
+            except InputError as exc:
+                raise p.fail(place, f"the vehicle does not build with {value!r} there: {exc.bare}") from None
+        out.append(Parameter(str(place), low, high))
+    return tuple(out)
+
+
+def metrics_given(scenario: Scenario | RoadScenario) -> list[tuple[str | None, str]]:
+    """(axle or None, metric) of every metric the scenario's cases can give."""
+    if isinstance(scenario, RoadScenario):
+        return [(None, m) for m in TYPE_METRICS[scenario.type]]
+    test = KC_TESTS.get(scenario.type)
+    return [(axle, m) for axle in scenario.axles for m in TEST_METRICS.get(test, ())]
+
+
+def _columns(top: Fields, scenarios: list[Scenario | RoadScenario]) -> tuple[tuple[str, ...], tuple[MetricColumn, ...]]:
+    raw = top.raw("metrics")
+    if not isinstance(raw, list) or not raw or not all(isinstance(m, str) for m in raw):
+        raise top.fail("metrics", f"expected a list of metric names, got {raw!r:.80}")
+    columns = []
+    for i, name in enumerate(raw):
+        axle, _, metric = name.rpartition(".")
+        found = [MetricColumn(f"{s.name}.c{c}.{name}", k, c, axle or None, metric)
+                 for k, s in enumerate(scenarios) if (axle or None, metric) in metrics_given(s)
+                 for c in range(1, len(s.cases) + 1)]
+        if not found:
+            given = sorted({f"{a}.{m}" if a else m for s in scenarios for a, m in metrics_given(s)})
+            raise top.doc.error(top.path("metrics") + (i,),
+                                f"no scenario of the sweep gives {name!r}; they give {', '.join(given) or 'none'}")
+        columns += found
+    return tuple(raw), tuple(columns)
+
+
+def _duration_scale(top: Fields) -> float:
+    scale = top.number("duration_scale", 1.0, positive=True, at_most=DURATION_SCALE_RANGE[1])
+    if scale < DURATION_SCALE_RANGE[0]:
+        raise top.fail("duration_scale", f"expected at least {DURATION_SCALE_RANGE[0]:g}, got {scale!r}")
+    return scale
+
+
+def load_sweep(path: str | Path) -> Sweep:
+    """Load and validate a sweep file (module docstring); InputError naming file:line, key and value."""
+    path = resolve(path, SWEEP_DIR, "sweep")
+    source = str(path)
+    doc = Document(read_text(path), source)
+    top = doc.top(_TOP)
+    vehicle_path = resolve(top.text("vehicle", str(DEFAULT_VEHICLE)), VEHICLE_DIR, "vehicle", base=path.parent)
+    vehicle = SourceFile(str(vehicle_path), read_text(vehicle_path))
+    raw = top.raw("scenarios")
+    if not isinstance(raw, list) or not raw or not all(isinstance(s, str) for s in raw):
+        raise top.fail("scenarios", f"expected a list of scenario files or built-in names, got {raw!r:.80}")
+    files, scenarios = [], []
+    for i, name in enumerate(raw):
+        try:
+            p = resolve(name, SCENARIO_DIR, "scenario", base=path.parent)
+        except InputError as exc:
+            raise doc.error(top.path("scenarios") + (i,), exc.bare) from None
+        files.append(SourceFile(str(p), read_text(p)))
+        scenarios.append(parse_scenario(files[-1].text, p))
+    names = [s.name for s in scenarios]
+    if len(set(names)) != len(names):
+        raise top.fail("scenarios", f"two scenarios have the same name in {names}: their columns would clash")
+    parameters = _parameters(top, vehicle)
+    design = Design.of(top.fields("design", ("type", "levels", "runs", "base_runs", "seed")), len(parameters))
+    metrics, columns = _columns(top, scenarios)
+    return Sweep(top.text("name", path.stem), top.text("description", ""), path, doc.text, vehicle, tuple(files),
+                 _duration_scale(top), parameters,
+                 design, metrics, columns, bool(top.choice("record", (True, False), False)))
+
