@@ -24,12 +24,12 @@ from vehicle.model.vehicle_file import load_vehicle
 from vehicle.scenarios.scenario_file import load_scenario
 from vsim_analysis.run_metrics import run_metrics
 from vsim_cli.main import main
-from vsim_cluster.executor import SerialExecutor, executor
+from vsim_cluster.executor import ClusterLost, SerialExecutor, executor
 from vsim_core.documents import Document
 from vsim_core.errors import InputError
 from vsim_core.shipped import DEFAULT_VEHICLE
 from vsim_recordings.recorder import simulate
-from vsim_sweeps.designs import Design, unit_points
+from vsim_sweeps.designs import Design, design_points, unit_points
 from vsim_sweeps.sensitivity import sobol_indices
 from vsim_sweeps.sweep import run_sweep
 from vsim_sweeps.sweep_file import load_sweep
@@ -102,7 +102,10 @@ def test_a_place_set_by_the_sweep_is_the_vehicle_file_edited_by_hand(serial_tabl
     widths = [float(r[header.index("short_pumping.c1.front.bump_camber_deg_per_m")]) for r in rows]
     assert len(set(widths)) == 3
     inputs = json.loads((out / "sweep.json").read_text())
-    assert inputs["sweep_yaml"] == sweep_path.read_text() and inputs["software_version"]
+    files = {Path(f["path"]).name: f["text"] for f in inputs["files"]}
+    assert files["sweep.yaml"] == sweep_path.read_text() and inputs["software_version"]
+    # every file the runs read: the vehicle, its bushing sets and its tyre
+    assert {"c_segment.yaml", "short_pumping.yaml", "fig5_9.yaml", "195_65R15.tir"} <= set(files)
 
 
 def test_serial_local_cluster_and_external_scheduler_give_the_same_bits(serial_table, tmp_path):
@@ -119,9 +122,12 @@ def test_serial_local_cluster_and_external_scheduler_give_the_same_bits(serial_t
 class _external_cluster:
     """A scheduler and two single-threaded workers started as separate processes (``dask`` commands)."""
 
+    last: "_external_cluster"
+
     def __init__(self, tmp: Path):
         self.file = tmp / "scheduler.json"
         self.procs: list[subprocess.Popen] = []
+        _external_cluster.last = self
 
     def __enter__(self) -> tuple[str, object]:
         dask = [sys.executable, "-m", "distributed.cli.dask_scheduler"]
@@ -139,7 +145,7 @@ class _external_cluster:
         return json.loads(self.file.read_text())["address"], self.client
 
     def __exit__(self, *exc) -> None:
-        self.client.close()
+        self.client.close(timeout=10)
         for p in reversed(self.procs):
             p.terminate()
             p.wait(timeout=30)
@@ -159,6 +165,23 @@ def test_a_killed_worker_costs_only_its_tasks(serial_table, tmp_path):
         with executor(address) as ex:
             report = run_sweep(load_sweep(sweep_path), tmp_path / "out", ex, progress=kill_one)
         assert killed and report.failed == 0
+    assert _table(tmp_path / "out") == _table(serial)
+
+
+def test_a_lost_scheduler_leaves_the_finished_rows_for_resume(serial_table, tmp_path):
+    sweep_path, serial = serial_table
+    with _external_cluster(tmp_path) as (address, _):
+        scheduler = _external_cluster.last.procs[0]
+
+        def kill_scheduler(progress) -> None:
+            if scheduler.poll() is None:
+                scheduler.kill()
+
+        with pytest.raises(ClusterLost), executor(address) as ex:
+            run_sweep(load_sweep(sweep_path), tmp_path / "out", ex, progress=kill_scheduler)
+    rows = _rows(tmp_path / "out")
+    assert 1 <= len(rows) < 3 and all(r[-1] == "" for r in rows)    # finished runs only, none "failed"
+    run_sweep(load_sweep(sweep_path), tmp_path / "out", SerialExecutor(), resume=True)
     assert _table(tmp_path / "out") == _table(serial)
 
 
@@ -232,7 +255,9 @@ def test_sobol_indices_of_the_ishigami_function():
 
 
 @pytest.mark.parametrize("change, key, message", [
-    (("front.spring.rate:", "front.spring.rat:"), "parameters.front.spring.rat", "unknown key 'rat'"),
+    (("front.spring.rate:", "front.spring.rat:"), "parameters.front.spring.rat", "no value there to scale"),
+    (("front.spring.rate: {min_factor: 0.8, max_factor: 1.2}", "front.spring.rat: {min: 25000, max: 30000}"),
+     "parameters.front.spring.rat", "unknown key 'rat'"),
     (("bushings.e2_front.y.Kr:", "bushings.e2_frnt.y.Kr:"), "parameters.bushings.e2_frnt.y.Kr", "no bushing"),
     (("{min: 2000, max: 4000}", "{min: 4000, max: 2000}"), "parameters.bushings.e2_front.y.Kr", "min < max"),
     (("runs: 3", "runs: 0"), "design.runs", "at least 1"),
@@ -241,6 +266,12 @@ def test_sobol_indices_of_the_ishigami_function():
     (("latin_hypercube, runs: 3", "sobol, base_runs: 6"), "design.base_runs", "power of two"),
     (("{min: 2000, max: 4000}", "{min: -4000, max: 2000}"), "parameters.bushings.e2_front.y.Kr",
      "does not build with -4000.0"),
+    (("bushings.e2_front.y.Kr:", "1:"), "parameters[1]", "expected a dotted place"),
+    (("front.spring.rate:", "front.hardpoints.tie_rod_inner.²:"), "parameters.front.hardpoints.tie_rod_inner.²",
+     "expected an index"),
+    (("parameters:", "vehicle: c_segmnt\nparameters:"), "vehicle", "no such vehicle file"),
+    (("metrics: [front.toe_loop_width_deg,", "metrics: [front.toe_loop_width_deg, front.toe_loop_width_deg,"),
+     "metrics[1]", "twice"),
 ])
 def test_bad_sweep_files_are_refused_before_any_run(tmp_path, change, key, message):
     sweep = _sweep(tmp_path, LHS.replace(*change))
@@ -248,6 +279,28 @@ def test_bad_sweep_files_are_refused_before_any_run(tmp_path, change, key, messa
         load_sweep(sweep)
     assert err.value.source.startswith(str(sweep)) and err.value.key == key
     assert main(["sweep", str(sweep), "-o", str(tmp_path / "out")]) == 2 and not (tmp_path / "out").exists()
+
+
+def test_a_bad_base_vehicle_or_scheduler_is_named_before_any_run(tmp_path):
+    bad = tmp_path / "car.yaml"
+    bad.write_text(DEFAULT_VEHICLE.read_text().replace("wheel_mass: 17.0", "wheel_mass: -17.0"))
+    sweep = _sweep(tmp_path, f"vehicle: {bad}\n" + LHS)
+    with pytest.raises(InputError, match="positive") as err:
+        load_sweep(sweep)
+    assert err.value.source.startswith(str(bad)) and err.value.key == "tyre.wheel_mass"
+    good = _sweep(tmp_path, LHS)
+    escaping = tmp_path / "escaping.yaml"
+    escaping.write_text(good.read_text().replace("name: test", "name: ../elsewhere"))
+    with pytest.raises(InputError, match="plain name") as err:
+        load_sweep(escaping)
+    assert err.value.key == "name"
+    for address in ("http://127.0.0.1:8786", "tcp://127.0.0.1:notaport"):
+        assert main(["sweep", str(good), "-o", str(tmp_path / "out"), "--scheduler", address]) == 2
+
+
+def test_grid_points_on_the_bounds_are_the_bounds():
+    points = design_points(Design("grid", levels=3), np.array([-0.3, 2.0]), np.array([0.1, 4.0]))
+    assert points[:, 0].min() == -0.3 and points[:, 0].max() == 0.1 and points[:, 1].max() == 4.0
 
 
 def test_places_of_the_vehicle_file():

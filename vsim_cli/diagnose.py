@@ -50,15 +50,19 @@ def _bench(args: argparse.Namespace, progress):
 def _kc(args: argparse.Namespace, progress):
     from vehicle.model.vehicle_file import load_vehicle
     from vsim_core.shipped import DEFAULT_VEHICLE
-    from vsim_cluster.executor import executor
+    from vsim_cluster.executor import ClusterLost, executor
     from vsim_diagnosis.kc_diagnosis import diagnose_kc
     from vsim_presentation.kc_report import summary, verdict_sentence, write_report
     from vsim_recordings.kc_dataset import read_kc_dataset
 
     vehicle = load_vehicle(args.vehicle or DEFAULT_VEHICLE)
     data = read_kc_dataset(args.rigdir)
-    with executor(args.scheduler, args.workers) as ex:
-        result = diagnose_kc(data, vehicle, executor=ex, progress=progress)
+    try:
+        with executor(args.scheduler, args.workers) as ex:
+            result = diagnose_kc(data, vehicle, executor=ex, progress=progress)
+    except ClusterLost as exc:
+        print(f"vsim: {exc}: the diagnosis stopped; run it again", file=sys.stderr)
+        raise SystemExit(1) from None
     written = write_report(result, vehicle, args.output, str(args.rigdir)) if args.output is not None else []
     return result, written, verdict_sentence, summary
 

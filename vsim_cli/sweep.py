@@ -18,24 +18,29 @@ def _clock(seconds: float) -> str:
 
 
 def _sweep(args: argparse.Namespace) -> int:
-    from vsim_cluster.executor import executor
+    from vsim_cluster.executor import ClusterLost, executor
     from vsim_core.files import read_text
     from vsim_presentation.sweep_figures import metric_plots
-    from vsim_sweeps.sweep import run_sweep
+    from vsim_sweeps.sweep import check_folder, run_sweep
     from vsim_sweeps.sweep_file import load_sweep
 
     sweep = load_sweep(args.sweep)
-    folder = args.output or Path("out") / f"sweep_{sweep.name}"
+    folder = (args.output or Path("out") / f"sweep_{sweep.name}").resolve()
+    check_folder(sweep, folder, resume=args.resume, overwrite=args.overwrite)
 
     def show(p) -> None:
         left = "?" if p.left_s is None else _clock(p.left_s)
         print(f"  runs {p.done}/{p.to_do} done ({p.failed} failed), {_clock(p.elapsed_s)} elapsed, ~{left} left",
               file=sys.stderr, flush=True)
 
-    with executor(args.scheduler, args.workers) as ex:
-        print(f"sweep {sweep.name}: {sweep.runs} runs ({sweep.design.type}, {len(sweep.parameters)} parameters, "
-              f"{len(sweep.columns)} metric columns) on {ex.description}", file=sys.stderr, flush=True)
-        report = run_sweep(sweep, folder, ex, resume=args.resume, overwrite=args.overwrite, progress=show)
+    try:
+        with executor(args.scheduler, args.workers) as ex:
+            print(f"sweep {sweep.name}: {sweep.runs} runs ({sweep.design.type}, {len(sweep.parameters)} parameters, "
+                  f"{len(sweep.columns)} metric columns) on {ex.description}", file=sys.stderr, flush=True)
+            report = run_sweep(sweep, folder, ex, resume=args.resume, overwrite=args.overwrite, progress=show)
+    except ClusterLost as exc:
+        print(f"vsim: {exc}; {folder / 'sweep.csv'} holds the runs finished: --resume completes it", file=sys.stderr)
+        return 1
     rows = list(csv.DictReader(read_text(report.files[0]).splitlines()))
     plots = [] if args.no_plots else metric_plots(rows, [p.place for p in sweep.parameters],
                                                   [c.name for c in sweep.columns], folder / "plots")
@@ -45,7 +50,7 @@ def _sweep(args: argparse.Namespace) -> int:
         print(f"wrote {path}")
     if plots:
         print(f"wrote {len(plots)} PNG(s) in {folder / 'plots'}")
-    return 0
+    return 1 if report.finished and report.failed == report.finished else 0   # every run failed
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:

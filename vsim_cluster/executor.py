@@ -1,11 +1,13 @@
 """Where a command's runs execute: on a Dask cluster started for it on this machine (the default), on
 an existing Dask cluster named by its scheduler's address, or in this process.
 
-Every task is a pure function of its arguments (a vehicle file's text, a scenario's text, values,
-a seed), so any worker computes the bits a serial run computes. A task that raises is an outcome
-with its reason, not the end of the others; a worker that dies takes its tasks with it and the
-scheduler gives them to the others (Dask's ``distributed.scheduler.allowed-failures``: a task that
-kills three workers fails with ``KilledWorker``).
+Every task is a pure function of its arguments (a vehicle file's text, a scenario, values, a
+seed), so any worker computes the bits a serial run computes (on workers of the same CPU type:
+numba compiles for the CPU it runs on). A task that raises is an outcome with its reason, not the
+end of the others; a worker that dies takes its tasks with it and the scheduler gives them to the
+others (a task that was on more dead workers than Dask's ``distributed.scheduler.allowed-failures``,
+3, fails with ``KilledWorker``). A cluster lost altogether (its scheduler gone) ends the session
+with :class:`ClusterLost`: the tasks not finished are not outcomes.
 
 The address comes from the command line (``--scheduler``), else :data:`SCHEDULER_ENV`, else a
 local cluster of one single-threaded worker process per core. ``serial`` runs in this process
@@ -69,8 +71,12 @@ class TaskFailed(RuntimeError):
     """A task of :meth:`Executor.map` failed; the message carries its reason."""
 
 
+class ClusterLost(RuntimeError):
+    """The cluster stopped answering (its scheduler gone): the tasks not finished have no outcome."""
+
+
 def _reason(exc: BaseException) -> str:
-    text = str(exc).strip().replace("\n", " ")
+    text = " ".join(str(exc).split())   # one line, whatever the exception printed
     return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
 
 
@@ -111,13 +117,21 @@ class DaskExecutor(Executor):
         try:
             for future in as_completed(futures):
                 i = index[future.key]
-                if future.status == "finished":
-                    yield Outcome(i, future.result())
-                else:
-                    yield Outcome(i, error=_reason(future.exception()))
+                try:
+                    if future.status not in ("finished", "error"):   # cancelled, or lost with the scheduler
+                        raise ClusterLost(f"{self.description} stopped answering (task {i + 1} of "
+                                          f"{len(futures)}: {future.status})")
+                    outcome = (Outcome(i, future.result()) if future.status == "finished"
+                               else Outcome(i, error=_reason(future.exception())))
+                except OSError as exc:   # the connection to the scheduler or a worker went down
+                    raise ClusterLost(f"{self.description} stopped answering ({_reason(exc)})") from None
+                yield outcome
                 future.release()
         finally:
-            self.client.cancel([f for f in futures if not f.done()])
+            try:
+                self.client.cancel([f for f in futures if not f.done()])
+            except Exception:   # noqa: BLE001 - a client already cut off has nothing left to cancel
+                pass
 
 
 def scheduler_address(given: str | None) -> str:
@@ -130,24 +144,27 @@ def scheduler_address(given: str | None) -> str:
 def executor(scheduler: str | None = None, workers: int | None = None) -> Iterator[Executor]:
     """An :class:`Executor` for a command (module docstring): ``scheduler`` is an address
     (``tcp://host:8786``), :data:`LOCAL` or :data:`SERIAL` (None: :func:`scheduler_address`);
-    ``workers`` sizes a local cluster (default: the machine's cores). A local cluster is closed on
-    leaving; an existing one is left running."""
+    ``workers`` sizes a local cluster (default: the cores this process may use). A local cluster is
+    closed on leaving; an existing one is left running."""
     address = scheduler_address(scheduler)
     if address == SERIAL:
         yield SerialExecutor()
         return
     if address == LOCAL:
-        n = workers or os.cpu_count() or 1
+        n = workers or len(os.sched_getaffinity(0)) or 1
         # one thread per worker process: the compiled step loops hold the GIL
-        with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+        # the dashboard on a free port: a second cluster on the machine must not collide with the first
+        with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
                           silence_logs=logging.CRITICAL) as cluster, Client(cluster) as client:
             yield DaskExecutor(client, f"a local Dask cluster of {n} worker process{'es' if n > 1 else ''}")
         return
     try:
         client = Client(address, timeout="20s")
-    except OSError as exc:
+    except (OSError, ValueError, TypeError) as exc:   # nobody there, or not an address
         raise InputError(f"no Dask scheduler answers at {address!r} ({exc}); expected the address a running "
                          f"scheduler prints (tcp://HOST:8786), '{LOCAL}' or '{SERIAL}'",
                          key="--scheduler / " + SCHEDULER_ENV) from None
+    # a lost scheduler is reported once, as ClusterLost, not by the client's reconnection attempts
+    logging.getLogger("distributed.client").setLevel(logging.CRITICAL)
     with client:
         yield DaskExecutor(client, f"the Dask cluster at {address}")

@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import math
 import time
-from contextlib import nullcontext
+from contextlib import closing, nullcontext
 from dataclasses import dataclass, field, replace
 from typing import Callable, Sequence
 
@@ -308,13 +308,15 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, executor: Execut
             """The compared rows of each vehicle on ``tests`` (NaN elsewhere), the runs in parallel."""
             n = len(tests)
             flat: list[dict[str, np.ndarray]] = [{}] * (n * len(vehicles))
-            for done, o in enumerate(pool.each(run_job, [j for v in vehicles for j in layout.jobs(v, tests)]), 1):
-                if o.error:
-                    raise TaskFailed(f"vehicle {o.index // n + 1} of {len(vehicles)} on "
-                                     f"{layout.tests[tests[o.index % n]].name}: {o.error}")
-                flat[o.index] = o.result
-                if len(vehicles) > 1 and done % n == 0:
-                    say(f"  {done}/{len(flat)} runs done on {pool.description}")
+            jobs = [j for v in vehicles for j in layout.jobs(v, tests)]
+            with closing(pool.each(run_job, jobs)) as outcomes:   # a failure cancels the others at once
+                for done, o in enumerate(outcomes, 1):
+                    if o.error:
+                        raise TaskFailed(f"vehicle {o.index // n + 1} of {len(vehicles)} on "
+                                         f"{layout.tests[tests[o.index % n]].name}: {o.error}")
+                    flat[o.index] = o.result
+                    if len(vehicles) > 1 and done % n == 0:
+                        say(f"  {done}/{len(flat)} runs done on {pool.description}")
             return [layout.stack(flat[i * n:(i + 1) * n], tests) for i in range(len(vehicles))]
 
         say(f"baseline {vehicle.name} on {len(data.tests)} recordings, {len(layout.tests)} tests "

@@ -92,5 +92,7 @@ def unit_points(design: Design, dimensions: int) -> np.ndarray:
 
 
 def design_points(design: Design, low: np.ndarray, high: np.ndarray) -> np.ndarray:
-    """(runs, d) parameter values of ``design`` between the bounds ``low`` and ``high`` (d each)."""
-    return low + unit_points(design, len(low)) * (high - low)
+    """(runs, d) parameter values of ``design`` between the bounds ``low`` and ``high`` (d each); a
+    point on a bound is that bound exactly (the values the sweep file's check built)."""
+    u = unit_points(design, len(low))
+    return low * (1.0 - u) + high * u

@@ -55,14 +55,22 @@ class SweepReport:
     files: list[Path] = field(default_factory=list)
 
 
-def _prepared(sweep: Sweep, folder: Path, points: np.ndarray, resume: bool, overwrite: bool) -> dict[int, list[str]]:
-    """The rows already in ``folder`` that this session keeps (module docstring)."""
-    table = folder / TABLE
+def check_folder(sweep: Sweep, folder: Path, *, resume: bool = False, overwrite: bool = False) -> None:
+    """InputError if ``folder`` holds a table this session may not continue (module docstring):
+    checked before a cluster starts."""
+    table = Path(folder) / TABLE
     if table.exists() and not (resume or overwrite):
         raise InputError("a sweep's table is already there: --resume completes it, --overwrite starts again",
                          source=str(table))
     if table.exists() and resume:
-        check_inputs(folder, sweep)
+        check_inputs(Path(folder), sweep)
+
+
+def _prepared(sweep: Sweep, folder: Path, points: np.ndarray, resume: bool, overwrite: bool) -> dict[int, list[str]]:
+    """The rows already in ``folder`` that this session keeps (module docstring)."""
+    check_folder(sweep, folder, resume=resume, overwrite=overwrite)
+    table = folder / TABLE
+    if table.exists() and resume:
         return read_table(table, sweep, points)
     if overwrite:
         for name in (TABLE, INPUTS, SENSITIVITY):
@@ -73,7 +81,9 @@ def _prepared(sweep: Sweep, folder: Path, points: np.ndarray, resume: bool, over
 
 def run_sweep(sweep: Sweep, folder: Path, executor: Executor, *, resume: bool = False, overwrite: bool = False,
               progress: Callable[[SweepProgress], None] | None = None) -> SweepReport:
-    """Make the runs of ``sweep`` that ``folder``'s table lacks on ``executor`` (module docstring)."""
+    """Make the runs of ``sweep`` that ``folder``'s table lacks on ``executor`` (module docstring).
+    A cluster lost on the way raises :class:`vsim_cluster.executor.ClusterLost`, the table holding
+    the runs finished before."""
     started = time.perf_counter()
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)

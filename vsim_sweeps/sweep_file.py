@@ -10,12 +10,15 @@ and value.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
+from bushings.parameter_sets import load_parameter_set
+from vehicle.model.definition import VehicleDefinition
 from vehicle.model.file_overrides import PlaceError, file_value, vehicle_with
+from vehicle.model.vehicle_file import parse_vehicle
 from vehicle.scenarios.road_scenario import RoadScenario
-from vehicle.scenarios.scenario import Scenario
+from vehicle.scenarios.scenario import NAME_PATTERN, Scenario
 from vehicle.scenarios.scenario_file import parse_scenario
 from vsim_analysis.kc_metrics import TEST_METRICS
 from vsim_analysis.road_metrics import TYPE_METRICS
@@ -42,7 +45,7 @@ class Parameter:
 
 @dataclass(frozen=True)
 class SourceFile:
-    """A file a run reads, as text, so that a worker anywhere runs the same inputs."""
+    """A file a run reads, by its absolute path, with its text."""
 
     path: str
     text: str
@@ -67,8 +70,9 @@ class Sweep:
     description: str
     path: Path
     text: str
-    vehicle: SourceFile
-    scenarios: tuple[SourceFile, ...]
+    vehicle: SourceFile                              #: the base vehicle file (absolute path) and its text
+    scenarios: tuple[Scenario | RoadScenario, ...]   #: parsed here: a worker resolves none of their paths
+    inputs: tuple[SourceFile, ...]                   #: every file the runs read (sweep, vehicle, scenarios, sets, tyre)
     duration_scale: float
     parameters: tuple[Parameter, ...]
     design: Design
@@ -91,6 +95,8 @@ def _parameters(top: Fields, vehicle: SourceFile) -> tuple[Parameter, ...]:
     p = top.fields("parameters", tuple(raw))
     out = []
     for place in raw:
+        if not isinstance(place, str):
+            raise p.fail(place, f"expected a dotted place in the vehicle file (front.spring.rate), got {place!r}")
         b = p.fields(place, ("min", "max", "min_factor", "max_factor"))
         try:
             base = file_value(data, str(place))
@@ -101,11 +107,9 @@ def _parameters(top: Fields, vehicle: SourceFile) -> tuple[Parameter, ...]:
             raise p.fail(place, "give min and max (the file's units) or min_factor and max_factor, not both")
         if relative:
             if base is None:
-                try:   # a key the file leaves out: one the format knows (then to its default), or a typo
-                    vehicle_with(vehicle.text, Path(vehicle.path), {place: 1.0}, p.doc.where(p.path(place)))
-                except InputError as exc:
-                    raise p.fail(place, f"not a number of the vehicle file {vehicle.path}: {exc.bare}") from None
-                raise p.fail(place, "the vehicle file leaves it to its default: give min and max, not factors")
+                raise p.fail(place, f"the vehicle file {vehicle.path} has no value there to scale (a key left to "
+                                    f"its default, or a typo): give min and max, which are checked against the "
+                                    f"format")
             low, high = (b.number(k, positive=True) * base for k in ("min_factor", "max_factor"))
             if base < 0:
                 low, high = high, low
@@ -117,7 +121,8 @@ def _parameters(top: Fields, vehicle: SourceFile) -> tuple[Parameter, ...]:
             try:
                 vehicle_with(vehicle.text, Path(vehicle.path), {place: value}, p.doc.where(p.path(place)))
             except InputError as exc:
-                raise p.fail(place, f"the vehicle does not build with {value!r} there: {exc.bare}") from None
+                raise p.fail(place, f"the vehicle does not build with {value!r} there: "
+                                    f"{exc.key + ': ' if exc.key else ''}{exc.bare}") from None
         out.append(Parameter(str(place), low, high))
     return tuple(out)
 
@@ -140,6 +145,8 @@ def _columns(top: Fields, scenarios: list[Scenario | RoadScenario]) -> tuple[tup
         found = [MetricColumn(f"{s.name}.c{c}.{name}", k, c, axle or None, metric)
                  for k, s in enumerate(scenarios) if (axle or None, metric) in metrics_given(s)
                  for c in range(1, len(s.cases) + 1)]
+        if name in raw[:i]:
+            raise top.doc.error(top.path("metrics") + (i,), f"{name!r} is asked for twice")
         if not found:
             given = sorted({f"{a}.{m}" if a else m for s in scenarios for a, m in metrics_given(s)})
             raise top.doc.error(top.path("metrics") + (i,),
@@ -157,30 +164,49 @@ def _duration_scale(top: Fields) -> float:
 
 def load_sweep(path: str | Path) -> Sweep:
     """Load and validate a sweep file (module docstring); InputError naming file:line, key and value."""
-    path = resolve(path, SWEEP_DIR, "sweep")
-    source = str(path)
-    doc = Document(read_text(path), source)
+    path = resolve(path, SWEEP_DIR, "sweep").resolve()
+    doc = Document(read_text(path), str(path))
     top = doc.top(_TOP)
-    vehicle_path = resolve(top.text("vehicle", str(DEFAULT_VEHICLE)), VEHICLE_DIR, "vehicle", base=path.parent)
+    name = top.text("name", path.stem)
+    if not NAME_PATTERN.fullmatch(name):
+        raise top.fail("name", f"expected a plain name (letters, digits, '_', '.', '-'; the output folder is "
+                               f"out/sweep_<name>), got {name!r}")
+    try:
+        vehicle_path = resolve(top.text("vehicle", str(DEFAULT_VEHICLE)), VEHICLE_DIR, "vehicle",
+                               base=path.parent).resolve()
+    except InputError as exc:
+        raise top.fail("vehicle", f"{exc.source}: {exc.bare}") from None
     vehicle = SourceFile(str(vehicle_path), read_text(vehicle_path))
+    base = parse_vehicle(vehicle.text, vehicle_path)   # the base vehicle's own errors name its file
     raw = top.raw("scenarios")
     if not isinstance(raw, list) or not raw or not all(isinstance(s, str) for s in raw):
         raise top.fail("scenarios", f"expected a list of scenario files or built-in names, got {raw!r:.80}")
     files, scenarios = [], []
-    for i, name in enumerate(raw):
+    for i, entry in enumerate(raw):
         try:
-            p = resolve(name, SCENARIO_DIR, "scenario", base=path.parent)
+            p = resolve(entry, SCENARIO_DIR, "scenario", base=path.parent).resolve()
         except InputError as exc:
             raise doc.error(top.path("scenarios") + (i,), exc.bare) from None
         files.append(SourceFile(str(p), read_text(p)))
-        scenarios.append(parse_scenario(files[-1].text, p))
+        scenarios.append(replace(parse_scenario(files[-1].text, p), vehicle=vehicle_path))
     names = [s.name for s in scenarios]
     if len(set(names)) != len(names):
         raise top.fail("scenarios", f"two scenarios have the same name in {names}: their columns would clash")
     parameters = _parameters(top, vehicle)
     design = Design.of(top.fields("design", ("type", "levels", "runs", "base_runs", "seed")), len(parameters))
     metrics, columns = _columns(top, scenarios)
-    return Sweep(top.text("name", path.stem), top.text("description", ""), path, doc.text, vehicle, tuple(files),
-                 _duration_scale(top), parameters,
-                 design, metrics, columns, bool(top.choice("record", (True, False), False)))
+    inputs = (SourceFile(str(path), doc.text), vehicle, *files, *_read_by(base))
+    return Sweep(name, top.text("description", ""), path, doc.text, vehicle, tuple(scenarios), inputs,
+                 _duration_scale(top), parameters, design, metrics, columns,
+                 bool(top.choice("record", (True, False), False)))
+
+
+def _read_by(vehicle: VehicleDefinition) -> list[SourceFile]:
+    """The files a run of ``vehicle`` reads besides its own: its bushing parameter sets and its tyre."""
+    names = {d.set_name for b in vehicle.bushings for d in b.directions.values() if d.set_name}
+    names |= {n for b in vehicle.bushings for d in b.directions.values() for n in d.families.sets.values()}
+    paths = sorted({load_parameter_set(n).path for n in names} - {None})
+    if vehicle.tyre.property_file is not None:
+        paths.append(vehicle.tyre.property_file)
+    return [SourceFile(str(p), read_text(p)) for p in paths]
 

@@ -1,17 +1,20 @@
-"""One run of a sweep: a pure function of the vehicle file's text, the scenarios' texts, the values
-set at their places and the duration scale, so that any worker of any cluster computes the bits a
-serial run computes. It returns the run's metrics; a failure (a diverged car, a metric that raises)
-is raised to the executor, which makes it the run's row with its reason."""
+"""One run of a sweep: a pure function of the vehicle file's text, the scenarios (parsed where the
+sweep was read), the values set at their places and the duration scale, so that any worker computes
+the bits a serial run computes. The worker reads the files the vehicle names (bushing parameter
+sets, tyre) by their absolute paths: a shared filesystem or the same installation. It returns the
+run's metrics; a failure (a diverged car, a metric that raises) is raised to the executor, which
+makes it the run's row with its reason."""
 
 from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 
 from vehicle.model.file_overrides import vehicle_with
-from vehicle.scenarios.scenario_file import parse_scenario
+from vehicle.scenarios.road_scenario import RoadScenario
+from vehicle.scenarios.scenario import Scenario
 from vsim_analysis.road_metrics import road_metrics
 from vsim_analysis.run_metrics import is_road, run_metrics
 from vsim_recordings.recorder import run_scenario, simulate
@@ -26,7 +29,7 @@ class RunTask:
     index: int                                #: 0-based run number in the design
     values: tuple[tuple[str, float], ...]     #: (place, value) of each parameter
     vehicle: SourceFile
-    scenarios: tuple[SourceFile, ...]
+    scenarios: tuple[Scenario | RoadScenario, ...]
     duration_scale: float
     columns: tuple[MetricColumn, ...]
     record_dir: str | None                    #: where to write each scenario's MCAP, or None
@@ -46,7 +49,8 @@ def tasks(sweep: Sweep, points: list[tuple[float, ...]], indices: list[int], rec
     """The :class:`RunTask` of each run number of ``indices`` (its parameter values in ``points``)."""
     places = [p.place for p in sweep.parameters]
     return [RunTask(i, tuple(zip(places, points[i])), sweep.vehicle, sweep.scenarios, sweep.duration_scale,
-                    sweep.columns, None if record_dir is None else str(record_dir), str(sweep.path)) for i in indices]
+                    sweep.columns, None if record_dir is None else str(record_dir.resolve()), str(sweep.path))
+            for i in indices]
 
 
 def _value(metrics: dict, column: MetricColumn) -> float:
@@ -61,8 +65,7 @@ def run_point(task: RunTask) -> RunOutcome:
     vehicle = vehicle_with(task.vehicle.text, Path(task.vehicle.path), dict(task.values),
                            f"{task.source}: run {task.index + 1}")
     out: dict[str, float] = {}
-    for k, f in enumerate(task.scenarios):
-        scenario = replace(parse_scenario(f.text, Path(f.path)), vehicle=Path(task.vehicle.path))
+    for k, scenario in enumerate(task.scenarios):
         if task.record_dir is None:
             run: Run = simulate(scenario, vehicle, duration_scale=task.duration_scale)
         else:

@@ -33,14 +33,13 @@ def header(sweep: Sweep) -> list[str]:
 
 
 def inputs_record(sweep: Sweep) -> dict:
-    """What the sweep was made from: the texts of the sweep, vehicle and scenario files, the
-    software version, and their fingerprint (a resumed sweep must have the same)."""
-    texts = [sweep.text, sweep.vehicle.text, *(s.text for s in sweep.scenarios)]
-    digest = hashlib.sha256("\0".join(texts).encode()).hexdigest()
-    return {"sweep_file": str(sweep.path), "inputs_sha256": digest, "software_version": software_version(),
-            "runs": sweep.runs, "sweep_yaml": sweep.text,
-            "vehicle": {"path": sweep.vehicle.path, "yaml": sweep.vehicle.text},
-            "scenarios": [{"path": s.path, "yaml": s.text} for s in sweep.scenarios]}
+    """What the sweep was made from: the path and text of every file its runs read (the sweep, the
+    vehicle, the scenarios, the vehicle's bushing parameter sets and tyre), the software version,
+    and their fingerprint (a resumed sweep must have the same)."""
+    version = software_version()
+    digest = hashlib.sha256("\0".join([version, *(f"{f.path}\0{f.text}" for f in sweep.inputs)]).encode()).hexdigest()
+    return {"sweep_file": str(sweep.path), "inputs_sha256": digest, "software_version": version,
+            "runs": sweep.runs, "files": [{"path": f.path, "text": f.text} for f in sweep.inputs]}
 
 
 def format_row(run: int, values: Sequence[float], metrics: Mapping[str, float], names: Sequence[str],
@@ -129,8 +128,8 @@ def check_inputs(folder: Path, sweep: Sweep) -> None:
         made = None
     if made != inputs_record(sweep)["inputs_sha256"]:
         raise InputError(f"the sweep there was not made from the same sweep, vehicle and scenario files as "
-                         f"{sweep.path} (their texts differ, or {INPUTS} is missing): --resume completes only the "
-                         f"same sweep; use --overwrite or another folder", source=str(path))
+                         f"{sweep.path} with this software version (a text differs, or {INPUTS} is missing): --resume "
+                         f"completes only the same sweep; use --overwrite or another folder", source=str(path))
 
 
 def numbers(rows: Iterable[list[str]], column: int) -> list[float]:

@@ -76,7 +76,9 @@ def _container(data: Any, place: str) -> tuple[Any, Any]:
     for i, part in enumerate(rest):
         last = i == len(rest) - 1
         if isinstance(node, list):
-            index = _AXES.get(part, int(part) if part.isdigit() else None)
+            point = len(node) == 3 and all(isinstance(v, (int, float)) for v in node)
+            index = _AXES.get(part) if point else None
+            index = int(part) if part.isdecimal() and part.isascii() else index
             if index is None or index >= len(node):
                 raise PlaceError(f"{'.'.join(rest[:i]) or place} is a list of {len(node)}: expected an index "
                                  f"0..{len(node) - 1}{' or x, y, z' if len(node) == 3 else ''}, got {part!r}")
