@@ -1,0 +1,74 @@
+"""The thesis's vehicle-level phenomena that the model reproduces (issue 30; the report is
+tools/thesis/report.md, made by tools/thesis_reproduction.py), held by their direction and rough
+size so that a later change cannot lose them silently: the loop against the pumping speed and its
+causes, the bushing's deflection following the pumping amplitude, and the laws' relaxation on the
+bench (RT more than STVS). The car's relaxation after a rack step and the fading memory of two steps
+are not reproduced (the report says why): no test holds them."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from vehicle.model.file_overrides import vehicle_with
+from vehicle.scenarios.scenario_file import load_scenario, parse_scenario
+from bushings.bank import BushingBank
+from bushings.parameter_sets import load_parameter_set
+from vsim_analysis.run_metrics import case_loop, case_mask, cases
+from vsim_core.shipped import DEFAULT_VEHICLE
+from vsim_recordings.recorder import simulate
+
+NO_DAMPERS = {f"{axle}.damper.curve.{i}.1": value for axle in ("front", "rear") for i, value in ((0, -1.0), (2, 1.0))}
+#: Pumping of the front axle, 20 mm, slow and ten times faster.
+SPEEDS = f"""name: speeds
+type: pumping
+vehicle: {DEFAULT_VEHICLE}
+axles: [front]
+output_rate_hz: 50
+settle: {{before_bushings_s: 0.5, before_input_s: 0.5}}
+defaults: {{shape: triangle, amplitude_mm: 20, cycles: 2}}
+cases: [{{speed_mm_s: 2}}, {{speed_mm_s: 20}}]
+"""
+
+
+def _camber_loops(model: str, values: dict) -> list[float]:
+    scenario = replace(parse_scenario(SPEEDS, Path("speeds.yaml")), bushing_model=model)
+    run = simulate(scenario, vehicle_with(DEFAULT_VEHICLE.read_text(), DEFAULT_VEHICLE, values, "test"))
+    return [case_loop(run, c, "pad_height_fl", "camber_fl", "pad_height_fl").width for c in cases(run)]
+
+
+def test_the_camber_loop_thins_with_the_pumping_speed_through_the_dampers():
+    rate_independent = _camber_loops("sts", NO_DAMPERS)
+    with_dampers = _camber_loops("sts", {})
+    dampers_alone = _camber_loops("linear", {})
+    nothing = _camber_loops("linear", NO_DAMPERS)
+    # the rig and the car's inertia make no loop; a rate-independent law nearly the same at both speeds
+    assert max(nothing) < 0.02 * rate_independent[0]
+    assert rate_independent[1] == pytest.approx(rate_independent[0], rel=0.08)
+    # the dampers' own loop grows with the speed (viscous: about in proportion) and runs against the
+    # sliders': with both, the loop thins, the more so the faster
+    assert dampers_alone[1] > 5 * dampers_alone[0]
+    assert with_dampers[0] < rate_independent[0] and with_dampers[1] < 0.5 * rate_independent[1]
+
+
+def test_the_rear_pivot_bushing_follows_the_pumping_amplitude():
+    run = simulate(replace(load_scenario("pumping"), bushing_model="stvs"), duration_scale=0.2)
+    pp = [np.ptp(run.signals["e1_rear_right_z_deflection"][case_mask(run, c)]) for c in cases(run)]
+    assert np.all(np.diff(pp) > 0)
+    assert 2.5 <= pp[2] / pp[0] <= 3.3      # 30 mm against 10 mm
+
+
+def test_the_laws_relax_on_the_bench_rt_more_than_stvs():
+    """Fig. 4.32's bushing-level half: held after a 50 ms ramp to 0.3 mm, the force keeps falling
+    from 0.5 s to 6 s, RT (fig5_8) more than STVS (fig5_9)."""
+    dt = 1e-3
+    t = np.arange(0.0, 6.0, dt)
+    e = (np.clip(t / 0.05, 0.0, 1.0) * 0.3e-3)[:, None]
+    loss = {}
+    for name in ("fig5_9", "fig5_8"):
+        force, _ = BushingBank([load_parameter_set(name).channel()]).run(e, dt)
+        loss[name] = 1.0 - force[-1, 0] / force[550, 0]
+    assert 0.02 < loss["fig5_9"] < loss["fig5_8"] < 0.1
