@@ -29,8 +29,8 @@ def _sweep(args: argparse.Namespace) -> int:
     check_folder(sweep, folder, resume=args.resume, overwrite=args.overwrite)
 
     def show(p) -> None:
-        left = "?" if p.left_s is None else _clock(p.left_s)
-        print(f"  runs {p.done}/{p.to_do} done ({p.failed} failed), {_clock(p.elapsed_s)} elapsed, ~{left} left",
+        print(f"  runs {p.done}/{p.to_do} done ({p.failed} failed), {_clock(p.elapsed_s)} elapsed, "
+              f"~{_clock(p.left_s)} left",
               file=sys.stderr, flush=True)
 
     try:

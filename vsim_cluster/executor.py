@@ -46,8 +46,6 @@ class Outcome:
 class Executor:
     """Runs tasks; :meth:`each` yields outcomes as they finish, :meth:`map` returns results in order."""
 
-    #: How many tasks run at once.
-    workers: int = 1
     #: What the executor is, for progress lines and reports.
     description: str = ""
 
@@ -102,11 +100,6 @@ class DaskExecutor(Executor):
     def __init__(self, client: Any, description: str):
         self.client = client
         self.description = description
-
-    @property
-    def workers(self) -> int:  # type: ignore[override]
-        """The threads of the cluster's workers now (at least 1)."""
-        return max(1, sum(self.client.nthreads().values()))
 
     def each(self, fn: Callable[[Any], Any], items: Sequence[Any]) -> Iterator[Outcome]:
         """``fn`` of every item as a task of the cluster, yielded as they finish; the tasks not

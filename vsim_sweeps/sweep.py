@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 import shutil
 import time
+from contextlib import closing
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
@@ -37,7 +38,7 @@ class SweepProgress:
     to_do: int
     failed: int
     elapsed_s: float
-    left_s: float | None      #: None until a run has finished
+    left_s: float             #: the runs left at the mean pace of those finished
 
 
 @dataclass
@@ -75,7 +76,8 @@ def _prepared(sweep: Sweep, folder: Path, points: np.ndarray, resume: bool, over
     if overwrite:
         for name in (TABLE, INPUTS, SENSITIVITY):
             (folder / name).unlink(missing_ok=True)
-        shutil.rmtree(folder / "runs", ignore_errors=True)
+        for name in ("runs", "plots"):
+            shutil.rmtree(folder / name, ignore_errors=True)
     return {}
 
 
@@ -99,17 +101,19 @@ def run_sweep(sweep: Sweep, folder: Path, executor: Executor, *, resume: bool = 
     writer = TableWriter(folder, sweep, done)
     compute_s, failed, count = 0.0, 0, 0
     try:
-        for outcome in executor.each(run_point, tasks(sweep, points, missing, record_dir)):
-            run = missing[outcome.index]
-            metrics = {} if outcome.error else outcome.result.metrics
-            compute_s += 0.0 if outcome.error else outcome.result.compute_s
-            failed += bool(outcome.error)
-            count += 1
-            writer.add(format_row(run + 1, points[run], metrics, names, outcome.error))
-            if progress is not None:
-                elapsed = time.perf_counter() - started
-                progress(SweepProgress(count, len(missing), failed, elapsed,
-                                       elapsed / count * (len(missing) - count)))
+        # closed on leaving (Ctrl-C too): the runs not finished are cancelled on the cluster at once
+        with closing(executor.each(run_point, tasks(sweep, points, missing, record_dir))) as outcomes:
+            for outcome in outcomes:
+                run = missing[outcome.index]
+                metrics = {} if outcome.error else outcome.result.metrics
+                compute_s += 0.0 if outcome.error else outcome.result.compute_s
+                failed += bool(outcome.error)
+                count += 1
+                writer.add(format_row(run + 1, points[run], metrics, names, outcome.error))
+                if progress is not None:
+                    elapsed = time.perf_counter() - started
+                    progress(SweepProgress(count, len(missing), failed, elapsed,
+                                           elapsed / count * (len(missing) - count)))
     finally:
         writer.finish()
     files = [writer.path, folder / INPUTS]
