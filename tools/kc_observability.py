@@ -10,7 +10,7 @@ error), in units of the channel's noise (the virtual rig's defaults). A baseline
 
     python tools/kc_observability.py [--vehicle V.yaml] [--duration-scale S] [--json]
 
-About 4 min on 2 cores at ``--duration-scale 0.25``.
+About 2 min on 2 cores at ``--duration-scale 0.25`` (its runs on a local Dask cluster, or where ``VSIM_SCHEDULER`` says).
 """
 
 from __future__ import annotations
@@ -18,9 +18,8 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import multiprocessing
 import sys
-from concurrent.futures import ProcessPoolExecutor
+from contextlib import closing
 from pathlib import Path
 
 import numpy as np
@@ -28,6 +27,7 @@ import numpy as np
 from vehicle.model.definition import VehicleDefinition
 from vehicle.model.vehicle_file import load_vehicle
 from vehicle.scenarios.scenario_file import load_scenario
+from vsim_cluster.executor import TaskFailed, executor
 from vsim_core.shipped import DEFAULT_VEHICLE
 from vsim_diagnosis.kc_catalogue import (BUSHING_CAUSES, MIN_EXCESS, VEHICLE_CAUSES, Hypothesis, extended_vehicle,
                                          locations, parameters)
@@ -62,6 +62,11 @@ def campaign(vehicle: VehicleDefinition, duration_scale: float) -> list[dict[str
     return out
 
 
+def _campaign(job: tuple[VehicleDefinition, float]) -> list[dict[str, np.ndarray]]:
+    """:func:`campaign` of a (vehicle, duration scale) pair: one task of the executor."""
+    return campaign(*job)
+
+
 def excess(base: list[dict[str, np.ndarray]], run: list[dict[str, np.ndarray]]) -> float:
     """RMS change over every channel and sample, each channel's mean per recording removed [noise]."""
     squares = [float(np.mean((d - d.mean()) ** 2)) for b, r in zip(base, run) for d in (r[n] - b[n] for n in b)]
@@ -79,15 +84,18 @@ def main() -> int:
     places = [Hypothesis(c, where, values) for c in (*BUSHING_CAUSES, *VEHICLE_CAUSES, "backlash")
               for where in locations(vehicle, c) for values in weak(c)]
     out: dict[str, dict[str, float]] = {}
-    with ProcessPoolExecutor(2, mp_context=multiprocessing.get_context("fork")) as pool:
-        runs = pool.map(campaign, [extended_vehicle(vehicle, [h]) for h in places], [args.duration_scale] * len(places))
-        for h, run in zip(places, runs):
-            x = excess(base, run)
+    with executor() as ex, closing(ex.each(_campaign, [(extended_vehicle(vehicle, [h]), args.duration_scale)
+                                                       for h in places])) as outcomes:
+        for o in outcomes:   # printed as they finish
+            if o.error:
+                raise TaskFailed(f"{places[o.index].label}: {o.error}")
+            h, x = places[o.index], excess(base, o.result)
             if not args.json:
                 print(f"{h.label:40s} {parameters(h.cause)[0].name} = {h.values[parameters(h.cause)[0].name]:<8.4g}"
                       f" excess {x:7.2f}", flush=True)
             if x < out.get(h.label, {}).get("excess", math.inf):   # a sided cause: its weaker sign
                 out[h.label] = {"excess": x, "floor": floor(h.cause, x)}
+    out = {label: out[label] for label in dict.fromkeys(h.label for h in places)}   # in the places' order
     if args.json:
         print(json.dumps(out))
     else:

@@ -5,7 +5,6 @@ indices for a Sobol' design."""
 from __future__ import annotations
 
 import argparse
-import csv
 import sys
 from pathlib import Path
 
@@ -19,7 +18,6 @@ def _clock(seconds: float) -> str:
 
 def _sweep(args: argparse.Namespace) -> int:
     from vsim_cluster.executor import ClusterLost, executor
-    from vsim_core.files import read_text
     from vsim_presentation.sweep_figures import metric_plots
     from vsim_sweeps.sweep import check_folder, run_sweep
     from vsim_sweeps.sweep_file import load_sweep
@@ -41,8 +39,7 @@ def _sweep(args: argparse.Namespace) -> int:
     except ClusterLost as exc:
         print(f"vsim: {exc}; {folder / 'sweep.csv'} holds the runs finished: --resume completes it", file=sys.stderr)
         return 1
-    rows = list(csv.DictReader(read_text(report.files[0]).splitlines()))
-    plots = [] if args.no_plots else metric_plots(rows, [p.place for p in sweep.parameters],
+    plots = [] if args.no_plots else metric_plots(report.table, [p.place for p in sweep.parameters],
                                                   [c.name for c in sweep.columns], folder / "plots")
     print(f"{report.finished}/{report.runs} runs in the table ({report.failed} failed; {report.computed} made now in "
           f"{_clock(report.wall_s)})")

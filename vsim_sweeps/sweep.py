@@ -45,14 +45,13 @@ class SweepProgress:
 class SweepReport:
     """A finished (or interrupted) sweep: its table and what the session computed."""
 
-    folder: Path
     runs: int                                  #: runs of the design
     finished: int                              #: rows in the table
     failed: int                                #: rows with a reason
     computed: int                              #: runs made by this session
     wall_s: float
     compute_s: float                           #: sum of the runs' own simulation times
-    executor: str
+    table: list[dict[str, str]]                #: the table's rows in run order, by column (as written)
     files: list[Path] = field(default_factory=list)
 
 
@@ -119,9 +118,8 @@ def run_sweep(sweep: Sweep, folder: Path, executor: Executor, *, resume: bool = 
     files = [writer.path, folder / INPUTS]
     if sweep.design.type == "sobol" and len(writer.rows) == len(points):
         files.append(_write_sensitivity(folder, sweep, writer.rows))
-    return SweepReport(folder, len(points), len(writer.rows),
-                       sum(1 for r in writer.rows.values() if r[-1]), count, time.perf_counter() - started,
-                       compute_s, executor.description, files)
+    return SweepReport(len(points), len(writer.rows), sum(1 for r in writer.rows.values() if r[-1]), count,
+                       time.perf_counter() - started, compute_s, writer.records(), files)
 
 
 def _write_sensitivity(folder: Path, sweep: Sweep, rows: dict[int, list[str]]) -> Path:

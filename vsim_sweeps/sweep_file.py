@@ -69,14 +69,12 @@ class Sweep:
     name: str
     description: str
     path: Path
-    text: str
     vehicle: SourceFile                              #: the base vehicle file (absolute path) and its text
     scenarios: tuple[Scenario | RoadScenario, ...]   #: parsed here: a worker resolves none of their paths
     inputs: tuple[SourceFile, ...]                   #: every file the runs read (sweep, vehicle, scenarios, sets, tyre)
     duration_scale: float
     parameters: tuple[Parameter, ...]
     design: Design
-    metrics: tuple[str, ...]
     columns: tuple[MetricColumn, ...]
     record: bool
 
@@ -99,7 +97,7 @@ def _parameters(top: Fields, vehicle: SourceFile) -> tuple[Parameter, ...]:
             raise p.fail(place, f"expected a dotted place in the vehicle file (front.spring.rate), got {place!r}")
         b = p.fields(place, ("min", "max", "min_factor", "max_factor"))
         try:
-            base = file_value(data, str(place))
+            base = file_value(data, place)
         except PlaceError as exc:
             raise p.fail(place, f"not a number of the vehicle file {vehicle.path}: {exc}") from None
         relative = b.has("min_factor") or b.has("max_factor")
@@ -123,7 +121,7 @@ def _parameters(top: Fields, vehicle: SourceFile) -> tuple[Parameter, ...]:
             except InputError as exc:
                 raise p.fail(place, f"the vehicle does not build with {value!r} there: "
                                     f"{exc.key + ': ' if exc.key else ''}{exc.bare}") from None
-        out.append(Parameter(str(place), low, high))
+        out.append(Parameter(place, low, high))
     return tuple(out)
 
 
@@ -135,7 +133,7 @@ def metrics_given(scenario: Scenario | RoadScenario) -> list[tuple[str | None, s
     return [(axle, m) for axle in scenario.axles for m in TEST_METRICS.get(test, ())]
 
 
-def _columns(top: Fields, scenarios: list[Scenario | RoadScenario]) -> tuple[tuple[str, ...], tuple[MetricColumn, ...]]:
+def _columns(top: Fields, scenarios: list[Scenario | RoadScenario]) -> tuple[MetricColumn, ...]:
     raw = top.raw("metrics")
     if not isinstance(raw, list) or not raw or not all(isinstance(m, str) for m in raw):
         raise top.fail("metrics", f"expected a list of metric names, got {raw!r:.80}")
@@ -152,7 +150,7 @@ def _columns(top: Fields, scenarios: list[Scenario | RoadScenario]) -> tuple[tup
             raise top.doc.error(top.path("metrics") + (i,),
                                 f"no scenario of the sweep gives {name!r}; they give {', '.join(given) or 'none'}")
         columns += found
-    return tuple(raw), tuple(columns)
+    return tuple(columns)
 
 
 def _duration_scale(top: Fields) -> float:
@@ -194,10 +192,10 @@ def load_sweep(path: str | Path) -> Sweep:
         raise top.fail("scenarios", f"two scenarios have the same name in {names}: their columns would clash")
     parameters = _parameters(top, vehicle)
     design = Design.of(top.fields("design", ("type", "levels", "runs", "base_runs", "seed")), len(parameters))
-    metrics, columns = _columns(top, scenarios)
+    columns = _columns(top, scenarios)
     inputs = (SourceFile(str(path), doc.text), vehicle, *files, *_read_by(base))
-    return Sweep(name, top.text("description", ""), path, doc.text, vehicle, tuple(scenarios), inputs,
-                 _duration_scale(top), parameters, design, metrics, columns,
+    return Sweep(name, top.text("description", ""), path, vehicle, tuple(scenarios), inputs,
+                 _duration_scale(top), parameters, design, columns,
                  bool(top.choice("record", (True, False), False)))
 
 

@@ -15,7 +15,7 @@ import io
 import json
 import math
 from pathlib import Path
-from typing import Iterable, Mapping, Sequence
+from typing import Mapping, Sequence
 
 from vsim_core.errors import InputError
 from vsim_core.files import atomic_output, read_text
@@ -112,6 +112,10 @@ class TableWriter:
         self.stream.close()
         self._write_ordered()
 
+    def records(self) -> list[dict[str, str]]:
+        """The table's rows in run order, each by column name (cells as written)."""
+        return [dict(zip(self.header, self.rows[k])) for k in sorted(self.rows)]
+
 
 def write_inputs(folder: Path, sweep: Sweep) -> None:
     """``sweep.json`` of :func:`inputs_record` (atomically)."""
@@ -131,7 +135,3 @@ def check_inputs(folder: Path, sweep: Sweep) -> None:
                          f"{sweep.path} with this software version (a text differs, or {INPUTS} is missing): --resume "
                          f"completes only the same sweep; use --overwrite or another folder", source=str(path))
 
-
-def numbers(rows: Iterable[list[str]], column: int) -> list[float]:
-    """The numbers of one column of table rows."""
-    return [float(r[column]) for r in rows]
