@@ -345,3 +345,53 @@ def test_vsim_plot_writes_pngs(run_file: Path, tmp_path: Path) -> None:
     for name in names:
         data = (out / name).read_bytes()
         assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 10_000
+
+
+class _Blocks:
+    """A stand-in writer and layout for BackgroundWriter: records what it writes, fails on request."""
+
+    def __init__(self, fail_at: int = -1):
+        self.written, self.fail_at = [], fail_at
+
+    def values(self, block):
+        return block.measured
+
+    def write_block(self, t_s, values, pos, quat):
+        if len(self.written) == self.fail_at:
+            raise OSError("no space left on device")
+        self.written.append(t_s.copy())
+        return np.round(t_s * 1e9).astype(np.uint64)
+
+
+def _block(k: int):
+    from vehicle.simulation.outputs import SampleBlock
+
+    t = np.arange(k * 3, k * 3 + 3) * 0.02 + 0.02
+    return SampleBlock(t, 1, 2, t, np.zeros((3, 0)), np.full((3, 2), float(k)), np.empty((3, 0, 3)),
+                       np.empty((3, 0, 4)))
+
+
+def test_background_writer_keeps_the_order_and_hands_its_errors_to_the_caller() -> None:
+    """Blocks are written in the order given and kept for the run in memory; a failed write is
+    raised at the caller's next put (nothing after it is written) and, when the caller itself
+    stops on an error, joined to that error as a note."""
+    from vsim_recordings.background import BackgroundWriter
+
+    sink = _Blocks()
+    with BackgroundWriter(sink, sink) as writer:
+        for k in range(20):
+            writer.put(_block(k))
+    assert [t[0] for t in sink.written] == [_block(k).time_s[0] for k in range(20)]
+    assert np.array_equal(np.concatenate(writer.values)[:, 0], np.repeat(np.arange(20.0), 3))
+    failing = _Blocks(fail_at=2)
+    with pytest.raises(OSError, match="no space left"):
+        with BackgroundWriter(failing, failing) as writer:
+            for k in range(20):
+                writer.put(_block(k))
+    assert len(failing.written) == 2
+    failing = _Blocks(fail_at=0)
+    with pytest.raises(KeyboardInterrupt) as stopped:
+        with BackgroundWriter(failing, failing) as writer:
+            writer.put(_block(0))
+            raise KeyboardInterrupt
+    assert "the recording also failed: OSError: no space left on device" in stopped.value.__notes__

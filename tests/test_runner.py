@@ -145,14 +145,14 @@ def test_interrupted_run_leaves_a_readable_incomplete_file(tmp_path: Path) -> No
 
     def progress(p) -> None:
         calls.append(p)
-        if len(calls) == 30:
+        if len(calls) == 3:   # after the third block of samples
             raise KeyboardInterrupt
 
     with pytest.raises(KeyboardInterrupt):
         run_scenario(load_scenario(small_scenario(tmp_path)), out, progress=progress)
     run = load_run(out)
     assert not run.complete and run.reason == "KeyboardInterrupt"
-    assert run.t_s.size == 30 and calls[-1].done_s == pytest.approx(run.t_s[-1])
+    assert run.t_s.size > 3 and calls[-1].done_s == pytest.approx(run.t_s[-1])   # every sample reported is kept
     assert not out.with_name(out.name + PARTIAL_SUFFIX).exists()
 
 

@@ -194,3 +194,84 @@ def test_a_reset_rig_repeats_a_fresh_rigs_run_bit_for_bit(vehicle):
     used.reset()
     np.testing.assert_array_equal(stroke(used), fresh)
     assert np.abs(unreset - fresh).max() > 1.0  # N: the first stroke's memory, the state reset() clears
+
+
+def test_sampled_run_matches_playing_and_measuring_from_python(vehicle):
+    """rig.sampled (steps, mj_forward and the measurement in one compiled loop) = play() then
+    measure() from Python at every sample, bit for bit, body poses included; with the inputs held
+    it equals step()."""
+    import mujoco
+
+    rigs = [KCRig(vehicle) for _ in range(2)]
+    every, samples = 15, 6
+    t = np.arange(1, every * samples + 1) * 1e-3
+    rows = np.zeros((len(t), 17))
+    rows[:, :4] = np.outer(np.sin(25 * t), [0.01, 0.012, -0.01, -0.008])
+    rows[:, 8:12] = np.outer(t, [2000.0] * 4)
+    rows[:, 16] = 0.003 * t
+    bodies = np.arange(1, rigs[0].model.nbody)
+    measured, pos, quat = rigs[0].sampled(samples, every, rows, bodies)
+    r, d = rigs[1], rigs[1].data
+    for k in range(samples):
+        r.play(rows[k * every:(k + 1) * every])
+        o, a = r.measure(), rigs[0].outputs(measured[k])
+        np.testing.assert_array_equal(pos[k], d.xpos[bodies])
+        np.testing.assert_array_equal(quat[k], d.xquat[bodies])
+        np.testing.assert_array_equal(a.bushing_force, o.bushing_force)
+        np.testing.assert_array_equal(a.bushing_deflection, o.bushing_deflection)
+        assert (a.spring_force, a.damper_force, a.closure_error) == (o.spring_force, o.damper_force, o.closure_error)
+        for c in CORNERS:
+            w, v = a.wheels[c], o.wheels[c]
+            assert (w.camber, w.toe, w.steer, w.half_track, w.travel, w.pad_height, w.pad_torque) == \
+                   (v.camber, v.toe, v.steer, v.half_track, v.travel, v.pad_height, v.pad_torque)
+            np.testing.assert_array_equal(w.pad_force, v.pad_force)
+    held = rigs[0].sampled(2, every)[0][-1]
+    r.step(2 * every)
+    mujoco.mj_forward(r.model, d)
+    np.testing.assert_array_equal(held, rigs[0].sampled(1, 0)[0][0])   # no steps: the same instant again
+    assert r.outputs(held).bushing_force.tolist() == r.measure().bushing_force.tolist()
+
+
+def test_measured_quantities_against_their_definitions(vehicle):
+    """The compiled measurement against the quantities read from MuJoCo another way: the pad's Fz
+    is the force of its drive equality's row, the spring force its curve at the spring's
+    compression plus preload, a wheel's travel its centre's height change, the closure error the
+    largest closure row error; and the measurement refuses to run once MuJoCo's constraint rows
+    have moved (a friction row added)."""
+    import mujoco
+
+    r = KCRig(vehicle)
+    r.set_pads([0.02, -0.01, 0.015, 0.0])
+    r.settle(0.5)
+    o = r.measure()
+    m, d = r.model, r.data
+    rows = np.flatnonzero(d.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY)
+    for k, c in enumerate(CORNERS):
+        first = rows[d.efc_id[rows] == r.pad_eq[k]][0]
+        assert o.wheels[c].pad_force[2] == d.efc_force[first]
+        assert o.wheels[c].travel == pytest.approx(o.wheels[c].wheel_centre[2] - r.design_centre_z[k], abs=1e-15)
+    spring = r.coupling.springs[0]
+    joint = spring.kind == "joint"
+    coord = d.qpos[m.jnt_qposadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, spring.target)]] if joint else \
+        d.ten_length[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_TENDON, spring.target)]
+    x = spring.sign * (coord - r.coupling.sp_design[0])
+    curve = spring.spring.curve
+    expected = spring.preload + np.interp(x, curve.x, curve.y) - curve(0.0)
+    assert o.spring_force[spring.name] == pytest.approx(expected, rel=1e-12)
+    closure = [np.linalg.norm(d.efc_pos[rows[d.efc_id[rows] == eq]][:n]) for eq, n in zip(r.closure_eq, r.closure_rows)]
+    assert o.closure_error == pytest.approx(max(closure), rel=1e-12)
+    m.dof_frictionloss[0] = 1.0
+    with pytest.raises(RuntimeError, match="constraint rows moved"):
+        r.measure()
+
+
+def test_a_sampled_block_ends_at_mujocos_reset(vehicle):
+    """When MuJoCo resets the state (a non-finite position here), the compiled sampling stops after
+    the first sample that follows, and the rig says it was reset."""
+    r = KCRig(vehicle)
+    measured, _, _ = r.sampled(5, 10)
+    assert len(measured) == 5 and not r.was_reset()
+    r.data.qpos[r.coupling.bushings.qpos[0]] = np.nan
+    measured, pos, quat = r.sampled(5, 10)
+    assert len(measured) == len(pos) == len(quat) == 1 and r.was_reset()
+    assert np.isfinite(measured).all()   # the sample after the reset: the design pose again

@@ -28,7 +28,6 @@ from __future__ import annotations
 from typing import Any, Mapping
 
 import numpy as np
-from scipy.signal import butter, filtfilt
 
 from vehicle.scenarios.road_scenario import CIRCLE_STEER_IN_S, DEFAULT_RISE_TIME_S
 from vsim_recordings.run_format import Run
@@ -173,6 +172,8 @@ def _steps(run: Run, case: Mapping[str, Any]) -> list[tuple[float, float]]:
 
 def low_pass(y: np.ndarray, rate_hz: float) -> np.ndarray:
     """``y`` sampled at ``rate_hz`` filtered by :data:`RESPONSE_FILTER_HZ`'s zero-phase low-pass."""
+    from scipy.signal import butter, filtfilt   # here: scipy.signal takes 0.4 s to import, and a rig run needs none
+
     b, a = butter(2, min(RESPONSE_FILTER_HZ, 0.4 * rate_hz), fs=rate_hz)
     return filtfilt(b, a, y, padlen=min(3 * len(a), len(y) - 1)) if len(y) > 1 else y
 

@@ -145,7 +145,7 @@ def executor(scheduler: str | None = None, workers: int | None = None) -> Iterat
         return
     if address == LOCAL:
         n = workers or len(os.sched_getaffinity(0)) or 1
-        # one thread per worker process: the compiled step loops hold the GIL
+        # one thread per worker process: a run holds the GIL outside its compiled stepping
         # the dashboard on a free port: a second cluster on the machine must not collide with the first
         with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
                           silence_logs=logging.CRITICAL) as cluster, Client(cluster) as client:

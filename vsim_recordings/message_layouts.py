@@ -134,16 +134,20 @@ class JointStateLayout:
         self.suffix = struct.pack("<II", 0, 0)  # empty velocity and effort
         self.message_len = self.values_offset + 8 * self.size + len(self.suffix)
 
-    def encode(self, t_ns: int, values: np.ndarray) -> bytes:
-        """Message bytes for one step at ``t_ns`` with the group's ``values``."""
-        sec, nanos = divmod(t_ns, 1_000_000_000)
-        return (
-            CDR_LE_HEADER
-            + struct.pack("<iI", sec, nanos)
-            + self.prefix
-            + np.ascontiguousarray(values, dtype="<f8").tobytes()
-            + self.suffix
-        )
+    def encode_block(self, t_ns: np.ndarray, values: np.ndarray) -> np.ndarray:
+        """Message bytes (steps, message length) for steps at ``t_ns`` (steps,) with the group's
+        ``values`` (steps, size): one row a message."""
+        n = len(t_ns)
+        buf = np.empty((n, self.message_len), dtype=np.uint8)
+        buf[:, :4] = np.frombuffer(CDR_LE_HEADER, dtype=np.uint8)
+        sec, nanos = np.divmod(np.asarray(t_ns, dtype=np.int64), 1_000_000_000)
+        buf[:, 4:8] = sec.astype("<i4")[:, None].view(np.uint8)
+        buf[:, 8:12] = nanos.astype("<u4")[:, None].view(np.uint8)
+        buf[:, 12:self.values_offset] = np.frombuffer(self.prefix, dtype=np.uint8)
+        end = self.values_offset + 8 * self.size
+        buf[:, self.values_offset:end] = np.ascontiguousarray(values, dtype="<f8").view(np.uint8).reshape(n, -1)
+        buf[:, end:] = np.frombuffer(self.suffix, dtype=np.uint8)
+        return buf
 
     def matches(self, data: bytes) -> bool:
         """Whether ``data`` has this layout (same names, same number of values)."""

@@ -1,6 +1,7 @@
 """Recording a scenario run: played on the rig (:class:`vehicle.simulation.runner.ScenarioRun`) or on
-the road (:class:`vehicle.simulation.road_runner.RoadRun`) and written sample by sample into one MCAP run file (:func:`run_scenario`), or kept in memory as the
-same :class:`vsim_recordings.run_format.Run` without the body poses (:func:`simulate`).
+the road (:class:`vehicle.simulation.road_runner.RoadRun`) and written block by block into one MCAP
+run file by a thread of its own (:func:`run_scenario`, :mod:`vsim_recordings.background`), or kept
+in memory as the same :class:`vsim_recordings.run_format.Run` without the body poses (:func:`simulate`).
 
 The file is closed and marked incomplete when the run stops early: divergence, Ctrl-C or any other
 exception (:class:`vsim_recordings.run_writer.RunWriter`).
@@ -26,6 +27,7 @@ from vehicle.scenarios.schedule import Progress
 from vehicle.simulation.mounted import MountedCar
 from vehicle.simulation.road_runner import RoadRun
 from vehicle.simulation.runner import ScenarioRun
+from vsim_recordings.background import BackgroundWriter
 from vsim_recordings.road_signals import RoadSignalLayout
 from vsim_recordings.run_format import GeomSpec, Run, RunMetadata, rotation_matrix
 from vsim_recordings.run_signals import SignalLayout, road_facts, run_metadata
@@ -59,16 +61,16 @@ def _suspension(car: MountedCar) -> tuple[list[str], list[str], list[str]]:
 
 
 def _play(scenario: Scenario | RoadScenario, vehicle: VehicleDefinition, duration_scale: float,
-          progress: Callable[[Progress], None] | None, timestep_s: float = BuildOptions.timestep
+          progress: Callable[[Progress], None] | None, timestep_s: float = BuildOptions.timestep, poses: bool = True
           ) -> tuple[ScenarioRun | RoadRun, SignalLayout | RoadSignalLayout, RunMetadata]:
-    """The run of ``scenario`` on ``vehicle`` (on the rig or on the road, as its type says), the
-    signals it records and its metadata."""
+    """The run of ``scenario`` on ``vehicle`` (on the rig or on the road, as its type says; with the
+    bodies' ``poses`` or not), the signals it records and its metadata."""
     if isinstance(scenario, RoadScenario):
-        play = RoadRun(scenario, vehicle, duration_scale, progress, timestep_s)
+        play = RoadRun(scenario, vehicle, duration_scale, progress, timestep_s, poses)
         layout = RoadSignalLayout(*_suspension(play.car))
         road = road_facts(play.car.steering_ratio, play.car.wheelbase, play.car.tyre_file)
     else:
-        play = ScenarioRun(scenario, vehicle, duration_scale, progress, timestep_s)
+        play = ScenarioRun(scenario, vehicle, duration_scale, progress, timestep_s, poses)
         layout, road = SignalLayout(scenario.x_quantity, *_suspension(play.car)), None
     metadata = run_metadata(scenario, play.plan, duration_scale, play.dt, play.car.car.channels, road, vehicle.text)
     return play, layout, metadata
@@ -92,17 +94,14 @@ def run_scenario(scenario: Scenario | RoadScenario, output: Path, *, bushing_mod
                                    duration_scale, progress)
     output.parent.mkdir(parents=True, exist_ok=True)
     bodies = play.bodies()
-    times_ns, rows = [], []
     with RunWriter(output, signals=layout.specs, bodies=bodies, geometry=geometry_from_model(play.car.model, bodies),
                    metadata=metadata, overwrite=overwrite) as writer:
-        with closing(play.samples()) as samples:  # leaves the rig's context at once if writing fails
-            for s in samples:
-                values = layout.values(s)
-                writer.write(s.time_s, values, s.body_pos, s.body_quat_wxyz)
-                times_ns.append(writer.last_time_ns)
-                rows.append(values)
+        # the blocks are closed first (the rig's context left at once if writing fails), then the queue is written
+        with BackgroundWriter(writer, layout) as sink, closing(play.blocks()) as blocks:
+            for block in blocks:
+                sink.put(block)
     # the times as the file holds them: whole nanoseconds
-    run = _in_memory(output, np.array(times_ns, dtype=np.uint64) / 1e9, rows, layout, metadata)
+    run = _in_memory(output, np.concatenate(sink.times_ns) / 1e9, sink.values, layout, metadata)
     return RunResult(output, play.total_s, time.perf_counter() - started, play.stepping_s, run)
 
 
@@ -115,22 +114,22 @@ def simulate(scenario: Scenario | RoadScenario, vehicle: VehicleDefinition | Non
     changed in code); ``timestep_s`` the car's time step.
     """
     play, layout, metadata = _play(scenario, load_vehicle(scenario.vehicle) if vehicle is None else vehicle,
-                                   duration_scale, progress, timestep_s)
+                                   duration_scale, progress, timestep_s, poses=False)
     times, rows = [], []
-    with closing(play.samples()) as samples:
-        for s in samples:
-            times.append(s.time_s)
-            rows.append(layout.values(s))
+    with closing(play.blocks()) as blocks:
+        for block in blocks:
+            times.append(block.time_s)
+            rows.append(layout.values(block))
     if vehicle is not None:
         metadata = replace(metadata, extra={**metadata.extra, "vehicle_file": "(in memory)"})
-    return _in_memory(Path("(in memory)"), np.array(times), rows, layout, metadata)
+    return _in_memory(Path("(in memory)"), np.concatenate(times), rows, layout, metadata)
 
 
-def _in_memory(path: Path, t_s: np.ndarray, rows: list[np.ndarray], layout: SignalLayout | RoadSignalLayout,
+def _in_memory(path: Path, t_s: np.ndarray, blocks: list[np.ndarray], layout: SignalLayout | RoadSignalLayout,
                metadata: RunMetadata) -> Run:
-    """A complete :class:`Run` of the samples' ``rows`` (one per time in ``t_s``), without body poses."""
+    """A complete :class:`Run` of the blocks of values ``blocks`` (one row per time in ``t_s``), without body poses."""
     specs = layout.specs
-    values = np.array(rows).reshape(len(rows), len(specs))
+    values = np.concatenate(blocks).reshape(len(t_s), len(specs))
     signals = {s.name: values[:, i] for i, s in enumerate(specs)}
     return Run(path=path, t_s=t_s, signals=signals, units={s.name: s.unit for s in specs},
                groups={s.name: s.group for s in specs}, specs=specs, body_names=[],

@@ -11,7 +11,7 @@ import numpy as np
 
 from vehicle.model.definition import CORNERS
 from vehicle.scenarios.channels import CORNER_TAGS
-from vehicle.simulation.outputs import RoadSample
+from vehicle.simulation.outputs import ROAD_BODY, ROAD_WHEEL, MeasuredColumns, SampleBlock
 from vsim_core.units import DEG_PER_RAD, MM_PER_M, per_si
 from vsim_recordings.run_format import SignalSpec
 from vsim_recordings.run_signals import SuspensionSignals
@@ -19,7 +19,7 @@ from vsim_tyres.road_contact import SIGNALS as TYRE_SIGNALS
 
 _TAGS = tuple(CORNER_TAGS[c] for c in CORNERS)
 _KMH = per_si("km/h")
-#: The body's signals: name, unit, and the factor from the SI value of RoadOutputs.
+#: The body's signals: name (in vehicle.simulation.outputs.ROAD_BODY), unit, and the factor from its SI value.
 VEHICLE_SIGNALS = (("x", "m", 1.0), ("y", "m", 1.0), ("yaw", "deg", DEG_PER_RAD), ("roll", "deg", DEG_PER_RAD),
                    ("pitch", "deg", DEG_PER_RAD), ("speed", "km/h", _KMH), ("sideslip", "deg", DEG_PER_RAD),
                    ("yaw_rate", "deg/s", DEG_PER_RAD), ("lateral_acceleration", "m/s²", 1.0),
@@ -27,7 +27,8 @@ VEHICLE_SIGNALS = (("x", "m", 1.0), ("y", "m", 1.0), ("yaw", "deg", DEG_PER_RAD)
 #: The driver's signals.
 DRIVER_SIGNALS = (("steering_wheel", "deg", DEG_PER_RAD), ("rack", "mm", MM_PER_M), ("target_speed", "km/h", _KMH),
                   ("drive_force", "N", 1.0))
-#: Each tyre's recorded signals: the name in vsim_tyres.road_contact.SIGNALS, the recorded name, unit and factor.
+#: Each tyre's recorded signals: the name in vsim_tyres.road_contact.SIGNALS (in this order), the recorded name,
+#: unit and factor.
 TYRE_RECORDED = {"Fz_N": ("tyre_fz", "N", 1.0), "Fx_N": ("tyre_fx", "N", 1.0), "Fy_N": ("tyre_fy", "N", 1.0),
                  "Mz_Nm": ("tyre_mz", "N·m", 1.0), "My_Nm": ("tyre_my", "N·m", 1.0), "kappa": ("slip_ratio", "-", 1.0),
                  "alpha_rad": ("slip_angle", "deg", DEG_PER_RAD), "gamma_rad": ("inclination", "deg", DEG_PER_RAD),
@@ -35,32 +36,34 @@ TYRE_RECORDED = {"Fz_N": ("tyre_fz", "N", 1.0), "Fx_N": ("tyre_fx", "N", 1.0), "
 
 
 class RoadSignalLayout:
-    """The recorded signals of the car on the road, and one sample's values in the same order."""
+    """The recorded signals of the car on the road, and a block of samples' values in the same order."""
 
     def __init__(self, bushings: Sequence[str] = (), springs: Sequence[str] = (), dampers: Sequence[str] = ()):
+        """The signals above, read from the car's measured vectors (:attr:`vehicle.simulation.road.RoadCar.columns`)."""
+        columns = MeasuredColumns(ROAD_BODY, ROAD_WHEEL + TYRE_SIGNALS, len(springs), len(dampers), len(bushings))
         specs = [SignalSpec(n, u, "vehicle") for n, u, _ in VEHICLE_SIGNALS]
         specs += [SignalSpec(n, u, "driver") for n, u, _ in DRIVER_SIGNALS]
         for quantity, unit in (("wheel_travel", "mm"), ("camber", "deg"), ("toe", "deg"), ("steer", "deg")):
             specs += [SignalSpec(f"{quantity}_{t}", unit, quantity) for t in _TAGS]
         for name, unit, _ in TYRE_RECORDED.values():
             specs += [SignalSpec(f"{name}_{t}", unit, "tyres") for t in _TAGS]
-        self.tyre_scale = np.array([TYRE_RECORDED[s][2] for s in TYRE_SIGNALS])
-        self.suspension = SuspensionSignals(bushings, springs, dampers)
+        # measured columns and their factors to the recorded units, in the order of the specs
+        # (the driver's steering-wheel angle and target speed come from the block's inputs)
+        body = [(columns.of(n), f) for n, _, f in VEHICLE_SIGNALS]
+        wheels = [(columns.wheel(q), f) for q, f in (("travel", MM_PER_M), ("camber", DEG_PER_RAD),
+                                                     ("toe", DEG_PER_RAD), ("steer", DEG_PER_RAD))]
+        wheels += [(columns.wheel(s), TYRE_RECORDED[s][2]) for s in TYRE_RECORDED]
+        self._body = np.array([c for c, _ in body]), np.array([f for _, f in body])
+        self._driver = np.array([columns.of("rack"), columns.of("drive_force")])
+        self._wheels = np.concatenate([c for c, _ in wheels]), np.concatenate([np.full(4, f) for _, f in wheels])
+        self.suspension = SuspensionSignals(columns, bushings, springs, dampers)
         self.specs = specs + self.suspension.specs
 
-    def values(self, s: RoadSample) -> np.ndarray:
-        """One sample's values, in the recorded units and the order of :attr:`specs`."""
-        o = s.outputs
-        body = (o.position[0], o.position[1], o.yaw, o.roll, o.pitch, o.speed, o.sideslip, o.yaw_rate,
-                o.lateral_acceleration, o.longitudinal_acceleration)
-        driver = (s.steering_wheel, o.rack, s.target_speed, o.drive_force)
-        w = [o.wheels[c] for c in CORNERS]
-        tyres = np.array([x.tyre for x in w]) * self.tyre_scale   # (corner, signal): recorded signal-major
-        return np.concatenate([
-            [v * f for v, (_, _, f) in zip(body, VEHICLE_SIGNALS)],
-            [v * f for v, (_, _, f) in zip(driver, DRIVER_SIGNALS)],
-            [x.travel * MM_PER_M for x in w], [x.camber * DEG_PER_RAD for x in w], [x.toe * DEG_PER_RAD for x in w],
-            [x.steer * DEG_PER_RAD for x in w],
-            tyres.T.ravel(),
-            self.suspension.values(s),
-        ])
+    def values(self, block: SampleBlock) -> np.ndarray:
+        """The block's values (samples, signals), in the recorded units and the order of :attr:`specs`."""
+        m, u = block.measured, block.inputs
+        (steering, rack, speed, drive) = (f for _, _, f in DRIVER_SIGNALS)
+        driver = np.column_stack([u[:, 0] * steering, m[:, self._driver[0]] * rack, u[:, 1] * speed,
+                                  m[:, self._driver[1]] * drive])
+        return np.hstack([m[:, self._body[0]] * self._body[1], driver, m[:, self._wheels[0]] * self._wheels[1],
+                          self.suspension.values(block)])

@@ -24,7 +24,7 @@ from vehicle.scenarios.channels import CORNER_TAGS, INPUT_CHANNELS, input_quanti
 from vehicle.scenarios.road_scenario import RoadScenario
 from vehicle.scenarios.scenario import Scenario
 from vehicle.scenarios.schedule import CaseSchedule
-from vehicle.simulation.outputs import RoadSample, Sample
+from vehicle.simulation.outputs import RIG_WHEEL, MeasuredColumns, SampleBlock
 from vsim_core import units
 from vsim_core.files import read_text
 from vsim_core.units import DEG_PER_RAD, MM_PER_M
@@ -37,12 +37,14 @@ _TAGS = tuple(CORNER_TAGS[c] for c in CORNERS)
 
 
 class SignalLayout:
-    """The recorded signals of a rig, and one sample's values in the same order."""
+    """The recorded signals of a rig, and a block of samples' values in the same order."""
 
     def __init__(self, x_quantity: str | None, bushings: Sequence[str] = (), springs: Sequence[str] = (),
                  dampers: Sequence[str] = ()):
         """Wheel, pad and input signals, then each named spring's and damper's force and each bushing
-        direction's (``"<bushing>.<direction>"``) deflection and force; a rig records none of those."""
+        direction's (``"<bushing>.<direction>"``) deflection and force, read from the rig's measured
+        vectors (:attr:`vehicle.simulation.rig.KCRig.columns`)."""
+        columns = MeasuredColumns((), RIG_WHEEL, len(springs), len(dampers), len(bushings))
 
         def hint(tag: str) -> str | None:
             return f"{x_quantity}_{tag}" if x_quantity else None
@@ -54,38 +56,39 @@ class SignalLayout:
         specs += [SignalSpec(f"wheel_centre_{a}_{t}", "mm", "wheel_centre") for t in _TAGS for a in "xyz"]
         specs += [SignalSpec(f"pad_height_{t}", "mm", "pads") for t in _TAGS]
         specs += [SignalSpec(f"pad_fz_{t}", "N", "pads") for t in _TAGS]
+        # the wheels' signals, in the order above: measured columns and their factors to the recorded units
+        read = [("travel", MM_PER_M), ("camber", DEG_PER_RAD), ("toe", DEG_PER_RAD), ("half_track", MM_PER_M),
+                ("steer", DEG_PER_RAD)]
+        self._columns = np.concatenate([columns.wheel(q) for q, _ in read]
+                                       + [np.ravel(np.column_stack([columns.wheel(f"centre_{a}") for a in "xyz"])),
+                                          columns.wheel("pad_height"), columns.wheel("pad_fz")])
+        self._scale = np.concatenate([np.full(4, f) for _, f in read] + [np.full(12, MM_PER_M), np.full(4, MM_PER_M),
+                                                                         np.ones(4)])
         self.input_scale = np.array([units.per_si(INPUT_UNITS[input_quantity(ch)]) for ch in INPUT_CHANNELS])
         specs += [SignalSpec(ch, INPUT_UNITS[input_quantity(ch)], "inputs") for ch in INPUT_CHANNELS]
-        self.suspension = SuspensionSignals(bushings, springs, dampers)
+        self.suspension = SuspensionSignals(columns, bushings, springs, dampers)
         self.specs = specs + self.suspension.specs
 
-    def values(self, s: Sample) -> np.ndarray:
-        """One sample's values, in the recorded units and the order of :attr:`specs`."""
-        o = s.outputs
-        w = [o.wheels[c] for c in CORNERS]
-        centre = np.array([x.wheel_centre for x in w])
-        return np.concatenate([
-            (centre[:, 2] - s.design_centre_z) * MM_PER_M,
-            [x.camber * DEG_PER_RAD for x in w], [x.toe * DEG_PER_RAD for x in w],
-            [x.half_track * MM_PER_M for x in w], [x.steer * DEG_PER_RAD for x in w],
-            centre.ravel() * MM_PER_M,
-            [x.pad_height * MM_PER_M for x in w], [x.pad_force[2] for x in w],
-            s.inputs * self.input_scale,
-            self.suspension.values(s),
-        ])
+    def values(self, block: SampleBlock) -> np.ndarray:
+        """The block's values (samples, signals), in the recorded units and the order of :attr:`specs`."""
+        return np.hstack([block.measured[:, self._columns] * self._scale, block.inputs * self.input_scale,
+                          self.suspension.values(block)])
 
 
 class SuspensionSignals:
     """The signals every run of the car records, on the rig or on the road, after its own: each
     named spring's and damper's force, each bushing direction's (``"<bushing>.<direction>"``)
     deflection and force (one group per bushing), then case, phase, time since the input started
-    and the loop-closure error."""
+    and the loop-closure error; read from the car's measured vectors (``columns``)."""
 
-    def __init__(self, bushings: Sequence[str] = (), springs: Sequence[str] = (), dampers: Sequence[str] = ()):
+    def __init__(self, columns: MeasuredColumns, bushings: Sequence[str] = (), springs: Sequence[str] = (),
+                 dampers: Sequence[str] = ()):
+        """The signals of the named parts, read from measured vectors of ``columns``."""
+        self.columns = columns
         self.springs, self.dampers, self.bushings = list(springs), list(dampers), list(bushings)
         specs = [SignalSpec(f"{n}_force", "N", "springs") for n in self.springs]
         specs += [SignalSpec(f"{n}_force", "N", "dampers") for n in self.dampers]
-        rotation = np.array([is_rotation(n) for n in self.bushings])
+        rotation = np.array([is_rotation(n) for n in self.bushings], dtype=bool)
         self.deflection_scale = np.where(rotation, DEG_PER_RAD, MM_PER_M)
         for name, rot in zip(self.bushings, rotation):
             bushing, direction = name.split(".")
@@ -96,12 +99,15 @@ class SuspensionSignals:
                   SignalSpec("input_time", "s", "run"), SignalSpec("closure_error", "mm", "run")]
         self.specs = specs
 
-    def values(self, s: Sample | RoadSample) -> np.ndarray:
-        """Their values at sample ``s``, in the recorded units and the order of :attr:`specs`."""
-        o = s.outputs
-        bushing = np.column_stack([o.bushing_deflection * self.deflection_scale, o.bushing_force]).ravel()
-        return np.concatenate([[o.spring_force[n] for n in self.springs], [o.damper_force[n] for n in self.dampers],
-                               bushing, [s.case, s.phase, s.input_time_s, o.closure_error * MM_PER_M]])
+    def values(self, block: SampleBlock) -> np.ndarray:
+        """Their values (samples, signals) in ``block``, in the recorded units and the order of :attr:`specs`."""
+        m, c = block.measured, self.columns
+        n = len(m)
+        bushing = np.empty((n, 2 * len(self.bushings)))
+        bushing[:, 0::2] = m[:, c.deflection] * self.deflection_scale
+        bushing[:, 1::2] = m[:, c.force]
+        return np.column_stack([m[:, c.springs], m[:, c.dampers], bushing, np.full(n, float(block.case)),
+                                np.full(n, float(block.phase)), block.input_time_s, m[:, c.closure_error] * MM_PER_M])
 
 
 def road_facts(steering_ratio: float, wheelbase_m: float, tyre_file: Path) -> dict[str, Any]:

@@ -172,37 +172,46 @@ class RunWriter:
             entities = [_scene_entity(b, [g for g in geometry if g.body == b]) for b in with_geoms]
             scene.log(SceneUpdate(entities=entities), log_time=0)
 
-    @property
-    def last_time_ns(self) -> int:
-        """The log time of the last step written [ns] (the file's time base: whole nanoseconds)."""
-        return self._last_t_ns
-
     def write(self, t_s: float, values: np.ndarray, body_pos_m: np.ndarray, body_quat_wxyz: np.ndarray) -> None:
         """Record one step at simulation time ``t_s`` (s, ≥ 0, strictly increasing)."""
+        self.write_block(np.array([t_s]), np.asarray(values)[None], np.asarray(body_pos_m)[None],
+                         np.asarray(body_quat_wxyz)[None])
+
+    def write_block(self, t_s: np.ndarray, values: np.ndarray, body_pos_m: np.ndarray,
+                    body_quat_wxyz: np.ndarray) -> np.ndarray:
+        """Record consecutive steps at simulation times ``t_s`` (n,) (s, ≥ 0, strictly increasing),
+        with ``values`` (n, signals), ``body_pos_m`` (n, bodies, 3) and ``body_quat_wxyz`` (n,
+        bodies, 4); returns their log times [ns] (the file's time base: whole nanoseconds)."""
         if self._closed:
             raise ValueError(f"{self.path}: write after close")
-        t_ns = int(round(t_s * 1e9))
-        if t_ns <= self._last_t_ns:
-            raise ValueError(f"{self.path}: time {t_s} s is negative or not after the previous step")
+        t_ns = np.round(np.asarray(t_s, dtype=np.float64) * 1e9).astype(np.int64)
         values = np.asarray(values, dtype=np.float64)
         pos = np.asarray(body_pos_m, dtype=np.float64)
         quat = np.asarray(body_quat_wxyz, dtype=np.float64)
-        n_bodies = len(self.bodies)
-        if values.shape != (len(self.signals),) or pos.shape != (n_bodies, 3) or quat.shape != (n_bodies, 4):
+        n, n_bodies = len(t_ns), len(self.bodies)
+        if (t_ns.shape != (n,) or values.shape != (n, len(self.signals)) or pos.shape != (n, n_bodies, 3)
+                or quat.shape != (n, n_bodies, 4)):
             raise ValueError(
-                f"{self.path}: expected values ({len(self.signals)},), poses ({n_bodies}, 3) and "
-                f"({n_bodies}, 4); got {values.shape}, {pos.shape}, {quat.shape}"
+                f"{self.path}: expected values (n, {len(self.signals)}), poses (n, {n_bodies}, 3) and "
+                f"(n, {n_bodies}, 4) at times (n,); got {values.shape}, {pos.shape}, {quat.shape} at {t_ns.shape}"
             )
-        self._last_t_ns = t_ns
-        if n_bodies:
-            timestamp = timestamp_field(t_ns)
-            layout = self._tf_layouts.get(len(timestamp))
-            if layout is None:
-                layout = self._tf_layouts[len(timestamp)] = FrameTransformsLayout(self.bodies, len(timestamp))
-            poses = np.concatenate([pos, quat[:, 1:], quat[:, :1]], axis=1)
-            self._tf_channel.log(layout.encode(timestamp, poses), log_time=t_ns)
-        for channel, layout, members in self._groups:
-            channel.log(layout.encode(t_ns, values[members]), log_time=t_ns)
+        before = np.concatenate([[self._last_t_ns], t_ns[:-1]])
+        late = np.flatnonzero(t_ns <= before)
+        if late.size:
+            raise ValueError(f"{self.path}: time {t_s[late[0]]} s is negative or not after the previous step")
+        poses = np.concatenate([pos, quat[:, :, 1:], quat[:, :, :1]], axis=2)
+        groups = [(channel, layout.encode_block(t_ns, values[:, members])) for channel, layout, members in self._groups]
+        for k, t in enumerate(t_ns.tolist()):
+            if n_bodies:
+                timestamp = timestamp_field(t)
+                layout = self._tf_layouts.get(len(timestamp))
+                if layout is None:
+                    layout = self._tf_layouts[len(timestamp)] = FrameTransformsLayout(self.bodies, len(timestamp))
+                self._tf_channel.log(layout.encode(timestamp, poses[k]), log_time=t)
+            for channel, messages in groups:
+                channel.log(messages[k].tobytes(), log_time=t)
+            self._last_t_ns = t
+        return t_ns.astype(np.uint64)
 
     def close(self, *, complete: bool = True, reason: str = "") -> None:
         """Write the ``vsim.status`` record, finish the MCAP and move it to its final name.

@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numba as nb
 import numpy as np
 from scipy.optimize import brentq, fsolve
 from scipy.spatial.transform import Rotation
@@ -46,17 +47,21 @@ def contact_point(centre, spin_axis, radius: float) -> np.ndarray:
 
 def wheel_angles(spin_out: np.ndarray, sign: float = 1.0) -> tuple[float, float]:
     """(toe-in, camber) [rad] of a wheel from its outward spin axis (ISO 8855 signs)."""
-    toe = math.atan2(spin_out[0], sign * spin_out[1])
-    camber = -math.asin(float(np.clip(spin_out[2], -1.0, 1.0)))
+    spin_out = np.asarray(spin_out, float)
+    toe, camber, _ = wheel_orientation(sign * spin_out[0], sign * spin_out[1], sign * spin_out[2], sign)
     return toe, camber
 
 
-def wheel_orientation(spin_left: np.ndarray, sign: float) -> tuple[float, float, float]:
-    """(toe-in, camber, steer) [rad] of a wheel from its spin axis pointing to the vehicle's left,
-    in the frame the angles are taken in; ``sign`` +1 for a left wheel, −1 for a right one. Steer
-    is the yaw of the heading ``spin_left × z``, to the left positive."""
-    toe, camber = wheel_angles(sign * spin_left, sign)
-    return toe, camber, math.atan2(-spin_left[0], spin_left[1])
+@nb.njit(cache=True)
+def wheel_orientation(left_x: float, left_y: float, left_z: float, sign: float) -> tuple[float, float, float]:
+    """(toe-in, camber, steer) [rad] of a wheel from its spin axis pointing to the vehicle's left
+    (components in the frame the angles are taken in); ``sign`` +1 for a left wheel, −1 for a right
+    one. Steer is the yaw of the heading ``spin_left × z``, to the left positive. Compiled: the
+    rig's measurement calls it at every sample (vehicle.simulation.probes)."""
+    out_x, out_y, out_z = sign * left_x, sign * left_y, sign * left_z   # the outward spin axis
+    toe = math.atan2(out_x, sign * out_y)
+    camber = -math.asin(1.0 if out_z > 1.0 else (-1.0 if out_z < -1.0 else out_z))
+    return toe, camber, math.atan2(-left_x, left_y)
 
 
 @dataclass(frozen=True)

@@ -33,7 +33,7 @@ import numpy as np
 from bushings.extended_bank import ExtendedBank
 from vehicle.model.builder import CarModel
 from vehicle.model.elements import CrossTerm
-from vehicle.simulation import stepping
+from vehicle.simulation import probes, stepping
 
 
 def _pad_curves(curves) -> tuple[np.ndarray, np.ndarray]:
@@ -48,14 +48,6 @@ def _pad_curves(curves) -> tuple[np.ndarray, np.ndarray]:
             y.append(y[-1] + 1e3 * slope)
         xs[i], ys[i] = x, y
     return xs, ys
-
-
-def _segments(xq: np.ndarray, xs: np.ndarray, ys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Slope and intercept of each curve's segment at ``xq`` (linear extrapolation at the ends)."""
-    rows = np.arange(len(xq))
-    i = np.clip((xs <= xq[:, None]).sum(axis=1) - 1, 0, xs.shape[1] - 2)
-    slope = (ys[rows, i + 1] - ys[rows, i]) / (xs[rows, i + 1] - xs[rows, i])
-    return slope, ys[rows, i] - slope * xs[rows, i]
 
 
 class BushingForces:
@@ -83,7 +75,6 @@ class BushingForces:
         effects = [channels[i].effects for i in self.bank_idx]
         #: possibly empty (all laws linear, in the joints); None = laws off, joints only (KCRig.bushing_laws_off)
         self.bank: ExtendedBank | None = ExtendedBank(params, effects)
-        self.bank_force = np.zeros(self.bank_idx.size)
         self.bank_jnt, self.bank_qpos = ids[self.bank_idx], self.qpos[self.bank_idx]
         self.bank_dof = self.dof[self.bank_idx]
         self.K_ref = self.K[self.bank_idx].copy()
@@ -102,7 +93,6 @@ class BushingForces:
         if self.bank is not None and self.bank.size:
             e = d.qpos[self.bank_qpos]
             force, tangent = self.bank.step(e, dt)
-            self.bank_force = force
             if self.saturating.any():
                 self.K_ref[:] = np.where(self.saturating, np.maximum(self.K[self.bank_idx], tangent), self.K_ref)
                 self.model.jnt_stiffness[self.bank_jnt] = self.K_ref
@@ -110,9 +100,16 @@ class BushingForces:
         if self.cross_k.size:
             d.qfrc_applied[self.dof] -= self.cross_forces()
 
+    def probe_args(self) -> tuple:
+        """Arguments of :func:`vehicle.simulation.probes.bushings` after (qpos, qvel)."""
+        on = self.bank is not None
+        return (self.qpos.astype(np.int64), self.dof.astype(np.int64), self.K, self.C, on,
+                self.bank_idx.astype(np.int64) if on else np.zeros(0, np.int64),
+                self.bank.force if on else np.zeros(0), self.cross_channels, self.cross_k)
+
     def deflections(self) -> np.ndarray:
         """Deflection of every direction [m or rad], in the bushing's frame."""
-        return self.data.qpos[self.qpos].copy()
+        return self._read()[0]
 
     def cross_forces(self) -> np.ndarray:
         """Force of the cross stiffnesses on every direction [N or N·m], resisting deflection."""
@@ -125,17 +122,18 @@ class BushingForces:
 
     def forces(self) -> np.ndarray:
         """Force of every direction [N or N·m], resisting its deflection (joint damping included)."""
-        d = self.data
-        force = self.K * d.qpos[self.qpos] + self.C * d.qvel[self.dof]
-        if self.bank is not None:
-            force[self.bank_idx] = self.bank_force + self.C[self.bank_idx] * d.qvel[self.bank_dof]
-        return force + self.cross_forces()
+        return self._read()[1]
+
+    def _read(self) -> tuple[np.ndarray, np.ndarray]:
+        deflection, force = np.zeros(self.qpos.size), np.zeros(self.qpos.size)
+        probes.bushings(deflection, force, self.data.qpos, self.data.qvel, *self.probe_args())
+        return deflection, force
 
     def reset(self) -> None:
         """Forget the bushings' history (virgin state)."""
         if self.bank is not None:
             self.bank.reset()
-        self.bank_force = np.zeros(self.bank_idx.size)
+            self.bank.force[:] = 0.0   # what the measurement reads before the next step (the kernel only writes it)
 
 
 class ForceCoupling:
@@ -196,32 +194,17 @@ class ForceCoupling:
     def apply(self, dt: float) -> None:
         """Compute and write the forces for the next step of length ``dt`` [s] (one compiled call)."""
         stepping.coupling_step(dt, *self.kernel_arrays())
-        b = self.bushings
-        if b.bank is not None:
-            b.bank_force = b.bank.force
 
     # -- outputs -----------------------------------------------------------------------------
-    def spring_compression(self) -> np.ndarray:
-        """Compression of every spring from design [m], bump positive."""
-        d = self.data
-        coord = np.where(self.sp_joint, d.qpos[np.where(self.sp_joint, self.sp_qadr, 0)],
-                         d.ten_length[np.where(self.sp_joint, 0, self.sp_index)])
-        return self.sp_sign * (coord - self.sp_design)
-
-    def spring_forces(self) -> np.ndarray:
-        """Force of every spring [N], pushing apart."""
-        x = self.spring_compression()
-        slope, offset = _segments(x, self.sp_xs, self.sp_ys)
-        return self.sp_preload + slope * x + offset - self.sp_y0
-
-    def damper_forces(self) -> np.ndarray:
-        """Force of every damper [N], pushing apart (positive in compression)."""
-        d = self.data
-        velocity = np.where(self.dp_joint, d.qvel[np.where(self.dp_joint, self.dp_index, 0)],
-                            d.ten_velocity[np.where(self.dp_joint, 0, self.dp_index)])
-        speed = self.dp_sign * velocity
-        slope, offset = _segments(speed, self.dp_xs, self.dp_ys)
-        return slope * speed + offset
+    def probe_args(self) -> tuple:
+        """(bushings, springs, dampers): the arguments of :func:`vehicle.simulation.probes.bushings`
+        after (qpos, qvel), of :func:`~vehicle.simulation.probes.springs` after (qpos, ten_length)
+        and of :func:`~vehicle.simulation.probes.dampers` after (qvel, ten_velocity)."""
+        spring = (np.asarray(self.sp_joint, bool), self.sp_qadr.astype(np.int64), self.sp_index.astype(np.int64),
+                  self.sp_design, self.sp_sign.astype(float), self.sp_xs, self.sp_ys, self.sp_preload, self.sp_y0)
+        damp = (np.asarray(self.dp_joint, bool), self.dp_index.astype(np.int64), self.dp_sign.astype(float),
+                self.dp_xs, self.dp_ys)
+        return self.bushings.probe_args(), spring, damp
 
     def reset(self) -> None:
         """Forget the bushings' history (virgin state)."""

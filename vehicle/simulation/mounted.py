@@ -1,6 +1,6 @@
 """What every mounting of the car shares (the K&C rig, :mod:`vehicle.simulation.rig`; the road,
 :mod:`vehicle.simulation.road`): the vehicle built with its springs' preloads, its MuJoCo state,
-the bushing coupling, the wheels, the loop closures' errors, the body's ride height, switching the
+the bushing coupling, the wheels, the columns of its measured vector and the suspension's part of it, the body's ride height, switching the
 bushing laws off while the car settles, and the time spent in the compiled stepping loop."""
 
 from __future__ import annotations
@@ -16,10 +16,15 @@ from vehicle.model.builder import CarModel, build
 from vehicle.model.definition import CORNERS, VehicleDefinition
 from vehicle.model.elements import BuildOptions
 from vehicle.model.statics import resolve_preloads
+from vehicle.simulation import probes
 from vehicle.simulation.coupling import ForceCoupling
+from vehicle.simulation.outputs import MeasuredColumns
 
 # a plain int: comparing an array with the pybind enum goes element by element through Python (100 µs)
 _EQUALITY_ROW = int(mujoco.mjtConstraint.mjCNSTR_EQUALITY)
+#: MuJoCo's warnings that come with a reset of the state (a non-finite or huge position, velocity or acceleration).
+RESET_WARNINGS = np.array([int(w) for w in (mujoco.mjtWarning.mjWARN_BADQPOS, mujoco.mjtWarning.mjWARN_BADQVEL,
+                                            mujoco.mjtWarning.mjWARN_BADQACC)], dtype=np.int64)
 
 
 class MountedCar:
@@ -41,14 +46,12 @@ class MountedCar:
         #: without the mounting's first, empty call, which compiles the loop or loads it from numba's cache.
         self.stepping_s = 0.0
 
-    def _timed(self, loop: Callable[..., None], *args) -> None:
-        """Call the compiled ``loop`` with ``args``, adding its wall time to :attr:`stepping_s`."""
+    def _timed(self, loop: Callable[..., Any], *args) -> Any:
+        """Call the compiled ``loop`` with ``args``, adding its wall time to :attr:`stepping_s`; its result."""
         started = time.perf_counter()
-        loop(*args)
+        result = loop(*args)
         self.stepping_s += time.perf_counter() - started
-        b = self.coupling.bushings
-        if b.bank is not None:
-            b.bank_force = b.bank.force
+        return result
 
     @contextmanager
     def bushing_laws_off(self) -> Iterator[None]:
@@ -64,35 +67,31 @@ class MountedCar:
             forces.bank = laws
             self.coupling.reset()
 
+    def was_reset(self) -> bool:
+        """Whether MuJoCo has reset the state since the car was built (see :data:`RESET_WARNINGS`)."""
+        return bool(self.data.warning.number[RESET_WARNINGS].any())
+
     def ride_height(self) -> float:
         """Height of the body's ride-height point above the ground [m]."""
         return float(self.car.body_point(self.data, self.vehicle.body.ride_height_point)[2])
 
-    def suspension_outputs(self, first_rows: np.ndarray) -> dict[str, Any]:
-        """The fields of :class:`~vehicle.simulation.outputs.SuspensionOutputs` at the current state
-        (``mj_forward`` done; ``first_rows`` from :meth:`_eq_first_rows`)."""
-        c = self.coupling
-        return dict(time=float(self.data.time), bushing_names=tuple(ch.name for ch in self.car.channels),
-                    bushing_deflection=c.bushings.deflections(), bushing_force=c.bushings.forces(),
-                    spring_force=dict(zip((e.name for e in c.springs), c.spring_forces().tolist())),
-                    damper_force=dict(zip((e.name for e in c.dampers), c.damper_forces().tolist())),
-                    closure_error=self._closure_error(first_rows))
+    def measured_columns(self, head: tuple[str, ...], wheel: tuple[str, ...]) -> MeasuredColumns:
+        """The columns of this car's measured vector with the mounting's ``head`` and ``wheel`` quantities."""
+        return MeasuredColumns(head, wheel, len(self.coupling.springs), len(self.coupling.dampers),
+                               len(self.car.channels))
 
-    def _eq_first_rows(self) -> np.ndarray:
-        """Index in ``efc_*`` of the first row of every equality, -1 where inactive (an equality's
-        rows are consecutive)."""
+    def equality_rows(self) -> np.ndarray:
+        """Index in ``efc_*`` of the first row of every equality, -1 where inactive (after ``mj_forward``)."""
         d = self.data
-        rows = np.flatnonzero(d.efc_type[: d.nefc] == _EQUALITY_ROW)
-        first = np.full(self.model.neq, -1)
-        eq, at = np.unique(d.efc_id[rows], return_index=True)
-        first[eq] = rows[at]
-        return first
+        return probes.first_rows(d.efc_type, d.efc_id, d.nefc, self.model.neq, _EQUALITY_ROW)
 
-    def _closure_error(self, first_rows: np.ndarray) -> float:
-        """Largest position error of the loop closures [m] (connect, weld position, tie-rod length),
-        from the equalities' first rows (:meth:`_eq_first_rows`)."""
+    def suspension_args(self, rows: np.ndarray) -> tuple:
+        """The arguments of :func:`vehicle.simulation.probes.suspension` after its data (bushings,
+        springs, dampers, closures), ``rows`` from :meth:`equality_rows`."""
+        closure = (rows[self.closure_eq].astype(np.int64), self.closure_rows.astype(np.int64))
+        return (*self.coupling.probe_args(), closure)
+
+    def suspension_data(self) -> tuple:
+        """The data arguments of :func:`vehicle.simulation.probes.suspension` (views of MuJoCo's memory)."""
         d = self.data
-        rows = first_rows[self.closure_eq][:, None] + np.arange(3)
-        used = np.arange(3) < self.closure_rows[:, None]  # 3 position rows, 1 for a tendon length
-        pos = np.where(used, d.efc_pos[np.minimum(rows, d.nefc - 1)], 0.0)
-        return float(np.sqrt((pos * pos).sum(axis=1)).max())
+        return d.qpos, d.qvel, d.ten_length, d.ten_velocity, d.efc_pos

@@ -15,10 +15,9 @@ import numpy as np
 
 from vehicle.model.definition import CORNERS, SIDE_SIGN, VehicleDefinition
 from vehicle.model.elements import BuildOptions
-from vehicle.model.kinematics import wheel_orientation
-from vehicle.simulation import stepping
-from vehicle.simulation.mounted import MountedCar
-from vehicle.simulation.outputs import RigOutputs, WheelOutputs
+from vehicle.simulation import probes, stepping
+from vehicle.simulation.mounted import RESET_WARNINGS, MountedCar
+from vehicle.simulation.outputs import RIG_WHEEL, RigOutputs, WheelOutputs
 
 _NO_INPUTS = np.zeros((0, 17))
 _INACTIVE = np.zeros(5, dtype=bool)
@@ -41,6 +40,21 @@ class KCRig(MountedCar):
                                      for c in CORNERS])
         self._run(0, _NO_INPUTS, _INACTIVE)
         self.stepping_s = 0.0
+        #: Where each quantity sits in the rig's measured vector (:meth:`sampled`, :meth:`measure`).
+        self.columns = self.measured_columns((), RIG_WHEEL)
+        # The compiled measurement reads the constraint rows through views taken here: valid while
+        # MuJoCo allocates them alike every step, which holds when their number cannot change
+        # (no contacts, no limits: checked) and is verified after every measurement.
+        if not (m.opt.disableflags & mujoco.mjtDisableBit.mjDSBL_CONTACT) or m.jnt_limited.any() or m.tendon_limited.any():
+            raise ValueError("the rig's measurement needs a model without contacts or limits")
+        mujoco.mj_forward(m, self.data)
+        self._rows = self.equality_rows()
+        self._efc_force, self._efc_pos = self.data.efc_force, self.data.efc_pos   # the views the probe reads
+        self._efc = (self.data.nefc, self._efc_force.ctypes.data, self._efc_pos.ctypes.data)
+        #: Wheel-centre heights at design [m] (order of CORNERS): the reference of the wheel travel.
+        self.design_centre_z = self.data.site_xpos[self.centre_site, 2].copy()
+        self._probe_bank: object = False   # the bank the probe's arguments were built for
+        self._probe: tuple = ()
 
     # -- inputs ------------------------------------------------------------------------------
     def set_pads(self, heights) -> None:
@@ -125,20 +139,70 @@ class KCRig(MountedCar):
                 out.append(self.measure())
         return out
 
+    def sampled(self, samples: int, every: int, inputs: np.ndarray = _NO_INPUTS,
+                bodies: np.ndarray = np.zeros(0, np.int64)) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Advance ``samples × every`` steps, measuring after every ``every`` steps, without coming
+        back to Python: the measured vectors (samples, columns) (:attr:`columns`) and the world poses
+        of the bodies ``bodies`` (ids) (samples, bodies, 3) and (samples, bodies, 4). ``inputs``:
+        one row per step as :meth:`play` takes them, or none (held). Fewer samples when MuJoCo
+        reset the state (:meth:`was_reset`): up to the first that follows the reset."""
+        inputs = np.ascontiguousarray(inputs, dtype=float)
+        if inputs.shape[0] not in (0, samples * every) or inputs.shape[1:] != _NO_INPUTS.shape[1:]:
+            raise ValueError(f"expected rig inputs of shape ({samples * every}, {_NO_INPUTS.shape[1]}), got {inputs.shape}")
+        m, d = self.model, self.data
+        measured = np.empty((samples, self.columns.size))
+        pos, quat = np.empty((samples, bodies.size, 3)), np.empty((samples, bodies.size, 4))
+        rig = (m.eq_data, self.pad_eq, self.rack_eq, d.xfrc_applied, self.carriage_body, self.wheel_body)
+        done = self._timed(stepping.run_sampled, every, inputs, _ALL_ACTIVE if inputs.shape[0] else _INACTIVE, rig,
+                           m._address, d._address, m.opt.timestep, self.coupling.kernel_arrays(), self._probe_args(),
+                           bodies.astype(np.int64), d.xpos, d.xquat, measured, pos, quat, d.warning.number,
+                           RESET_WARNINGS)
+        self._check_rows()
+        return measured[:done], pos[:done], quat[:done]
+
     # -- outputs -----------------------------------------------------------------------------
     def measure(self) -> RigOutputs:
         """The rig's outputs at the current state."""
-        m, d = self.model, self.data
-        mujoco.mj_forward(m, d)
-        first_rows = self._eq_first_rows()
-        fz = d.efc_force[first_rows[self.pad_eq]]
+        mujoco.mj_forward(self.model, self.data)
+        self._check_rows()
+        v = np.empty(self.columns.size)
+        probes.rig_sample(v, *self._probe_args())
+        return self.outputs(v)
+
+    def outputs(self, v: np.ndarray) -> RigOutputs:
+        """The :class:`RigOutputs` of one measured vector ``v`` (:attr:`columns`)."""
+        cols, c = self.columns, self.coupling
         wheels = {}
         for k, corner in enumerate(CORNERS):
-            spin_left = d.xmat[self.wheel_body[k]].reshape(3, 3)[:, 1]
-            toe, camber, steer = wheel_orientation(spin_left, SIDE_SIGN[corner])
-            centre = d.site_xpos[self.centre_site[k]].copy()
-            force = np.array([d.xfrc_applied[self.carriage_body[k], 0], d.xfrc_applied[self.carriage_body[k], 1], fz[k]])
-            wheels[corner] = WheelOutputs(camber, toe, steer, abs(centre[1]), centre,
-                                          force, float(d.qpos[self.pad_qpos[k]]),
-                                          float(d.xfrc_applied[self.wheel_body[k], 5]))
-        return RigOutputs(wheels=wheels, **self.suspension_outputs(first_rows))
+            w = dict(zip(RIG_WHEEL, v[cols.wheels_start + k * len(RIG_WHEEL):][:len(RIG_WHEEL)].tolist()))
+            wheels[corner] = WheelOutputs(w["camber"], w["toe"], w["steer"], w["half_track"], w["travel"],
+                                          np.array([w["centre_x"], w["centre_y"], w["centre_z"]]),
+                                          np.array([w["pad_fx"], w["pad_fy"], w["pad_fz"]]), w["pad_height"],
+                                          w["pad_torque"])
+        return RigOutputs(time=float(self.data.time), bushing_names=tuple(ch.name for ch in self.car.channels),
+                          bushing_deflection=v[cols.deflection].copy(), bushing_force=v[cols.force].copy(),
+                          spring_force=dict(zip((e.name for e in c.springs), v[cols.springs].tolist())),
+                          damper_force=dict(zip((e.name for e in c.dampers), v[cols.dampers].tolist())),
+                          closure_error=float(v[cols.closure_error]), wheels=wheels)
+
+    def _probe_args(self) -> tuple:
+        """The arguments of :func:`vehicle.simulation.probes.rig_sample` after ``out`` (rebuilt when
+        the bushing laws are switched, see MountedCar.bushing_laws_off)."""
+        bank = self.coupling.bushings.bank
+        if self._probe_bank is not bank:
+            self._probe_bank = bank
+            d = self.data
+            wheels = (d.xmat, d.site_xpos, d.xfrc_applied, d.qpos, self._efc_force, self.wheel_body.astype(np.int64),
+                      self.centre_site.astype(np.int64), self.carriage_body.astype(np.int64),
+                      self._rows[self.pad_eq].astype(np.int64), self.pad_qpos.astype(np.int64),
+                      np.array([SIDE_SIGN[c] for c in CORNERS], dtype=float), self.design_centre_z)
+            data = (d.qpos, d.qvel, d.ten_length, d.ten_velocity, self._efc_pos)
+            self._probe = (wheels, data, self.suspension_args(self._rows))
+        return self._probe
+
+    def _check_rows(self) -> None:
+        """Raise RuntimeError if MuJoCo moved the constraint rows from where the compiled measurement
+        reads them (the views taken at construction)."""
+        d = self.data
+        if (d.nefc, d.efc_force.ctypes.data, d.efc_pos.ctypes.data) != self._efc:
+            raise RuntimeError("the rig's constraint rows moved: its measurement would read stale memory")

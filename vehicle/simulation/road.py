@@ -9,7 +9,7 @@ also takes an extra drive torque and a brake (the spin joint's dry friction). In
 (:data:`N_INPUTS` columns): rack [m], target speed [m/s] (NaN: the throttle held), four drive
 torques [N·m] (order of ``CORNERS``, positive driving), four brake torques [N·m].
 
-Outputs (:meth:`RoadCar.measure`) follow ISO 8855: the body's motion in the intermediate axis
+Outputs (:meth:`RoadCar.measure`, :data:`vehicle.simulation.outputs.ROAD_BODY`) follow ISO 8855: the body's motion in the intermediate axis
 system (x forward and y left in the road's plane, turned by the yaw angle), at the body's centre of
 mass; wheel angles relative to the body as on the rig (toe-in, camber top-out, steer to the left
 positive).
@@ -27,9 +27,9 @@ import numpy as np
 from vehicle.model.definition import CORNERS, SIDE_SIGN, VehicleDefinition
 from vehicle.model.elements import BuildOptions
 from vehicle.model.kinematics import steering_ratio, wheel_orientation
-from vehicle.simulation import stepping
+from vehicle.simulation import probes, stepping
 from vehicle.simulation.mounted import MountedCar
-from vehicle.simulation.outputs import RoadOutputs, RoadWheel
+from vehicle.simulation.outputs import ROAD_BODY, ROAD_WHEEL
 from vsim_core.errors import InputError
 from vsim_tyres import magic_formula
 from vsim_tyres.road_contact import N_SIGNALS, N_STATE, SIGNALS, effective_rolling_radius, mirrored_wheels
@@ -102,6 +102,8 @@ class RoadCar(MountedCar):
         self._design_z = [getattr(self.vehicle, c.split("_")[0]).hardpoints["wheel_centre"][2] for c in CORNERS]
         self._run(0, _NO_INPUTS)
         self.stepping_s = 0.0
+        #: Where each quantity sits in the car's measured vector (:meth:`measure`).
+        self.columns = self.measured_columns(ROAD_BODY, ROAD_WHEEL + tuple(SIGNALS))
 
     def _run(self, n: int, inputs: np.ndarray) -> None:
         m, d = self.model, self.data
@@ -149,8 +151,8 @@ class RoadCar(MountedCar):
         mujoco.mj_forward(self.model, self.data)
         return float(self.data.energy.sum())
 
-    def measure(self) -> RoadOutputs:
-        """The car's outputs at the current state (ISO 8855, see the module)."""
+    def measure(self) -> np.ndarray:
+        """The car's measured vector at the current state (:attr:`columns`; ISO 8855, see the module)."""
         m, d = self.model, self.data
         mujoco.mj_forward(m, d)
         mujoco.mj_rnePostConstraint(m, d)   # the bodies' accelerations (cacc)
@@ -165,17 +167,18 @@ class RoadCar(MountedCar):
         accel = acceleration[3:] + m.opt.gravity   # MuJoCo's accelerations carry −g (an accelerometer's reading)
         c, s = math.cos(yaw), math.sin(yaw)
         vx, vy = c * velocity[0] + s * velocity[1], -s * velocity[0] + c * velocity[1]
-        wheels = {}
+        body = (d.xipos[self.chassis, 0], d.xipos[self.chassis, 1], yaw, roll, pitch, vx, vy, omega[2],
+                c * accel[0] + s * accel[1], -s * accel[0] + c * accel[1],
+                math.atan2(vy, vx) if math.hypot(vx, vy) > SIDESLIP_MIN_SPEED_MPS else 0.0,
+                d.qpos[self.rack_qpos], self.driver_state[1])
+        wheels = []
         for k, corner in enumerate(CORNERS):
             spin_left = rot.T @ d.xmat[self.wheel_body[k]].reshape(3, 3)[:, 1]   # in the body's frame
-            toe, camber, steer = wheel_orientation(spin_left, SIDE_SIGN[corner])
+            toe, camber, steer = wheel_orientation(*spin_left, SIDE_SIGN[corner])
             centre = rot.T @ (d.xipos[self.wheel_body[k]] - d.xpos[self.chassis])
-            wheels[corner] = RoadWheel(camber, toe, steer, float(centre[2] - self._design_z[k]),
-                                       self.tyre_signals[k].copy())
-        return RoadOutputs(
-            position=(float(d.xipos[self.chassis, 0]), float(d.xipos[self.chassis, 1])),
-            yaw=yaw, roll=roll, pitch=pitch, speed=vx, lateral_speed=vy, yaw_rate=float(omega[2]),
-            longitudinal_acceleration=c * accel[0] + s * accel[1], lateral_acceleration=-s * accel[0] + c * accel[1],
-            sideslip=math.atan2(vy, vx) if math.hypot(vx, vy) > SIDESLIP_MIN_SPEED_MPS else 0.0,
-            rack=float(d.qpos[self.rack_qpos]), drive_force=float(self.driver_state[1]), wheels=wheels,
-            **self.suspension_outputs(self._eq_first_rows()))
+            wheels.append(np.concatenate([[camber, toe, steer, centre[2] - self._design_z[k]], self.tyre_signals[k]]))
+        v = np.empty(self.columns.size)
+        v[:self.columns.suspension_start] = np.concatenate([body, *wheels])
+        probes.suspension(v[self.columns.suspension_start:], *self.suspension_data(),
+                          *self.suspension_args(self.equality_rows()))
+        return v

@@ -1,5 +1,5 @@
 """Playing a road scenario: the cases one after the other on one time axis, each on a freshly built
-car, yielding the samples that a recording keeps (:mod:`vsim_recordings.recorder`).
+car, yielding the samples that a recording keeps in blocks (:mod:`vsim_recordings.recorder`).
 
 Each case goes through :data:`vehicle.scenarios.schedule.ROAD_PHASES`: 0, at rest and braked with
 every bushing direction linear (the car settles on its tyres); 1, at rest with the bushing laws on
@@ -9,8 +9,8 @@ scenario says. The car runs in the world's x direction at the start of phase 2.
 
 A run stops with :class:`~vehicle.simulation.runner.DivergenceError` when the suspension leaves
 its valid range (as on the rig) or, once at speed, when the body's sideslip exceeds the
-scenario's limit (the car spun) or a wheel stays off the ground longer than allowed; the sample
-that shows it is yielded first.
+scenario's limit (the car spun) or a wheel stays off the ground longer than allowed; the samples
+up to the one that shows it are yielded first.
 """
 
 from __future__ import annotations
@@ -24,9 +24,9 @@ from vehicle.model.definition import CORNERS, VehicleDefinition
 from vehicle.model.elements import BuildOptions
 from vehicle.scenarios.road_scenario import RoadCase, RoadScenario, steering_and_speed
 from vehicle.scenarios.schedule import ROAD_PHASES, CaseSchedule, Progress, output_interval
-from vehicle.simulation.outputs import RoadOutputs, RoadSample
+from vehicle.simulation.outputs import MeasuredColumns, SampleBlock
 from vehicle.simulation.road import RoadCar
-from vehicle.simulation.runner import DivergenceError, PlayedScenario, check_divergence
+from vehicle.simulation.runner import PlayedScenario, blocks_of
 from vsim_core.units import DEG_PER_RAD
 
 #: The brake that holds the car while it settles [N·m per wheel] (far above what the slope of the
@@ -34,19 +34,24 @@ from vsim_core.units import DEG_PER_RAD
 SETTLE_BRAKE_NM = 500.0
 
 
-def check_road(car: RoadCar, o: RoadOutputs, scenario: RoadScenario, time_s: float, case: str,
-               lifted_s: np.ndarray, dt_s: float) -> None:
-    """Raise DivergenceError if the car left its valid range; ``lifted_s`` (per wheel, updated here)
-    is how long each wheel has been off the ground, ``dt_s`` the time since the last check."""
-    check_divergence(car, o, scenario, time_s, case)
-    if abs(o.sideslip) > scenario.limits.sideslip_rad:
-        raise DivergenceError(time_s, case, f"body sideslip {o.sideslip * DEG_PER_RAD:.1f} deg beyond the limit "
-                                            f"{scenario.limits.sideslip_rad * DEG_PER_RAD:g} deg (the car spun)")
-    for k, corner in enumerate(CORNERS):
-        lifted_s[k] = lifted_s[k] + dt_s if o.wheels[corner].tyre[0] <= 0.0 else 0.0
-        if lifted_s[k] > scenario.limits.wheel_lift_s:
-            raise DivergenceError(time_s, case, f"wheel {corner} off the ground for {lifted_s[k]:.2f} s, beyond the "
-                                                f"limit {scenario.limits.wheel_lift_s:g} s")
+def road_divergence(block: SampleBlock, columns: MeasuredColumns, scenario: RoadScenario, lifted_s: np.ndarray,
+                    dt_s: float) -> tuple[int, str] | None:
+    """The first row of ``block`` (at speed) at which the body's sideslip exceeds the scenario's
+    limit (the car spun) or a wheel has been off the ground too long, and what; None if none.
+    ``lifted_s`` (per wheel, updated here) is how long each wheel has been off the ground, ``dt_s``
+    the time between rows."""
+    sideslip = block.measured[:, columns.of("sideslip")]
+    load = block.measured[:, columns.wheel("Fz_N")]
+    for row in range(len(sideslip)):
+        if abs(sideslip[row]) > scenario.limits.sideslip_rad:
+            return row, (f"body sideslip {sideslip[row] * DEG_PER_RAD:.1f} deg beyond the limit "
+                         f"{scenario.limits.sideslip_rad * DEG_PER_RAD:g} deg (the car spun)")
+        for k, corner in enumerate(CORNERS):
+            lifted_s[k] = lifted_s[k] + dt_s if load[row, k] <= 0.0 else 0.0
+            if lifted_s[k] > scenario.limits.wheel_lift_s:
+                return row, (f"wheel {corner} off the ground for {lifted_s[k]:.2f} s, beyond the limit "
+                             f"{scenario.limits.wheel_lift_s:g} s")
+    return None
 
 
 class RoadRun(PlayedScenario):
@@ -55,53 +60,74 @@ class RoadRun(PlayedScenario):
     phases = ROAD_PHASES
 
     def __init__(self, scenario: RoadScenario, vehicle: VehicleDefinition, duration_scale: float = 1.0,
-                 progress: Callable[[Progress], None] | None = None, timestep_s: float = BuildOptions.timestep):
-        super().__init__(scenario, vehicle, duration_scale, progress, lambda v, o: RoadCar(v, options=o), timestep_s)
+                 progress: Callable[[Progress], None] | None = None, timestep_s: float = BuildOptions.timestep,
+                 poses: bool = True):
+        super().__init__(scenario, vehicle, duration_scale, progress, lambda v, o: RoadCar(v, options=o), timestep_s,
+                         poses)
 
-    def _case(self, car: RoadCar, case: RoadCase, number: int, when: CaseSchedule) -> Iterator[RoadSample]:
-        """The samples of one case from a fresh car, one every output interval."""
+    def _case(self, car: RoadCar, case: RoadCase, number: int, when: CaseSchedule) -> Iterator[SampleBlock]:
+        """The samples of one case from a fresh car, one every output interval, in blocks of at most
+        :data:`~vehicle.simulation.runner.BLOCK_SAMPLES`."""
         d, dt, scenario = car.data, self.dt, self.scenario
         every = output_interval(scenario, dt)
-        bodies = np.arange(1, car.model.nbody)
+        names = tuple(ch.name for ch in car.car.channels)
         name = f"{number} '{case.label}'"
         input_start = sum(when.steps[:3])
         lifted = np.zeros(len(CORNERS))
         step = 0
 
-        def sample(phase: int, steering: float, speed: float) -> Iterator[RoadSample]:
-            t = when.start_s + step * dt
-            o = car.measure()
-            yield RoadSample(t, number, phase, (step - input_start) * dt, steering, speed, o, d.xpos[bodies],
-                             d.xquat[bodies])
-            if phase >= 2:   # at speed: before, wheels touch down and the body's slip means nothing
-                check_road(car, o, scenario, t, name, lifted, every * dt)
-            else:
-                check_divergence(car, o, scenario, t, name)
-            self._report(number, case.label, phase, t)
-
-        def hold(phase: int, speed: float) -> Iterator[RoadSample]:
+        def measure(phase: int, samples: int, apart: int,
+                    advance: Callable[[int], tuple[float, float]]) -> Iterator[SampleBlock]:
+            """``samples`` samples, each after ``advance(k)`` has run the ``apart`` steps before sample
+            k of the block (and returned the steering-wheel angle [rad] and the target speed [m/s]
+            at their end); the block ends at the first sample after MuJoCo reset the state."""
             nonlocal step
+            rows, inputs = np.empty((samples, car.columns.size)), np.empty((samples, 2))
+            pos = np.empty((samples, self.recorded_bodies.size, 3))
+            quat = np.empty((samples, self.recorded_bodies.size, 4))
+            n = 0
+            while n < samples and not (n and car.was_reset()):
+                inputs[n] = advance(n)
+                rows[n] = car.measure()
+                pos[n], quat[n] = d.xpos[self.recorded_bodies], d.xquat[self.recorded_bodies]
+                n += 1
+            steps = step + apart * np.arange(1, n + 1)
+            step = int(steps[-1])
+            block = SampleBlock(when.start_s + steps * dt, number, phase, (steps - input_start) * dt, inputs[:n],
+                                rows[:n], pos[:n], quat[:n])
+            # at speed only: before, wheels touch down and the body's slip means nothing
+            also = (lambda b: road_divergence(b, car.columns, scenario, lifted, every * dt)) if phase >= 2 else (
+                lambda b: None)
+            yield from self._checked(block, car.columns, names, car, name, also)
+            self._report(number, case.label, phase, float(block.time_s[-1]))
+
+        def hold(phase: int, speed: float) -> Iterator[SampleBlock]:
             u = car.drive_inputs(np.zeros(every), np.full(every, speed))
-            for _ in range(when.steps[phase] // every):
+
+            def advance(_: int) -> tuple[float, float]:
                 if math.isnan(speed):
                     car.step(every)
                 else:
                     car.play(u)
-                step += every
-                yield from sample(phase, 0.0, speed)
+                return 0.0, speed
+
+            for samples in blocks_of(when.steps[phase] // every):
+                yield from measure(phase, samples, every, advance)
+
+        def steer(k: int) -> tuple[float, float]:
+            t = (step + k * every - input_start + np.arange(1, every + 1)) * dt / self.duration_scale
+            steering, speed = steering_and_speed(case, t, scenario.throttle)
+            ahead = case.steering(t + car.rack_lead_s / self.duration_scale)
+            car.play(car.drive_inputs(ahead, speed))
+            return float(steering[-1]), float(speed[-1])
 
         car.set_brakes(SETTLE_BRAKE_NM)
         with car.bushing_laws_off():
-            yield from sample(0, 0.0, math.nan)
+            yield from measure(0, 1, 0, lambda _: (0.0, math.nan))
             yield from hold(0, math.nan)
         yield from hold(1, math.nan)
         car.set_brakes(0.0)
         car.set_speed(case.speed_mps)
         yield from hold(2, case.speed_mps)
-        for _ in range(when.steps[3] // every):
-            t = (step - input_start + np.arange(1, every + 1)) * dt / self.duration_scale
-            steering, speed = steering_and_speed(case, t, scenario.throttle)
-            ahead = case.steering(t + car.rack_lead_s / self.duration_scale)
-            car.play(car.drive_inputs(ahead, speed))
-            step += every
-            yield from sample(3, float(steering[-1]), float(speed[-1]))
+        for samples in blocks_of(when.steps[3] // every):
+            yield from measure(3, samples, every, steer)

@@ -1,6 +1,8 @@
 """Playing a scenario on the K&C rig: the cases one after the other on one time axis, each from a
-freshly built rig, yielding the samples that a recording keeps (:mod:`vsim_recordings.recorder`
-records them in a file or in memory).
+freshly built rig, yielding the samples that a recording keeps in blocks
+(:class:`vehicle.simulation.outputs.SampleBlock`; :mod:`vsim_recordings.recorder` records them in a
+file or in memory). A block's samples are stepped and measured in one compiled call
+(:meth:`vehicle.simulation.rig.KCRig.sampled`): no Python runs between them.
 
 Each case goes through the three phases of :data:`vehicle.scenarios.schedule.PHASES`: 0, rest with
 every bushing direction linear at its reference stiffness (the car settles under gravity); 1, rest
@@ -9,8 +11,9 @@ follows case k's last one by one output interval.
 
 A run stops with :class:`DivergenceError` (time, bushing, direction, value) when the state turns
 non-finite, MuJoCo reports an unstable acceleration, a bushing deflects beyond the scenario's
-limits or a loop closure opens beyond its bound; the sample that shows it is yielded first, so that
-a recording keeps it.
+limits or a loop closure opens beyond its bound; the samples up to the one that shows it are
+yielded first, so that a recording keeps them (an unstable acceleration is seen at the end of its
+block, up to BLOCK_SAMPLES samples late).
 """
 
 from __future__ import annotations
@@ -21,13 +24,15 @@ from typing import Any, Callable, Iterator
 import mujoco
 import numpy as np
 
-from vehicle.model.definition import CORNERS, VehicleDefinition, is_rotation
+from vehicle.model.definition import VehicleDefinition, is_rotation
 from vehicle.model.elements import BuildOptions
+from vehicle.model.statics import resolve_preloads
 from vehicle.scenarios.channels import INPUT_CHANNELS
 from vehicle.scenarios.road_scenario import RoadScenario
 from vehicle.scenarios.scenario import Case, Scenario
 from vehicle.scenarios.schedule import PHASES, CaseSchedule, Progress, output_interval, schedule
-from vehicle.simulation.outputs import RigOutputs, Sample
+from vehicle.simulation.mounted import MountedCar
+from vehicle.simulation.outputs import MeasuredColumns, SampleBlock
 from vehicle.simulation.rig import KCRig
 from vsim_core.units import DEG_PER_RAD, MM_PER_M
 
@@ -41,37 +46,62 @@ class DivergenceError(RuntimeError):
         self.time_s, self.case, self.what = time_s, case, what
 
 
-def check_divergence(rig: KCRig, o: RigOutputs, scenario: Scenario, time_s: float, case: str) -> None:
-    """Raise :class:`DivergenceError` if the state of ``rig`` left its valid range."""
-    names = o.bushing_names
-    bad = ~(np.isfinite(o.bushing_deflection) & np.isfinite(o.bushing_force))
+#: Samples measured in one compiled call: progress, Ctrl-C and the state checks come between calls.
+BLOCK_SAMPLES = 50
+#: The wheel quantities every mounting measures from the joints' positions (their non-finite values diverge).
+_POSE = ("camber", "toe", "steer", "travel")
+
+
+def divergence(block: SampleBlock, columns: MeasuredColumns, names: tuple[str, ...], car: MountedCar,
+               scenario: Scenario | RoadScenario) -> tuple[int, str] | None:
+    """The first row of ``block`` (the last ones measured on ``car``) at which the car left its
+    valid range, and what left it; None if it did not: a non-finite bushing state or wheel pose, a
+    bushing deflection beyond the scenario's limits, an opened loop closure (each at its row);
+    non-finite joint positions now, or MuJoCo's reset of the state (at the block's last row, the
+    first after the reset)."""
+    m = block.measured
+    found = []   # (row, priority within a row, what)
+    rows = np.arange(len(m))
+    deflection, force = m[:, columns.deflection], m[:, columns.force]
+    bad = ~(np.isfinite(deflection) & np.isfinite(force))
     if bad.any():
-        i = int(np.argmax(bad))
+        r, i = np.argwhere(bad)[0]
         bushing, direction = names[i].split(".")
-        raise DivergenceError(time_s, case, f"bushing {bushing}, direction {direction}: non-finite state "
-                                            f"(deflection {o.bushing_deflection[i]}, force {o.bushing_force[i]})")
-    if not np.all(np.isfinite(rig.data.qpos)):
-        raise DivergenceError(time_s, case, "non-finite joint positions")
-    if rig.data.warning[mujoco.mjtWarning.mjWARN_BADQACC].number:
-        raise DivergenceError(time_s, case, "MuJoCo found a non-finite or huge acceleration and reset the state")
+        found.append((r, 0, f"bushing {bushing}, direction {direction}: non-finite state "
+                            f"(deflection {deflection[r, i]}, force {force[r, i]})"))
+    pose = m[:, np.concatenate([columns.wheel(q) for q in _POSE])]
+    state_bad = ~np.isfinite(pose).all(axis=1)
+    if state_bad.any() or not np.all(np.isfinite(car.data.qpos)):
+        found.append((rows[state_bad][0] if state_bad.any() else rows[-1], 1, "non-finite joint positions"))
+    if car.was_reset():   # the block ends at the first sample after it
+        found.append((rows[-1], 2, "MuJoCo found a non-finite or huge position, velocity or acceleration and "
+                                   "reset the state"))
     rotation, limit = _deflection_limits(names, scenario.limits.rotation_rad, scenario.limits.translation_m)
-    ratio = np.abs(o.bushing_deflection) / limit
-    i = int(np.argmax(ratio))
-    if ratio[i] > 1.0:
+    ratio = np.abs(deflection) / limit
+    beyond = ratio.max(axis=1, initial=0.0) > 1.0
+    if beyond.any():
+        r = rows[beyond][0]
+        i = int(np.argmax(ratio[r]))
         bushing, direction = names[i].split(".")
         scale, unit = (DEG_PER_RAD, "deg") if rotation[i] else (MM_PER_M, "mm")
-        raise DivergenceError(time_s, case, f"bushing {bushing}, direction {direction}: deflection "
-                                            f"{o.bushing_deflection[i] * scale:.3f} {unit} beyond the limit "
-                                            f"{limit[i] * scale:g} {unit}")
-    if o.closure_error > scenario.limits.closure_error_m:
-        raise DivergenceError(time_s, case, f"loop-closure error {o.closure_error * MM_PER_M:.3f} mm beyond the "
-                                            f"limit {scenario.limits.closure_error_m * MM_PER_M:g} mm")
+        found.append((r, 3, f"bushing {bushing}, direction {direction}: deflection "
+                            f"{deflection[r, i] * scale:.3f} {unit} beyond the limit {limit[i] * scale:g} {unit}"))
+    closure = m[:, columns.closure_error]
+    opened = closure > scenario.limits.closure_error_m
+    if opened.any():
+        r = rows[opened][0]
+        found.append((r, 4, f"loop-closure error {closure[r] * MM_PER_M:.3f} mm beyond the limit "
+                            f"{scenario.limits.closure_error_m * MM_PER_M:g} mm"))
+    if not found:
+        return None
+    row, _, what = min(found, key=lambda f: f[:2])
+    return int(row), what
 
 
 @functools.lru_cache(maxsize=8)
 def _deflection_limits(names: tuple[str, ...], rotation_rad: float, translation_m: float) -> tuple[np.ndarray, np.ndarray]:
     """Which bushing directions turn, and each one's deflection limit (computed once per run, not per sample)."""
-    rotation = np.array([is_rotation(n) for n in names])
+    rotation = np.array([is_rotation(n) for n in names], dtype=bool)
     return rotation, np.where(rotation, rotation_rad, translation_m)
 
 
@@ -79,33 +109,38 @@ class PlayedScenario:
     """What every play of a scenario shares, on the rig or on the road: the schedule of its cases,
     the first case's car (``mount(vehicle, options)``), the simulated time and the time spent in
     the compiled stepping loop. ``duration_scale`` multiplies every duration (settle phases,
-    periods, holds) for quick runs; ``progress`` is called after every sample with a :class:`Progress`;
-    ``timestep_s`` is the car's time step (its convergence is measured in tools/benchmarks)."""
+    periods, holds) for quick runs; ``progress`` is called after every block with a :class:`Progress`;
+    ``timestep_s`` is the car's time step (its convergence is measured in tools/benchmarks);
+    ``poses`` whether the blocks carry the bodies' poses (a recording's replay needs them)."""
 
     #: Names of a case's phases (the ``phase`` signal is the index).
     phases: tuple[str, ...] = PHASES
 
     def __init__(self, scenario: Scenario | RoadScenario, vehicle: VehicleDefinition, duration_scale: float,
                  progress: Callable[[Progress], None] | None, mount: Callable[[VehicleDefinition, BuildOptions], Any],
-                 timestep_s: float = BuildOptions.timestep):
-        self.scenario, self.vehicle, self.duration_scale = scenario, vehicle, duration_scale
+                 timestep_s: float = BuildOptions.timestep, poses: bool = True):
+        # the preloads resolved once for every case's car (each build would solve the kinematics again)
+        self.scenario, self.vehicle, self.duration_scale = scenario, resolve_preloads(vehicle), duration_scale
         self.progress, self._mount = progress, mount
         self.options = BuildOptions(bushing_model=scenario.bushing_model, timestep=timestep_s)
         self.dt = self.options.timestep
         self.plan = schedule(scenario, duration_scale, self.dt)   # checks the scale before the build
         #: The first case's car (each later case builds its own).
-        self.car = mount(vehicle, self.options)
+        self.car = mount(self.vehicle, self.options)
         self.total_s = self.plan[-1].end_s(self.dt)
+        #: Ids of the bodies whose poses the blocks carry: every body but the world (``poses``), or none.
+        self.recorded_bodies = np.arange(1 if poses else 0, self.car.model.nbody if poses else 0, dtype=np.int64)
         #: Wall time the cases spent in the compiled stepping loop [s] (their cars' ``stepping_s``).
         self.stepping_s = 0.0
 
     def bodies(self) -> list[str]:
-        """Names of the model's bodies whose poses the samples carry (the world excepted)."""
+        """Names of the bodies whose poses the blocks carry."""
         m = self.car.model
-        return [mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, i) for i in range(1, m.nbody)]
+        return [mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, i) for i in self.recorded_bodies]
 
-    def samples(self) -> Iterator[Any]:
-        """Every sample of every case, in time order, each case on a fresh car (the subclass's ``_case``)."""
+    def blocks(self) -> Iterator[SampleBlock]:
+        """Every sample of every case in blocks, in time order, each case on a fresh car (the
+        subclass's ``_case``)."""
         car = self.car
         for k, (case, when) in enumerate(zip(self.scenario.cases, self.plan), start=1):
             if k > 1:
@@ -114,6 +149,18 @@ class PlayedScenario:
                 yield from self._case(car, case, k, when)
             finally:
                 self.stepping_s += car.stepping_s
+
+    def _checked(self, block: SampleBlock, columns: MeasuredColumns, names: tuple[str, ...], car: MountedCar,
+                 case: str, also: Callable[[SampleBlock], tuple[int, str] | None] = lambda block: None
+                 ) -> Iterator[SampleBlock]:
+        """``block``; if the car left its valid range in it (:func:`divergence`, then ``also``),
+        its rows up to the first that shows it, then DivergenceError."""
+        found = [f for f in (divergence(block, columns, names, car, self.scenario), also(block)) if f is not None]
+        if found:
+            row, what = min(found, key=lambda f: f[0])   # the suspension's reason first at one row
+            yield block.upto(row)
+            raise DivergenceError(float(block.time_s[row]), case, what)
+        yield block
 
     def _report(self, number: int, label: str, phase: int, time_s: float) -> None:
         """Tell ``progress`` (if any) where the run is."""
@@ -126,44 +173,49 @@ class ScenarioRun(PlayedScenario):
     """The cases of a scenario played one after the other on ``vehicle``, each on a fresh rig."""
 
     def __init__(self, scenario: Scenario, vehicle: VehicleDefinition, duration_scale: float = 1.0,
-                 progress: Callable[[Progress], None] | None = None, timestep_s: float = BuildOptions.timestep):
-        super().__init__(scenario, vehicle, duration_scale, progress, KCRig, timestep_s)
+                 progress: Callable[[Progress], None] | None = None, timestep_s: float = BuildOptions.timestep,
+                 poses: bool = True):
+        super().__init__(scenario, vehicle, duration_scale, progress, KCRig, timestep_s, poses)
 
-    def _case(self, rig: KCRig, case: Case, number: int, when: CaseSchedule) -> Iterator[Sample]:
-        """The samples of one case from a fresh rig, one every output interval."""
-        m, d = rig.model, rig.data
+    def _case(self, rig: KCRig, case: Case, number: int, when: CaseSchedule) -> Iterator[SampleBlock]:
+        """The samples of one case from a fresh rig, one every output interval, in blocks of at most
+        :data:`BLOCK_SAMPLES` measured in compiled code."""
         dt, scenario = self.dt, self.scenario
         every = output_interval(scenario, dt)
-        bodies = np.arange(1, m.nbody)
-        rest = np.zeros(len(INPUT_CHANNELS))
-        design = rig.measure()
-        design_z = np.array([design.wheels[c].wheel_centre[2] for c in CORNERS])
+        names = tuple(ch.name for ch in rig.car.channels)
         name = f"{number} '{case.label}'"
         input_start = sum(when.steps[:2])
         step = 0
 
-        def sample(phase: int, inputs: np.ndarray) -> Iterator[Sample]:
-            t = when.start_s + step * dt
-            o = rig.measure()
-            yield Sample(t, number, phase, (step - input_start) * dt, inputs, o, design_z, d.xpos[bodies],
-                         d.xquat[bodies])
-            check_divergence(rig, o, scenario, t, name)
-            self._report(number, case.label, phase, t)
-
-        def hold(phase: int) -> Iterator[Sample]:
+        def measure(phase: int, samples: int, apart: int, inputs: np.ndarray) -> Iterator[SampleBlock]:
+            """``samples`` samples ``apart`` steps apart, with ``inputs`` one row per step (none: held)."""
             nonlocal step
-            for _ in range(when.steps[phase] // every):
-                rig.step(every)
-                step += every
-                yield from sample(phase, rest)
+            measured, pos, quat = rig.sampled(samples, apart, inputs, self.recorded_bodies)
+            steps = step + apart * np.arange(1, len(measured) + 1)   # fewer samples after a reset
+            step = int(steps[-1])
+            held = np.zeros((len(measured), len(INPUT_CHANNELS)))
+            block = SampleBlock(when.start_s + steps * dt, number, phase, (steps - input_start) * dt,
+                                inputs[apart - 1::apart][:len(measured)] if len(inputs) else held, measured, pos, quat)
+            yield from self._checked(block, rig.columns, names, rig, name)
+            self._report(number, case.label, phase, float(block.time_s[-1]))
 
-        rig.set_inputs(rest)
+        def hold(phase: int) -> Iterator[SampleBlock]:
+            for samples in blocks_of(when.steps[phase] // every):
+                yield from measure(phase, samples, every, _HELD)
+
+        rig.set_inputs(np.zeros(len(INPUT_CHANNELS)))
         with rig.bushing_laws_off():
-            yield from sample(0, rest)
+            yield from measure(0, 1, 0, _HELD)
             yield from hold(0)
         yield from hold(1)
-        for _ in range(when.steps[2] // every):
-            u = case.inputs((step - input_start + np.arange(1, every + 1)) * dt / self.duration_scale)
-            rig.play(u)
-            step += every
-            yield from sample(2, u[-1])
+        for samples in blocks_of(when.steps[2] // every):
+            t = (step - input_start + np.arange(1, samples * every + 1)) * dt / self.duration_scale
+            yield from measure(2, samples, every, case.inputs(t))
+
+
+_HELD = np.zeros((0, len(INPUT_CHANNELS)))
+
+
+def blocks_of(samples: int) -> list[int]:
+    """The sizes of ``samples`` samples cut into blocks of at most BLOCK_SAMPLES."""
+    return [min(BLOCK_SAMPLES, samples - k) for k in range(0, samples, BLOCK_SAMPLES)]

@@ -5,7 +5,9 @@ A numpy coupling called from a Python loop cost ~150–250 µs per step on the r
 :func:`bushings.extended_bank.step_extended`), the bushings' cross stiffnesses, the damper and spring
 laws and ``mj_step`` (called through ctypes on the model's and data's addresses) all run in
 compiled code, so a step costs ``mj_step`` plus the bank kernel. :func:`run` gives bit-identical
-results to calling ``ForceCoupling.apply`` and ``mujoco.mj_step`` from Python (tests/test_vehicle_rig.py).
+results to calling ``ForceCoupling.apply`` and ``mujoco.mj_step`` from Python (tests/test_vehicle_rig.py);
+:func:`run_sampled` also measures the rig's outputs every so many steps (vehicle.simulation.probes)
+without coming back to Python.
 
 Arrays of ``MjModel``/``MjData`` are numpy views of MuJoCo's memory, so the loop reads and writes
 them in place.
@@ -22,31 +24,23 @@ import numba as nb
 import numpy as np
 
 from bushings import extended_bank as _xb
+from vehicle.simulation import probes
+from vehicle.simulation.probes import rig_sample, segment
 from vsim_core.compiled_cache import follow
 from vsim_tyres import road_contact
 from vsim_tyres.road_contact import tyre_wrenches
 
 # the loops compile the bushing kernels and the tyres into themselves: their cache follows those files
-follow(__file__, *_xb.KERNEL_FILES, *road_contact.TYRE_FILES)
+follow(__file__, *_xb.KERNEL_FILES, *road_contact.TYRE_FILES, probes.__file__, *probes.FOLLOWED)
 
 _LIB = ctypes.CDLL(str(next(Path(mujoco.__file__).parent.glob("libmujoco.so*"))))
 _mj_step = _LIB.mj_step
 _mj_step.argtypes = (ctypes.c_size_t, ctypes.c_size_t)  # mjModel*, mjData* as addresses
 _mj_step.restype = None
 _mj_step1, _mj_step2 = _LIB.mj_step1, _LIB.mj_step2   # positions and velocities, then forces and integration
-for _f in (_mj_step1, _mj_step2):
+_mj_forward = _LIB.mj_forward
+for _f in (_mj_step1, _mj_step2, _mj_forward):
     _f.argtypes, _f.restype = (ctypes.c_size_t, ctypes.c_size_t), None
-
-
-@nb.njit(cache=True)
-def _segment(x, xs, ys):
-    """Slope and intercept of the padded curve (xs, ys) at x (linear extrapolation at the ends)."""
-    n = xs.shape[0]
-    i = 0
-    while i < n - 2 and xs[i + 1] <= x:
-        i += 1
-    slope = (ys[i + 1] - ys[i]) / (xs[i + 1] - xs[i])
-    return slope, ys[i] - slope * xs[i]
 
 
 @nb.njit(cache=True)
@@ -91,7 +85,7 @@ def coupling_step(h, qpos, qvel, qfrc, ten_length, ten_velocity, ten_J, ten_J_ro
     joint, index, sign, xs, ys, offset, gen = damp
     for k in range(joint.shape[0]):
         v = qvel[index[k]] if joint[k] else ten_velocity[index[k]]
-        slope, offset[k] = _segment(sign[k] * v, xs[k], ys[k])
+        slope, offset[k] = segment(sign[k] * v, xs[k], ys[k])
         if joint[k]:
             dof_damping[index[k]] = slope
         else:
@@ -103,7 +97,7 @@ def coupling_step(h, qpos, qvel, qfrc, ten_length, ten_velocity, ten_J, ten_J_ro
         for k in range(sjoint.shape[0]):
             coord = qpos[sqadr[k]] if sjoint[k] else ten_length[sindex[k]]
             x = ssign[k] * (coord - design[k])
-            slope, icpt = _segment(x, sxs[k], sys_[k])
+            slope, icpt = segment(x, sxs[k], sys_[k])
             rem[k] = -ssign[k] * (slope * x + icpt - y0[k] - rate[k] * x)
         _push(qfrc, ten_J, ten_J_rowadr, ten_J_rownnz, ten_J_colind, sjoint, sindex, rem)
 
@@ -142,6 +136,35 @@ def _run(mj_step, n, inputs, active, eq_data, pad_eq, rack_eq, xfrc, carriage, w
 def run(*args) -> None:
     """:func:`_run` with MuJoCo's ``mj_step``; ``args`` are the rest of its arguments, from ``n``."""
     _run(_mj_step, *args)
+
+
+@nb.njit(cache=True, nogil=True)   # a recording's writer thread runs meanwhile (vsim_recordings.background)
+def _run_sampled(mj_step, mj_forward, every, inputs, active, rig, m_addr, d_addr, h, coupling, probe, bodies, xpos,
+                 xquat, measured, body_pos, body_quat, warnings, resets):
+    """One sample every ``every`` steps for each row of ``measured``: :func:`_run` of ``every`` steps
+    (their rows of ``inputs``, none if it has no rows; ``rig`` = its arguments from ``eq_data`` to
+    ``wheel``), ``mj_forward``, the rig's measured vector into the row
+    (:func:`vehicle.simulation.probes.rig_sample`, ``probe`` its arguments after ``out``) and the
+    poses of ``bodies`` into ``body_pos``, ``body_quat``. Stops after the first sample at which one
+    of MuJoCo's warning counters ``warnings[resets]`` rose (MuJoCo reset the state); returns the
+    number of samples taken."""
+    counts = warnings[resets].copy()
+    for s in range(measured.shape[0]):
+        _run(mj_step, every, inputs[s * every:(s + 1) * every], active, *rig, m_addr, d_addr, h, *coupling)
+        mj_forward(m_addr, d_addr)
+        rig_sample(measured[s], *probe)
+        for b in range(bodies.shape[0]):
+            body_pos[s, b, :] = xpos[bodies[b]]
+            body_quat[s, b, :] = xquat[bodies[b]]
+        for k in range(resets.shape[0]):
+            if warnings[resets[k]] != counts[k]:
+                return s + 1
+    return measured.shape[0]
+
+
+def run_sampled(*args) -> int:
+    """:func:`_run_sampled` with MuJoCo's ``mj_step`` and ``mj_forward``; ``args`` from ``every``."""
+    return _run_sampled(_mj_step, _mj_forward, *args)
 
 
 @nb.njit(cache=True)
