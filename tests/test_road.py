@@ -103,3 +103,44 @@ def test_the_road_mounting_is_the_rig_car_without_the_rig() -> None:
     assert road.jnt_type[0] == mujoco.mjtJoint.mjJNT_FREE
     with pytest.raises(ValueError, match="neither on the rig nor clamped"):
         build(vehicle, BuildOptions(road=True))
+
+
+def test_the_compiled_road_measurement_is_its_definition() -> None:
+    """The measured vector of a car turning at speed against its definition computed with MuJoCo's
+    Python API and numpy: ISO 8855 body angles, speeds and accelerations in the intermediate axes
+    (MuJoCo's accelerations carry −g), wheel angles and travel in the body frame, the tyres' signals."""
+    from vehicle.model.kinematics import wheel_angles
+    from vehicle.model.definition import SIDE_SIGN
+
+    car = settled(brakes=0.0, seconds=1.0)
+    car.set_speed(15.0)
+    steps = 400
+    u = car.drive_inputs(np.full(steps, 1.5), np.full(steps, 15.0))   # 1.5 rad of steering wheel: a turn
+    measured, _, _ = car.sampled(2, steps // 2, u)
+    cols, m, d = car.columns, car.model, car.data
+    v = measured[-1]
+    mujoco.mj_forward(m, d)
+    mujoco.mj_rnePostConstraint(m, d)
+    rot = d.xmat[car.chassis].reshape(3, 3)
+    motion, acc = np.zeros(6), np.zeros(6)
+    mujoco.mj_objectVelocity(m, d, mujoco.mjtObj.mjOBJ_BODY, car.chassis, motion, 0)
+    mujoco.mj_objectAcceleration(m, d, mujoco.mjtObj.mjOBJ_BODY, car.chassis, acc, 0)
+    yaw = np.arctan2(rot[1, 0], rot[0, 0])
+    to_road = np.array([[np.cos(yaw), np.sin(yaw)], [-np.sin(yaw), np.cos(yaw)]])
+    speed = to_road @ motion[3:5]
+    accel = to_road @ (acc[3:5] + m.opt.gravity[:2])
+    expected = {"x": d.xipos[car.chassis, 0], "y": d.xipos[car.chassis, 1], "yaw": yaw,
+                "roll": np.arctan2(rot[2, 1], rot[2, 2]), "pitch": -np.arcsin(rot[2, 0]), "speed": speed[0],
+                "lateral_speed": speed[1], "yaw_rate": motion[2], "longitudinal_acceleration": accel[0],
+                "lateral_acceleration": accel[1], "sideslip": np.arctan2(speed[1], speed[0]),
+                "rack": d.qpos[car.rack_qpos], "drive_force": car.driver_state[1]}
+    for name, value in expected.items():
+        assert v[cols.of(name)] == pytest.approx(value, rel=1e-9, abs=1e-12), name
+    assert abs(v[cols.of("yaw_rate")]) > 0.05 and abs(v[cols.of("lateral_acceleration")]) > 0.5   # turning
+    for k, corner in enumerate(CORNERS):
+        spin_out = SIDE_SIGN[corner] * (rot.T @ d.xmat[car.wheel_body[k]].reshape(3, 3)[:, 1])
+        toe, camber = wheel_angles(spin_out, SIDE_SIGN[corner])
+        travel = (rot.T @ (d.xipos[car.wheel_body[k]] - d.xpos[car.chassis]))[2] - car._design_z[k]
+        for name, value in (("toe", toe), ("camber", camber), ("travel", travel)):
+            assert v[cols.wheel(name)[k]] == pytest.approx(value, abs=1e-12), (corner, name)
+        np.testing.assert_array_equal(v[[cols.wheel(s)[k] for s in SIGNALS]], car.tyre_signals[k])

@@ -1,8 +1,8 @@
-"""Writing a run's blocks of samples on a thread of its own while the car runs the next ones: on the
-rig the compiled stepping and measuring loop releases the GIL (vehicle.simulation.stepping.run_sampled),
-so on a machine with two cores the recording costs a rig run almost no time (on the road, whose
-loop holds the GIL and measures in Python, the two only take turns). Blocks are written in the
-order they are given, by one thread: the file is the same, byte for byte, as one written in line."""
+"""Writing a run's blocks of samples on a thread of its own while the car runs the next ones: the
+compiled stepping and measuring loops release the GIL (vehicle.simulation.stepping.run_sampled,
+run_road_sampled), so on a machine with two cores the recording costs a run almost no time.
+Blocks are written in the order they are given, by one thread: the file is the same, byte for
+byte, as one written in line."""
 
 from __future__ import annotations
 

@@ -17,7 +17,7 @@ import numpy as np
 
 from vehicle.model import kinematics
 from vehicle.model.kinematics import wheel_orientation
-from vehicle.simulation.outputs import RIG_WHEEL
+from vehicle.simulation.outputs import RIG_WHEEL, ROAD_BODY, ROAD_WHEEL
 from vsim_core.compiled_cache import follow
 
 #: Files the probes compile into themselves (the wheel angles): their cache follows them.
@@ -157,3 +157,65 @@ def rig_sample(out, wheels, data, suspension_args):
     ten_velocity, efc_pos; ``suspension_args`` the rest of :func:`suspension`'s)."""
     rig_wheels(out, *wheels)
     suspension(out[RIG_WHEEL_SIZE * wheels[5].shape[0]:], *data, *suspension_args)   # after the wheels
+
+
+@nb.njit(cache=True)
+def road_body(out, motion, acceleration, xmat, xipos, qpos, chassis, rack_qpos, driver_state, gravity, min_speed):
+    """What the car on the road measures of its body and driver into ``out`` (the columns of
+    vehicle.simulation.outputs.ROAD_BODY): ``motion`` and ``acceleration`` are MuJoCo's
+    (rotational, linear) velocity and acceleration of the body at its centre of mass, world axes
+    (``mj_objectVelocity``, ``mj_objectAcceleration``), the acceleration carrying −g."""
+    r = xmat[chassis]
+    yaw = math.atan2(r[3], r[0])
+    c, s = math.cos(yaw), math.sin(yaw)
+    vx, vy = c * motion[3] + s * motion[4], -s * motion[3] + c * motion[4]
+    ax, ay = acceleration[3] + gravity[0], acceleration[4] + gravity[1]   # an accelerometer's reading
+    out[0] = xipos[chassis, 0]
+    out[1] = xipos[chassis, 1]
+    out[2] = yaw
+    out[3] = math.atan2(r[7], r[8])
+    out[4] = -math.asin(max(-1.0, min(1.0, r[6])))
+    out[5] = vx
+    out[6] = vy
+    out[7] = motion[2]
+    out[8] = c * ax + s * ay
+    out[9] = -s * ax + c * ay
+    out[10] = math.atan2(vy, vx) if math.hypot(vx, vy) > min_speed else 0.0
+    out[11] = qpos[rack_qpos]
+    out[12] = driver_state[1]
+
+
+@nb.njit(cache=True)
+def road_wheels(out, xmat, xipos, xpos, wheel, chassis, sign, design_z, tyre_signals):
+    """What the car on the road measures at its four wheels into ``out`` (the columns of
+    vehicle.simulation.outputs.ROAD_WHEEL, then the tyre's ``tyre_signals``, for each wheel):
+    angles relative to the body, travel (wheel-centre height in the body frame from ``design_z``)."""
+    r = xmat[chassis]
+    size = len(ROAD_WHEEL) + tyre_signals.shape[1]
+    for k in range(wheel.shape[0]):
+        w = xmat[wheel[k]]
+        # the spin axis (the wheel's y axis) and the centre of mass in the body's frame: rᵀ·v
+        lx = r[0] * w[1] + r[3] * w[4] + r[6] * w[7]
+        ly = r[1] * w[1] + r[4] * w[4] + r[7] * w[7]
+        lz = r[2] * w[1] + r[5] * w[4] + r[8] * w[7]
+        toe, camber, steer = wheel_orientation(lx, ly, lz, sign[k])
+        dx, dy, dz = (xipos[wheel[k], 0] - xpos[chassis, 0], xipos[wheel[k], 1] - xpos[chassis, 1],
+                      xipos[wheel[k], 2] - xpos[chassis, 2])
+        base = k * size
+        out[base] = camber
+        out[base + 1] = toe
+        out[base + 2] = steer
+        out[base + 3] = r[2] * dx + r[5] * dy + r[8] * dz - design_z[k]
+        out[base + len(ROAD_WHEEL):base + size] = tyre_signals[k]
+
+
+@nb.njit(cache=True)
+def road_sample(out, motion, acceleration, body, wheels, data, suspension_args):
+    """One measured vector of the car on the road into ``out``: the body (``body`` the arguments of
+    :func:`road_body` after ``acceleration``), the wheels (``wheels`` those of :func:`road_wheels`
+    after ``out``), then the suspension (as in :func:`rig_sample`)."""
+    road_body(out, motion, acceleration, *body)
+    start = len(ROAD_BODY)
+    stop = start + wheels[3].shape[0] * (len(ROAD_WHEEL) + wheels[7].shape[1])
+    road_wheels(out[start:stop], *wheels)
+    suspension(out[stop:], *data, *suspension_args)

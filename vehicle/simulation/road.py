@@ -9,10 +9,11 @@ also takes an extra drive torque and a brake (the spin joint's dry friction). In
 (:data:`N_INPUTS` columns): rack [m], target speed [m/s] (NaN: the throttle held), four drive
 torques [N·m] (order of ``CORNERS``, positive driving), four brake torques [N·m].
 
-Outputs (:meth:`RoadCar.measure`, :data:`vehicle.simulation.outputs.ROAD_BODY`) follow ISO 8855: the body's motion in the intermediate axis
-system (x forward and y left in the road's plane, turned by the yaw angle), at the body's centre of
-mass; wheel angles relative to the body as on the rig (toe-in, camber top-out, steer to the left
-positive).
+Outputs (:meth:`RoadCar.sampled`, measured in the compiled loop by vehicle.simulation.probes; the
+columns of vehicle.simulation.outputs.ROAD_BODY and ROAD_WHEEL) follow ISO 8855: the body's motion
+in the intermediate axis system (x forward and y left in the road's plane, turned by the yaw
+angle), at the body's centre of mass; wheel angles relative to the body as on the rig (toe-in,
+camber top-out, steer to the left positive).
 """
 
 from __future__ import annotations
@@ -26,9 +27,9 @@ import numpy as np
 
 from vehicle.model.definition import CORNERS, SIDE_SIGN, VehicleDefinition
 from vehicle.model.elements import BuildOptions
-from vehicle.model.kinematics import steering_ratio, wheel_orientation
-from vehicle.simulation import probes, stepping
-from vehicle.simulation.mounted import MountedCar
+from vehicle.model.kinematics import steering_ratio
+from vehicle.simulation import stepping
+from vehicle.simulation.mounted import RESET_WARNINGS, MountedCar
 from vehicle.simulation.outputs import ROAD_BODY, ROAD_WHEEL
 from vsim_core.errors import InputError
 from vsim_tyres import magic_formula
@@ -99,11 +100,17 @@ class RoadCar(MountedCar):
                         self.driver_state)
         self._tyre_args = (self.tyres, self.mirrored, self.wheel_body, d.xipos, d.xmat, d.cvel, d.subtree_com,
                            m.body_rootid.astype(np.int64), self.tyre_state, d.xfrc_applied, self.tyre_signals)
-        self._design_z = [getattr(self.vehicle, c.split("_")[0]).hardpoints["wheel_centre"][2] for c in CORNERS]
+        self._design_z = np.array([getattr(self.vehicle, c.split("_")[0]).hardpoints["wheel_centre"][2]
+                                   for c in CORNERS])
         self._run(0, _NO_INPUTS)
         self.stepping_s = 0.0
-        #: Where each quantity sits in the car's measured vector (:meth:`measure`).
+        #: Where each quantity sits in the car's measured vector (:meth:`sampled`, :meth:`measure`).
         self.columns = self.measured_columns(ROAD_BODY, ROAD_WHEEL + tuple(SIGNALS))
+        self._sign = np.array([SIDE_SIGN[c] for c in CORNERS], dtype=float)
+        # the measurement reads the constraint rows through views taken before each call: valid
+        # while their number cannot change within it (no contacts, no limits: checked)
+        if not (m.opt.disableflags & mujoco.mjtDisableBit.mjDSBL_CONTACT) or m.jnt_limited.any() or m.tendon_limited.any():
+            raise ValueError("the road car's measurement needs a model without MuJoCo contacts or limits")
 
     def _run(self, n: int, inputs: np.ndarray) -> None:
         m, d = self.model, self.data
@@ -151,34 +158,36 @@ class RoadCar(MountedCar):
         mujoco.mj_forward(self.model, self.data)
         return float(self.data.energy.sum())
 
+    def sampled(self, samples: int, every: int, inputs: np.ndarray = _NO_INPUTS,
+                bodies: np.ndarray = np.zeros(0, np.int64)) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Advance ``samples × every`` steps, measuring after every ``every`` steps, without coming
+        back to Python: the measured vectors (samples, columns) (:attr:`columns`) and the world poses
+        of the bodies ``bodies`` (ids) (samples, bodies, 3) and (samples, bodies, 4). ``inputs``:
+        one row per step as :meth:`play` takes them, or none (held, the speed controller idle).
+        Fewer samples when MuJoCo reset the state (:meth:`was_reset`): up to the first that follows
+        the reset."""
+        inputs = np.ascontiguousarray(inputs, dtype=float)
+        if inputs.shape[0] not in (0, samples * every) or inputs.shape[1:] != _NO_INPUTS.shape[1:]:
+            raise ValueError(f"expected road inputs of shape ({samples * every}, {N_INPUTS}), got {inputs.shape}")
+        m, d = self.model, self.data
+        # the constraint rows as they are now (the brakes add or remove some between calls)
+        mujoco.mj_forward(m, d)
+        rows, efc = self.equality_rows(), (d.nefc, d.efc_pos.ctypes.data)
+        body = (d.xmat, d.xipos, d.qpos, self.chassis, self.rack_qpos, self.driver_state, m.opt.gravity,
+                SIDESLIP_MIN_SPEED_MPS)
+        wheels = (d.xmat, d.xipos, d.xpos, self.wheel_body.astype(np.int64), self.chassis, self._sign, self._design_z,
+                  self.tyre_signals)
+        probe = (body, wheels, self.suspension_data(), self.suspension_args(rows))
+        measured = np.empty((samples, self.columns.size))
+        pos, quat = np.empty((samples, bodies.size, 3)), np.empty((samples, bodies.size, 4))
+        done = self._timed(stepping.run_road_sampled, every, inputs, (m.eq_data, self.rack_eq, self.spin_dof,
+                           m.dof_frictionloss), m._address, d._address, m.opt.timestep, self.coupling.kernel_arrays(),
+                           self._tyre_args, self._driver, self.chassis, probe, bodies.astype(np.int64), d.xpos,
+                           d.xquat, measured, pos, quat, d.warning.number, RESET_WARNINGS)
+        if (d.nefc, d.efc_pos.ctypes.data) != efc:
+            raise RuntimeError("the road car's constraint rows moved: its measurement read stale memory")
+        return measured[:done], pos[:done], quat[:done]
+
     def measure(self) -> np.ndarray:
         """The car's measured vector at the current state (:attr:`columns`; ISO 8855, see the module)."""
-        m, d = self.model, self.data
-        mujoco.mj_forward(m, d)
-        mujoco.mj_rnePostConstraint(m, d)   # the bodies' accelerations (cacc)
-        rot = d.xmat[self.chassis].reshape(3, 3)
-        yaw = math.atan2(rot[1, 0], rot[0, 0])
-        pitch = -math.asin(max(-1.0, min(1.0, rot[2, 0])))
-        roll = math.atan2(rot[2, 1], rot[2, 2])
-        motion, acceleration = np.zeros(6), np.zeros(6)   # (rotational, linear), world axes, at the centre of mass
-        mujoco.mj_objectVelocity(m, d, mujoco.mjtObj.mjOBJ_BODY, self.chassis, motion, 0)
-        mujoco.mj_objectAcceleration(m, d, mujoco.mjtObj.mjOBJ_BODY, self.chassis, acceleration, 0)
-        omega, velocity = motion[:3], motion[3:]
-        accel = acceleration[3:] + m.opt.gravity   # MuJoCo's accelerations carry −g (an accelerometer's reading)
-        c, s = math.cos(yaw), math.sin(yaw)
-        vx, vy = c * velocity[0] + s * velocity[1], -s * velocity[0] + c * velocity[1]
-        body = (d.xipos[self.chassis, 0], d.xipos[self.chassis, 1], yaw, roll, pitch, vx, vy, omega[2],
-                c * accel[0] + s * accel[1], -s * accel[0] + c * accel[1],
-                math.atan2(vy, vx) if math.hypot(vx, vy) > SIDESLIP_MIN_SPEED_MPS else 0.0,
-                d.qpos[self.rack_qpos], self.driver_state[1])
-        wheels = []
-        for k, corner in enumerate(CORNERS):
-            spin_left = rot.T @ d.xmat[self.wheel_body[k]].reshape(3, 3)[:, 1]   # in the body's frame
-            toe, camber, steer = wheel_orientation(*spin_left, SIDE_SIGN[corner])
-            centre = rot.T @ (d.xipos[self.wheel_body[k]] - d.xpos[self.chassis])
-            wheels.append(np.concatenate([[camber, toe, steer, centre[2] - self._design_z[k]], self.tyre_signals[k]]))
-        v = np.empty(self.columns.size)
-        v[:self.columns.suspension_start] = np.concatenate([body, *wheels])
-        probes.suspension(v[self.columns.suspension_start:], *self.suspension_data(),
-                          *self.suspension_args(self.equality_rows()))
-        return v
+        return self.sampled(1, 0)[0][0]

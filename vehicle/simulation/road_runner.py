@@ -25,7 +25,7 @@ from vehicle.model.elements import BuildOptions
 from vehicle.scenarios.road_scenario import RoadCase, RoadScenario, steering_and_speed
 from vehicle.scenarios.schedule import ROAD_PHASES, CaseSchedule, Progress, output_interval
 from vehicle.simulation.outputs import MeasuredColumns, SampleBlock
-from vehicle.simulation.road import RoadCar
+from vehicle.simulation.road import N_INPUTS, RoadCar
 from vehicle.simulation.runner import PlayedScenario, blocks_of
 from vsim_core.units import DEG_PER_RAD
 
@@ -68,7 +68,7 @@ class RoadRun(PlayedScenario):
     def _case(self, car: RoadCar, case: RoadCase, number: int, when: CaseSchedule) -> Iterator[SampleBlock]:
         """The samples of one case from a fresh car, one every output interval, in blocks of at most
         :data:`~vehicle.simulation.runner.BLOCK_SAMPLES`."""
-        d, dt, scenario = car.data, self.dt, self.scenario
+        dt, scenario = self.dt, self.scenario
         every = output_interval(scenario, dt)
         names = tuple(ch.name for ch in car.car.channels)
         name = f"{number} '{case.label}'"
@@ -76,25 +76,17 @@ class RoadRun(PlayedScenario):
         lifted = np.zeros(len(CORNERS))
         step = 0
 
-        def measure(phase: int, samples: int, apart: int,
-                    advance: Callable[[int], tuple[float, float]]) -> Iterator[SampleBlock]:
-            """``samples`` samples, each after ``advance(k)`` has run the ``apart`` steps before sample
-            k of the block (and returned the steering-wheel angle [rad] and the target speed [m/s]
-            at their end); the block ends at the first sample after MuJoCo reset the state."""
+        def measure(phase: int, samples: int, apart: int, inputs: np.ndarray, driver: np.ndarray
+                    ) -> Iterator[SampleBlock]:
+            """``samples`` samples ``apart`` steps apart, with ``inputs`` one row per step (none: the
+            rack, drive and brakes held); ``driver`` (samples, 2): the steering-wheel angle [rad] and
+            the target speed [m/s] at each."""
             nonlocal step
-            rows, inputs = np.empty((samples, car.columns.size)), np.empty((samples, 2))
-            pos = np.empty((samples, self.recorded_bodies.size, 3))
-            quat = np.empty((samples, self.recorded_bodies.size, 4))
-            n = 0
-            while n < samples and not (n and car.was_reset()):
-                inputs[n] = advance(n)
-                rows[n] = car.measure()
-                pos[n], quat[n] = d.xpos[self.recorded_bodies], d.xquat[self.recorded_bodies]
-                n += 1
-            steps = step + apart * np.arange(1, n + 1)
+            measured, pos, quat = car.sampled(samples, apart, inputs, self.recorded_bodies)
+            steps = step + apart * np.arange(1, len(measured) + 1)   # fewer samples after a reset
             step = int(steps[-1])
-            block = SampleBlock(when.start_s + steps * dt, number, phase, (steps - input_start) * dt, inputs[:n],
-                                rows[:n], pos[:n], quat[:n])
+            block = SampleBlock(when.start_s + steps * dt, number, phase, (steps - input_start) * dt,
+                                driver[:len(measured)], measured, pos, quat)
             # at speed only: before, wheels touch down and the body's slip means nothing
             also = (lambda b: road_divergence(b, car.columns, scenario, lifted, every * dt)) if phase >= 2 else (
                 lambda b: None)
@@ -102,32 +94,26 @@ class RoadRun(PlayedScenario):
             self._report(number, case.label, phase, float(block.time_s[-1]))
 
         def hold(phase: int, speed: float) -> Iterator[SampleBlock]:
-            u = car.drive_inputs(np.zeros(every), np.full(every, speed))
-
-            def advance(_: int) -> tuple[float, float]:
-                if math.isnan(speed):
-                    car.step(every)
-                else:
-                    car.play(u)
-                return 0.0, speed
-
             for samples in blocks_of(when.steps[phase] // every):
-                yield from measure(phase, samples, every, advance)
-
-        def steer(k: int) -> tuple[float, float]:
-            t = (step + k * every - input_start + np.arange(1, every + 1)) * dt / self.duration_scale
-            steering, speed = steering_and_speed(case, t, scenario.throttle)
-            ahead = case.steering(t + car.rack_lead_s / self.duration_scale)
-            car.play(car.drive_inputs(ahead, speed))
-            return float(steering[-1]), float(speed[-1])
+                held = math.isnan(speed)   # the throttle held: no inputs, the speed controller idle
+                u = _NO_INPUTS if held else car.drive_inputs(np.zeros(samples * every), np.full(samples * every, speed))
+                yield from measure(phase, samples, every, u, np.array([[0.0, speed]] * samples))
 
         car.set_brakes(SETTLE_BRAKE_NM)
         with car.bushing_laws_off():
-            yield from measure(0, 1, 0, lambda _: (0.0, math.nan))
+            yield from measure(0, 1, 0, _NO_INPUTS, np.array([[0.0, math.nan]]))
             yield from hold(0, math.nan)
         yield from hold(1, math.nan)
         car.set_brakes(0.0)
         car.set_speed(case.speed_mps)
         yield from hold(2, case.speed_mps)
         for samples in blocks_of(when.steps[3] // every):
-            yield from measure(3, samples, every, steer)
+            t = (step - input_start + np.arange(1, samples * every + 1)) * dt / self.duration_scale
+            steering, speed = steering_and_speed(case, t, scenario.throttle)
+            ahead = case.steering(t + car.rack_lead_s / self.duration_scale)
+            at_samples = slice(every - 1, None, every)
+            yield from measure(3, samples, every, car.drive_inputs(ahead, speed),
+                               np.column_stack([steering[at_samples], speed[at_samples]]))
+
+
+_NO_INPUTS = np.zeros((0, N_INPUTS))

@@ -47,7 +47,7 @@ class DivergenceError(RuntimeError):
 
 
 #: Samples measured in one compiled call: progress, Ctrl-C and the state checks come between calls.
-BLOCK_SAMPLES = 50
+BLOCK_SAMPLES = 200
 #: The wheel quantities every mounting measures from the joints' positions (their non-finite values diverge).
 _POSE = ("camber", "toe", "steer", "travel")
 

@@ -25,7 +25,7 @@ import numpy as np
 
 from bushings import extended_bank as _xb
 from vehicle.simulation import probes
-from vehicle.simulation.probes import rig_sample, segment
+from vehicle.simulation.probes import rig_sample, road_sample, segment
 from vsim_core.compiled_cache import follow
 from vsim_tyres import road_contact
 from vsim_tyres.road_contact import tyre_wrenches
@@ -38,9 +38,15 @@ _mj_step = _LIB.mj_step
 _mj_step.argtypes = (ctypes.c_size_t, ctypes.c_size_t)  # mjModel*, mjData* as addresses
 _mj_step.restype = None
 _mj_step1, _mj_step2 = _LIB.mj_step1, _LIB.mj_step2   # positions and velocities, then forces and integration
-_mj_forward = _LIB.mj_forward
-for _f in (_mj_step1, _mj_step2, _mj_forward):
+_mj_forward, _mj_rne_post_constraint = _LIB.mj_forward, _LIB.mj_rnePostConstraint
+for _f in (_mj_step1, _mj_step2, _mj_forward, _mj_rne_post_constraint):
     _f.argtypes, _f.restype = (ctypes.c_size_t, ctypes.c_size_t), None
+# (model, data, object type, object id, result as an address, flg_local)
+_mj_object_velocity, _mj_object_acceleration = _LIB.mj_objectVelocity, _LIB.mj_objectAcceleration
+for _f in (_mj_object_velocity, _mj_object_acceleration):
+    _f.argtypes = (ctypes.c_size_t, ctypes.c_size_t, ctypes.c_int, ctypes.c_int, ctypes.c_size_t, ctypes.c_int)
+    _f.restype = None
+_BODY = int(mujoco.mjtObj.mjOBJ_BODY)
 
 
 @nb.njit(cache=True)
@@ -138,6 +144,19 @@ def run(*args) -> None:
     _run(_mj_step, *args)
 
 
+@nb.njit(cache=True)
+def _kept(s, bodies, xpos, xquat, body_pos, body_quat, warnings, resets, counts) -> bool:
+    """Copy the poses of ``bodies`` into row ``s`` of ``body_pos``, ``body_quat``; whether one of
+    MuJoCo's warning counters ``warnings[resets]`` rose from ``counts`` (MuJoCo reset the state)."""
+    for b in range(bodies.shape[0]):
+        body_pos[s, b, :] = xpos[bodies[b]]
+        body_quat[s, b, :] = xquat[bodies[b]]
+    for k in range(resets.shape[0]):
+        if warnings[resets[k]] != counts[k]:
+            return True
+    return False
+
+
 @nb.njit(cache=True, nogil=True)   # a recording's writer thread runs meanwhile (vsim_recordings.background)
 def _run_sampled(mj_step, mj_forward, every, inputs, active, rig, m_addr, d_addr, h, coupling, probe, bodies, xpos,
                  xquat, measured, body_pos, body_quat, warnings, resets):
@@ -153,12 +172,8 @@ def _run_sampled(mj_step, mj_forward, every, inputs, active, rig, m_addr, d_addr
         _run(mj_step, every, inputs[s * every:(s + 1) * every], active, *rig, m_addr, d_addr, h, *coupling)
         mj_forward(m_addr, d_addr)
         rig_sample(measured[s], *probe)
-        for b in range(bodies.shape[0]):
-            body_pos[s, b, :] = xpos[bodies[b]]
-            body_quat[s, b, :] = xquat[bodies[b]]
-        for k in range(resets.shape[0]):
-            if warnings[resets[k]] != counts[k]:
-                return s + 1
+        if _kept(s, bodies, xpos, xquat, body_pos, body_quat, warnings, resets, counts):
+            return s + 1
     return measured.shape[0]
 
 
@@ -206,6 +221,35 @@ def _run_road(mj_step1, mj_step2, n, inputs, eq_data, rack_eq, spin_dof, frictio
 def run_road(*args) -> None:
     """:func:`_run_road` with MuJoCo's ``mj_step1`` and ``mj_step2``; ``args`` from ``n``."""
     _run_road(_mj_step1, _mj_step2, *args)
+
+
+@nb.njit(cache=True, nogil=True)
+def _run_road_sampled(mj_step1, mj_step2, mj_forward, mj_rne_post_constraint, mj_object_velocity,
+                      mj_object_acceleration, every, inputs, road, m_addr, d_addr, h, coupling, tyres, driver, chassis,
+                      probe, bodies, xpos, xquat, measured, body_pos, body_quat, warnings, resets):
+    """:func:`_run_sampled` on the road: :func:`_run_road` of ``every`` steps (``road`` = its
+    arguments from ``eq_data`` to ``frictionloss``), ``mj_forward``, the bodies' accelerations
+    (``mj_rnePostConstraint``) and the velocity and acceleration of the body ``chassis``, then
+    :func:`vehicle.simulation.probes.road_sample` (``probe`` its arguments after ``acceleration``)."""
+    counts = warnings[resets].copy()
+    motion, acceleration = np.zeros(6), np.zeros(6)
+    for s in range(measured.shape[0]):
+        _run_road(mj_step1, mj_step2, every, inputs[s * every:(s + 1) * every], *road, m_addr, d_addr, h, coupling,
+                  tyres, driver)
+        mj_forward(m_addr, d_addr)
+        mj_rne_post_constraint(m_addr, d_addr)
+        mj_object_velocity(m_addr, d_addr, _BODY, chassis, motion.ctypes.data, 0)
+        mj_object_acceleration(m_addr, d_addr, _BODY, chassis, acceleration.ctypes.data, 0)
+        road_sample(measured[s], motion, acceleration, *probe)
+        if _kept(s, bodies, xpos, xquat, body_pos, body_quat, warnings, resets, counts):
+            return s + 1
+    return measured.shape[0]
+
+
+def run_road_sampled(*args) -> int:
+    """:func:`_run_road_sampled` with MuJoCo's functions; ``args`` from ``every``."""
+    return _run_road_sampled(_mj_step1, _mj_step2, _mj_forward, _mj_rne_post_constraint, _mj_object_velocity,
+                             _mj_object_acceleration, *args)
 
 
 def coupling_arrays(coupling) -> tuple:
