@@ -22,7 +22,9 @@ a constant probe force is absorbed by the stick phase, and the mapped prediction
 the rear pivot bushing came out up to 18 times too small, with the wrong sign in half of the
 channels. Full runs cost more and are right.
 
-The verdict follows :func:`vsim_diagnosis.verdict.decide` with the noise as the floor.
+The verdict follows :func:`vsim_diagnosis.verdict.decide` with the noise as the floor. Every test
+the baseline does not fit is found (the baseline fitted nothing: training tests count), with where
+in it the misfit sits; one confined to training tests makes the verdict "unexplained", not "none".
 """
 
 from __future__ import annotations
@@ -40,7 +42,7 @@ from vehicle.scenarios.scenario import Scenario
 from vsim_cluster.executor import Executor, TaskFailed, executor as open_executor
 from vsim_diagnosis.kc_catalogue import (BUSHING_CAUSES, VEHICLE_CAUSES, Hypothesis, extended_vehicle, locations,
                                          parameters)
-from vsim_diagnosis.verdict import Outcome, decide, split
+from vsim_diagnosis.verdict import Outcome, decide, misfit, misfit_stretch, split
 from vsim_recordings.kc_dataset import KCDataset
 from vsim_recordings.recorder import simulate
 
@@ -86,6 +88,7 @@ class Layout:
 
     channels: list[str]
     measured: np.ndarray          #: (N, C) in the channels' units
+    input_time: np.ndarray        #: (N,) time since its case's input started [s]
     recording: np.ndarray         #: (N,) index of the recording of each row (a rig session: one zero per channel)
     test: np.ndarray              #: (N,) index of the test of each row
     tests: list[Test]
@@ -95,7 +98,7 @@ class Layout:
         """The compared channels of a dataset, case by case, and the baseline ``vehicle``'s run of each case."""
         first = data.tests[0].run
         channels = [n for n in first.signals if n.rsplit("_", 1)[0] in COMPARED or n.rsplit("_", 2)[0] in COMPARED]
-        measured, recording, tests, start = [], [], [], 0
+        measured, times, recording, tests, start = [], [], [], [], 0
         for k, t in enumerate(data.tests):
             run, scale = t.run, float(t.run.metadata.extra.get("duration_scale", 1.0))
             phase, number = run.signals["phase"], run.signals["case"].astype(int)
@@ -103,12 +106,13 @@ class Layout:
                 on = (phase == 2) & (number == c)
                 n = int(on.sum())
                 measured.append(np.column_stack([run.signals[ch][on] for ch in channels]))
+                times.append(run.signals["input_time"][on])
                 recording.append(np.full(n, k))
                 job = Job(replace(t.scenario, cases=[case]), vehicle, scale, tuple(channels))
                 tests.append(Test(f"{t.name} case {c} ({case.label})", job, np.arange(start, start + n)))
                 start += n
         test = np.concatenate([np.full(len(t.rows), i) for i, t in enumerate(tests)])
-        return cls(channels, np.vstack(measured), np.concatenate(recording), test, tests)
+        return cls(channels, np.vstack(measured), np.concatenate(times), np.concatenate(recording), test, tests)
 
     def jobs(self, vehicle: VehicleDefinition, tests: Sequence[int]) -> list[Job]:
         """The runs of ``tests`` (indices) on ``vehicle``."""
@@ -152,6 +156,19 @@ class Candidate:
         return self.penalised(self.heldout_error if self.verified else self.screened_error)
 
 
+@dataclass(frozen=True)
+class Misfit:
+    """A test the baseline does not fit, and where in it (:func:`vsim_diagnosis.verdict.misfit_stretch`)."""
+
+    test: str
+    heldout: bool
+    error: float          #: the baseline's RMS error on it (1 = the noise)
+    chance: float         #: the chance that the noise alone shows a stretch as unlikely in the test
+    start_s: float        #: the stretch of the test holding the excess: from, to [s of its input]
+    end_s: float
+    channel: str          #: the channel with the most excess there
+
+
 @dataclass
 class KCDiagnosis(Outcome):
     """The outcome of :func:`diagnose_kc`."""
@@ -167,6 +184,7 @@ class KCDiagnosis(Outcome):
     noise: np.ndarray                #: per channel, estimated noise standard deviation (channel units)
     baseline: np.ndarray             #: the baseline's rows
     extended: VehicleDefinition | None   #: the baseline with the named cause
+    misfits: list[Misfit] = field(default_factory=list)   #: the tests the baseline does not fit
     wall_s: float = 0.0
 
     @property
@@ -200,6 +218,16 @@ class _Scorer:
         rec = self.layout.recording[rows]
         for k in np.unique(rec):
             r[rec == k] -= r[rec == k].mean(axis=0)
+        return r / self.noise
+
+    def robust_residual(self, predicted: np.ndarray) -> np.ndarray:
+        """(measured − predicted) / noise on every row, each channel's median in each recording
+        removed: a misfit confined to a stretch does not shift the zero of the rest of its recording,
+        as the mean would (the fits keep the mean, in which the residual stays affine)."""
+        r = self.layout.measured - predicted
+        rec = self.layout.recording
+        for k in np.unique(rec):
+            r[rec == k] -= np.median(r[rec == k], axis=0)
         return r / self.noise
 
     def test_errors(self, predicted: np.ndarray) -> np.ndarray:
@@ -348,12 +376,31 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, executor: Execut
         _verify(refit, rows([extended_vehicle(vehicle, [c.hypothesis]) for c in refit], every), scorer)
         top = sorted((min(a, b, key=lambda c: c.score) for a, b in zip(top, refit)), key=lambda c: c.score)
     best = top[0]
-    verdict = decide(before, best.heldout_error, 1.0)
+    errors = scorer.test_errors(base)
+    found = located_misfits(layout, scorer, base, errors)
+    for m in found:
+        say(f"the baseline does not fit {m.test}{' (held out)' if m.heldout else ''}: {m.error:.2f} × the noise, "
+            f"most between {m.start_s:.2f} and {m.end_s:.2f} s of its input, in {m.channel}")
+    verdict = decide(before, best.heldout_error, 1.0, any(not m.heldout for m in found))
     say(f"{best.hypothesis.label}: held-out error {before:.3f} -> {best.heldout_error:.3f}: {verdict}")
     return KCDiagnosis(best.hypothesis.cause if verdict == "named" else verdict, best, top + screened[VERIFIED:],
-                       heldout, [t.name for t in layout.tests], scorer.test_errors(base), before, layout, scorer.noise,
-                       base, extended_vehicle(vehicle, [best.hypothesis]) if verdict == "named" else None,
+                       heldout, [t.name for t in layout.tests], errors, before, layout, scorer.noise,
+                       base, extended_vehicle(vehicle, [best.hypothesis]) if verdict == "named" else None, found,
                        time.perf_counter() - started)
+
+
+def located_misfits(layout: Layout, scorer: _Scorer, predicted: np.ndarray, errors: np.ndarray) -> list[Misfit]:
+    """The tests ``predicted`` does not fit (:func:`vsim_diagnosis.verdict.misfit`: its per-test
+    ``errors`` or a stretch beyond the noise; every test, training or held out), each with where."""
+    residual = scorer.robust_residual(predicted)
+    out = []
+    for i, t in enumerate(layout.tests):
+        chance, first, last, channel = misfit_stretch(residual[t.rows])
+        if misfit(float(errors[i]), chance):
+            out.append(Misfit(t.name, bool(scorer.heldout[i]), float(errors[i]), chance,
+                              float(layout.input_time[t.rows[first]]), float(layout.input_time[t.rows[last]]),
+                              layout.channels[channel]))
+    return out
 
 
 def _verify(candidates: list[Candidate], simulated: list[np.ndarray], scorer: _Scorer) -> None:

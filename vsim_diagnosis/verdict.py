@@ -1,12 +1,14 @@
-"""What both diagnoses decide alike: which tests are held out from the fits, and, from the held-out
-error before and after the best cause and the noise floor, whether the cause is named, nothing
-significant is missing, or the mismatch is real but unexplained."""
+"""What both diagnoses decide alike: which tests are held out from the fits, which tests the baseline
+does not fit (any test: the baseline fitted nothing), and, from the held-out error before and after
+the best cause, the noise floor and those misfits, whether the cause is named, nothing significant
+is missing, or the mismatch is real but unexplained."""
 
 from __future__ import annotations
 
 import math
 
 import numpy as np
+from scipy.special import gammaincc
 
 #: Relative held-out error reduction below which a cause explains nothing significant.
 MIN_GAIN = 0.10
@@ -35,11 +37,52 @@ class Outcome:
         return self.verdict not in NOT_NAMED
 
 
-def decide(before: float, after: float, floor: float) -> str:
+#: A stretch of a test is misfit when, in one channel, its mean squared residual is at least
+#: NOISE_FACTOR² (in units of the noise) and the chance that the noise alone shows such a stretch
+#: somewhere in the test is below this (χ² with as many degrees as samples in the window, times the
+#: test's independent windows: a scan over every window and channel).
+MISFIT_CHANCE = 1e-6
+
+
+def misfit_stretch(residual: np.ndarray) -> tuple[float, int, int, int]:
+    """The least likely stretch of a test's ``residual`` under its noise (rows: samples in order;
+    columns: channels; in units of their noise): (the chance that noise alone shows one as unlikely
+    somewhere in the test, first row, last row, channel). Windows of a twentieth of the test (at
+    least 10 samples) are scanned in every channel; the stretch is where the best window's channel
+    stays above half its peak."""
+    n, channels = residual.shape
+    width = min(n, max(10, n // 20))
+    squares = np.vstack([np.zeros((1, channels)), np.cumsum(residual ** 2, axis=0)])
+    mean = (squares[width:] - squares[:-width]) / width                     # (windows, channels)
+    # the chance of a mean of `width` unit-variance squares at least this large (χ²), where it matters
+    tail = np.where(mean >= NOISE_FACTOR ** 2, gammaincc(0.5 * width, 0.5 * width * mean), 1.0)
+    k, channel = np.unravel_index(int(np.argmin(tail)), tail.shape)
+    chance = min(1.0, float(tail[k, channel]) * channels * n / width)
+    if chance >= 1.0:
+        return 1.0, 0, n - 1, int(channel)
+    above = mean[:, channel] >= 0.5 * mean[k, channel]
+    first, last = k, k
+    while first > 0 and above[first - 1]:
+        first -= 1
+    while last < len(above) - 1 and above[last + 1]:
+        last += 1
+    return chance, int(first), int(min(last + width - 1, n - 1)), int(channel)
+
+
+def misfit(error: float, chance: float, floor: float = 1.0) -> bool:
+    """Whether the baseline does not fit a test: its whole error beyond NOISE_FACTOR times the noise
+    ``floor`` (the criterion the held-out set passes or fails as a whole), or a stretch of it the
+    noise alone would show with a ``chance`` below MISFIT_CHANCE (:func:`misfit_stretch`)."""
+    return error > NOISE_FACTOR * floor or chance < MISFIT_CHANCE
+
+
+def decide(before: float, after: float, floor: float, misfit_elsewhere: bool = False) -> str:
     """``named``, ``none`` or ``unexplained`` from held-out errors before and after the best cause
-    and the noise floor (all relative RMS)."""
+    and the noise floor (all relative RMS); ``misfit_elsewhere``: the baseline does not fit some
+    training test (:func:`misfit`), which the held-out tests cannot judge a cause on: then a
+    baseline that fits the held-out tests is not "none" but "unexplained" (a local misfit)."""
     excess_before = math.sqrt(max(before ** 2 - floor ** 2, 0.0))
     excess_after = math.sqrt(max(after ** 2 - floor ** 2, 0.0))
     if after <= before * (1.0 - MIN_GAIN) and excess_after <= MAX_EXCESS_LEFT * excess_before:
         return "named"
-    return "none" if before <= NOISE_FACTOR * floor else "unexplained"
+    return "none" if before <= NOISE_FACTOR * floor and not misfit_elsewhere else "unexplained"

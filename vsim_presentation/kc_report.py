@@ -4,6 +4,7 @@ static load, and the ranking with its evidence."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Any
 
@@ -14,6 +15,7 @@ from vehicle.model.definition import VehicleDefinition
 from vsim_core.files import atomic_output
 from vsim_diagnosis.kc_catalogue import extended_vehicle_yaml, parameters
 from vsim_diagnosis.kc_diagnosis import KCDiagnosis
+from vsim_diagnosis.verdict import MISFIT_CHANCE, NOISE_FACTOR
 from vsim_presentation.diagnosis_report import Report, ranking_chart
 from vsim_presentation.figures import save_figure
 
@@ -45,11 +47,20 @@ def summary(d: KCDiagnosis) -> dict[str, Any]:
                      "heldout_error": c.heldout_error if c.verified else None, "training_error": c.screened_error,
                      "score": c.score, "n_parameters": len(parameters(c.hypothesis.cause)),
                      "parameters": dict(c.hypothesis.values)} for c in d.ranking],
-        "tests": [{"name": n, "heldout": bool(h), "error_before": float(b), "error_after": float(a)}
+        "tests": [{"name": n, "heldout": bool(h), "error_before": float(b), "error_after": float(a),
+                   "excess_before": excess(float(b))}
                   for n, h, b, a in zip(d.test_names, d.heldout, d.baseline_errors, after)],
+        "misfits": [{"test": m.test, "heldout": m.heldout, "error": m.error, "excess": excess(m.error),
+                     "noise_chance": m.chance, "start_s": m.start_s, "end_s": m.end_s, "channel": m.channel}
+                    for m in d.misfits],
         "noise": {c: float(s) for c, s in zip(d.layout.channels, d.noise)},
         "wall_s": d.wall_s,
     }
+
+
+def excess(error: float) -> float:
+    """The model error in excess of the noise, from an error in units of the noise (1: perfect)."""
+    return math.sqrt(max(error ** 2 - 1.0, 0.0))
 
 
 def _where(d: KCDiagnosis) -> str:
@@ -64,6 +75,12 @@ def verdict_sentence(d: KCDiagnosis) -> str:
         return (f"Nothing significant is missing: the baseline's held-out error ({before:.2f} × the measurement "
                 f"noise) is at the noise or no cause of the catalogue reduces it.")
     best = d.ranking[0]
+    if d.verdict == "unexplained" and before <= NOISE_FACTOR and d.misfits:
+        worst = max(d.misfits, key=lambda m: m.error)
+        return (f"A local misfit: the baseline fits the held-out tests ({before:.2f} × the noise) but not "
+                f"{len(d.misfits)} training test{'s' if len(d.misfits) > 1 else ''}, worst {worst.test} "
+                f"({worst.error:.2f} × the noise, most between {worst.start_s:.2f} and {worst.end_s:.2f} s of its "
+                f"input, in {worst.channel}); no catalogue cause can be judged on it.")
     if d.verdict == "unexplained":
         return (f"The mismatch is real ({before:.2f} × the noise on held-out tests) but no catalogue cause explains "
                 f"it; the best, {best.hypothesis.label}, only brings it to {best.heldout_error:.2f}.")
@@ -156,9 +173,18 @@ def write_report(d: KCDiagnosis, baseline: VehicleDefinition, out_dir: Path, dat
                      ", ".join(f"{k} = {v:.4g}" for k, v in c.hypothesis.values.items())) for c in d.ranking[:12]])
     report.picture("ranking.png")
     report.section("Tests")
-    report.table(("test", "held out", "error before", "error after"),
-                 [(t["name"], "yes" if t["heldout"] else "", f"{t['error_before']:.3f}", f"{t['error_after']:.3f}")
-                  for t in result["tests"]])
+    report.paragraph("Every test is checked, training ones included (the baseline fitted nothing): a test is "
+                     f"misfit when the baseline's error on it exceeds {NOISE_FACTOR:g} × the noise, or when one "
+                     f"channel over a stretch of it departs more than the noise would with a chance of "
+                     f"{MISFIT_CHANCE:g} anywhere in the test.")
+    report.table(("test", "held out", "error before", "excess over noise", "error after"),
+                 [(t["name"], "yes" if t["heldout"] else "", f"{t['error_before']:.3f}", f"{t['excess_before']:.3f}",
+                   f"{t['error_after']:.3f}") for t in result["tests"]])
+    if d.misfits:
+        report.section("Tests the baseline does not fit")
+        report.table(("test", "held out", "error", "chance from noise", "where (s of its input)", "worst channel"),
+                     [(m.test, "yes" if m.heldout else "", f"{m.error:.3f}", f"{m.chance:.1e}",
+                       f"{m.start_s:.2f} – {m.end_s:.2f}", m.channel) for m in d.misfits])
     report.section("Channels with the largest mismatch (held-out test with the largest baseline error)")
     report.picture("overlays.png")
     report.section("Error against amplitude and static load")

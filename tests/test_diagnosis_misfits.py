@@ -1,0 +1,98 @@
+"""Detection on every test the baseline did not fit (issue 29): a misfit confined to one test and
+one stretch of it, drawn at random from seeds (test, stretch, channel, size, shape) over white
+noise with per-recording zero errors, is found in its test, located in its stretch and channel, and
+turns a held-out "none" into "unexplained"; noise alone is never called a misfit."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from vehicle.scenarios.scenario import Scenario
+from vsim_diagnosis import kc_diagnosis
+from vsim_diagnosis.kc_diagnosis import Job, Layout, _Scorer, located_misfits
+from scipy.special import gammaincc
+
+from vsim_diagnosis.verdict import MISFIT_CHANCE, NOISE_FACTOR, decide, misfit, misfit_stretch, split
+
+CHANNELS = [f"camber_{t}" for t in ("fl", "fr", "rl", "rr")] + [f"toe_{t}" for t in ("fl", "fr", "rl", "rr")]
+
+
+def synthetic(rng: np.random.Generator, bump: bool) -> tuple[Layout, np.ndarray, tuple[int, int, int, int] | None]:
+    """A layout of 5 to 9 tests of 150 to 600 samples, its measurements = the baseline + noise
+    (drawn per kind of channel) + a zero error per recording; with ``bump``, a smooth misfit
+    (a raised cosine or a ramp, 3 to 8 noise deep) in one channel over a tenth to a third of one
+    test. Returns the layout, the baseline rows and (test, first row, last row, channel) of the bump."""
+    n_tests = int(rng.integers(5, 10))
+    lengths = rng.integers(150, 601, n_tests)
+    sigma = np.repeat(rng.uniform(0.5, 2.0, 2), 4)   # one noise per kind of sensor (camber, toe), as on a rig
+    tests, start = [], 0
+    dummy = Job(Scenario.__new__(Scenario), None, 1.0, tuple(CHANNELS))
+    for i, n in enumerate(lengths):
+        tests.append(kc_diagnosis.Test(f"test {i}", dummy, np.arange(start, start + n)))
+        start += n
+    baseline = np.cumsum(rng.normal(0.0, 0.05, (start, len(CHANNELS))), axis=0)   # any smooth prediction
+    recording = np.concatenate([np.full(n, i // 2) for i, n in enumerate(lengths)])
+    zeros = rng.uniform(-3.0, 3.0, (recording.max() + 1, len(CHANNELS)))
+    measured = baseline + rng.normal(0.0, 1.0, baseline.shape) * sigma + zeros[recording]
+    truth = None
+    if bump:
+        t = int(rng.integers(n_tests))
+        n = int(lengths[t])
+        span = int(rng.integers(n // 10, n // 3))
+        first = int(rng.integers(0, n - span))
+        channel = int(rng.integers(len(CHANNELS)))
+        x = np.linspace(0.0, 1.0, span)
+        shape = 0.5 * (1.0 - np.cos(2 * np.pi * x)) if rng.random() < 0.5 else np.minimum(x / 0.3, 1.0)
+        depth = rng.uniform(3.0, 8.0) * rng.choice([-1.0, 1.0])
+        measured[tests[t].rows[first:first + span], channel] += depth * sigma[channel] * shape
+        truth = (t, first, first + span - 1, channel)
+    test = np.concatenate([np.full(n, i) for i, n in enumerate(lengths)])
+    times = np.concatenate([np.arange(n) * 0.02 for n in lengths])
+    return Layout(CHANNELS, measured, times, recording, test, tests), baseline, truth
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_a_local_misfit_is_found_in_its_test_stretch_and_channel(seed: int) -> None:
+    layout, baseline, (t, first, last, channel) = synthetic(np.random.default_rng(seed), bump=True)
+    heldout = split(len(layout.tests))
+    scorer = _Scorer(layout, baseline, heldout)
+    errors = scorer.test_errors(baseline)
+    found = located_misfits(layout, scorer, baseline, errors)
+    assert [m.test for m in found] == [f"test {t}"], errors
+    m = found[0]
+    assert m.heldout == bool(heldout[t]) and m.error == pytest.approx(errors[t]) and m.chance < MISFIT_CHANCE
+    assert m.channel == CHANNELS[channel]
+    times = layout.input_time[layout.tests[t].rows]
+    # the located stretch lies on the bump, give or take the scan's window, and covers most of it
+    window = max(10, len(times) // 20) * 0.02
+    assert times[first] - window <= m.start_s and m.end_s <= times[last] + window, (m, times[first], times[last])
+    assert m.end_s - m.start_s >= 0.4 * (times[last] - times[first])
+    # a misfit on a training test only: the held-out tests cannot judge a cause, the verdict is not "none"
+    before = scorer.heldout_error(baseline)
+    assert decide(before, before, 1.0, misfit_elsewhere=not m.heldout) == ("unexplained" if not m.heldout or
+                                                                           before > NOISE_FACTOR else "none")
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_noise_alone_is_never_a_misfit(seed: int) -> None:
+    layout, baseline, _ = synthetic(np.random.default_rng(1000 + seed), bump=False)
+    scorer = _Scorer(layout, baseline, split(len(layout.tests)))
+    errors = scorer.test_errors(baseline)
+    residual = scorer.robust_residual(baseline)
+    for t, e in zip(layout.tests, errors):
+        chance = misfit_stretch(residual[t.rows])[0]
+        assert not misfit(float(e), chance), (e, chance)
+    assert errors.max() < 1.2   # far below the threshold: the noise is estimated right
+    assert not located_misfits(layout, scorer, baseline, errors)
+
+
+def test_the_stretch_of_a_lone_offset() -> None:
+    """Closed case: unit noise-level residual everywhere (no excess) but 4 noise over rows 200-299
+    of 1000 in channel 2: found there, with the χ² chance of a window of w = 50 samples all at 4
+    (mean square 16), times the 4 channels × 1000 / 50 windows scanned."""
+    r = np.ones((1000, 4))
+    r[200:300, 2] = 4.0
+    chance, first, last, channel = misfit_stretch(r)
+    assert channel == 2 and 170 <= first <= 210 and 290 <= last <= 330
+    assert chance == pytest.approx(gammaincc(25.0, 25.0 * 16.0) * 4 * 1000 / 50, rel=1e-9)
