@@ -27,6 +27,9 @@ SEEDS = [int(os.environ.get("VSIM_TEST_SEED", "1"))]
 def _check_named(result: dict, cause: str, effects: list[dict]) -> None:
     assert result["cause"] == cause, result["ranking"][:3]
     assert result["heldout_error_after"] <= 0.5 * result["heldout_error_before"]
+    # one cause hidden: the verdict lists it alone; it explains at least the 75 % its error halving implies
+    assert [c["cause"] for c in result["causes"]] == [cause] and result["explained"] in ("full", "partial")
+    assert result["share_explained"] >= 0.75 - 1e-9 or result["heldout_error_after"] <= result["noise_floor"]
     truth = effects[0]
     for name, fitted in result["parameters"].items():
         # The fitted magnitude is the hidden one, within 4 standard uncertainties or 25 % (the
@@ -53,7 +56,7 @@ def test_noise_alone_names_no_cause(tmp_path, seed):
     baseline, _, measured = measure(tmp_path, "none", seed)
     result = diagnose_fresh(measured, baseline)
     assert result["cause"] == "none", result["ranking"][:3]
-    assert result["location"] is None
+    assert result["location"] is None and result["causes"] == [] and result["explained"] == "full"
 
 
 def test_backlash_outside_the_catalogue_is_unexplained(tmp_path):

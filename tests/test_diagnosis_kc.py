@@ -236,11 +236,14 @@ def _excess(error: float) -> float:
 def check(result: dict, h: Hypothesis | None) -> None:
     if h is None:
         assert result["cause"] == "none", result["ranking"][:3]
+        assert result["causes"] == [] and result["explained"] == "full" and result["misfits"] == []
         return
     if h.cause == "backlash":
         assert result["cause"] == "unexplained", result["ranking"][:3]
+        assert result["explained"] == "none"
         return
     assert result["cause"] == h.cause, result["ranking"][:3]
+    assert [c["cause"] for c in result["causes"]] == [h.cause] and result["explained"] in ("full", "partial")
     assert result["location"] == h.location_json()
     assert _excess(result["heldout_error_after"]) <= 0.5 * _excess(result["heldout_error_before"])
     first = parameters(h.cause)[0]

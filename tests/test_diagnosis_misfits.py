@@ -13,7 +13,7 @@ from vsim_diagnosis import kc_diagnosis
 from vsim_diagnosis.kc_diagnosis import Job, Layout, _Scorer, located_misfits
 from scipy.special import gammaincc
 
-from vsim_diagnosis.verdict import MISFIT_CHANCE, NOISE_FACTOR, decide, misfit, misfit_stretch, split
+from vsim_diagnosis.verdict import MISFIT_CHANCE, NOISE_FACTOR, decide, explained, misfit, misfit_stretch, split
 
 CHANNELS = [f"camber_{t}" for t in ("fl", "fr", "rl", "rr")] + [f"toe_{t}" for t in ("fl", "fr", "rl", "rr")]
 
@@ -96,3 +96,17 @@ def test_the_stretch_of_a_lone_offset() -> None:
     chance, first, last, channel = misfit_stretch(r)
     assert channel == 2 and 170 <= first <= 210 and 290 <= last <= 330
     assert chance == pytest.approx(gammaincc(25.0, 25.0 * 16.0) * 4 * 1000 / 50, rel=1e-9)
+
+
+def test_how_much_a_verdict_explains() -> None:
+    """The share is the excess variance over the noise removed: 3 → 1.2 × the noise removes
+    1 − (1.2² − 1)/(3² − 1) = 94.5 %, fully (1.2 is within the noise factor); 3 → 2 removes
+    1 − 3/8 = 62.5 %, partly; a test left misfit makes it partial too."""
+    assert explained("none", 1.1, 1.1, 1.0) == ("full", 1.0)
+    assert explained("unexplained", 3.0, 2.9, 1.0) == ("none", 0.0)
+    how, share = explained("mullins", 3.0, 1.2, 1.0)
+    assert how == "full" and share == pytest.approx(1.0 - 0.44 / 8.0)
+    how, share = explained("mullins", 3.0, 2.0, 1.0)
+    assert how == "partial" and share == pytest.approx(0.625)
+    assert explained("mullins", 3.0, 1.2, 1.0, misfit_left=True)[0] == "partial"
+    assert explained("mullins", 0.03, 0.012, 0.01)[1] == pytest.approx(1.0 - 0.44 / 8.0)   # relative errors alike

@@ -24,7 +24,7 @@ from scipy.optimize import least_squares
 from bushings.extended_bank import ExtendedBank
 from bushings.parameter_sets import ParameterSet
 from vsim_diagnosis.catalogue import Cause, applicable
-from vsim_diagnosis.verdict import Outcome, decide, split
+from vsim_diagnosis.verdict import Outcome, decide, explained, split
 from vsim_recordings.bench_dataset import BenchDataset
 
 #: Penalty per fitted parameter on the held-out error used for ranking.
@@ -152,6 +152,13 @@ class BenchDiagnosis(Outcome):
     def heldout_error_after(self) -> float:
         """The held-out error with the best cause (the baseline's when nothing is missing)."""
         return self.best.heldout_error if self.best is not None and self.verdict != "none" else self.heldout_error_before
+
+    @property
+    def explained(self) -> tuple[str, float]:
+        """``full``, ``partial`` or ``none``, and the share of the excess over the noise explained
+        (:func:`vsim_diagnosis.verdict.explained`; the tests judged together)."""
+        return explained(self.verdict, self.heldout_error_before, self.heldout_error_after,
+                         aggregate(self.noise, self.heldout))
 
 
 class _Objective:

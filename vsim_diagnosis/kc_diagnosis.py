@@ -42,7 +42,7 @@ from vehicle.scenarios.scenario import Scenario
 from vsim_cluster.executor import Executor, TaskFailed, executor as open_executor
 from vsim_diagnosis.kc_catalogue import (BUSHING_CAUSES, VEHICLE_CAUSES, Hypothesis, extended_vehicle, locations,
                                          parameters)
-from vsim_diagnosis.verdict import Outcome, decide, misfit, misfit_stretch, split
+from vsim_diagnosis.verdict import Outcome, decide, explained, misfit, misfit_stretch, split
 from vsim_recordings.kc_dataset import KCDataset
 from vsim_recordings.recorder import simulate
 
@@ -185,7 +185,15 @@ class KCDiagnosis(Outcome):
     baseline: np.ndarray             #: the baseline's rows
     extended: VehicleDefinition | None   #: the baseline with the named cause
     misfits: list[Misfit] = field(default_factory=list)   #: the tests the baseline does not fit
+    misfits_after: list[Misfit] = field(default_factory=list)   #: those the named cause does not fit
     wall_s: float = 0.0
+
+    @property
+    def explained(self) -> tuple[str, float]:
+        """``full``, ``partial`` or ``none``, and the share of the excess over the noise explained
+        (:func:`vsim_diagnosis.verdict.explained`)."""
+        return explained(self.verdict, self.heldout_error_before, self.heldout_error_after, 1.0,
+                         bool(self.misfits_after))
 
     @property
     def heldout_error_after(self) -> float:
@@ -383,10 +391,13 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, executor: Execut
             f"most between {m.start_s:.2f} and {m.end_s:.2f} s of its input, in {m.channel}")
     verdict = decide(before, best.heldout_error, 1.0, any(not m.heldout for m in found))
     say(f"{best.hypothesis.label}: held-out error {before:.3f} -> {best.heldout_error:.3f}: {verdict}")
+    left = located_misfits(layout, scorer, best.simulated, best.test_errors) if verdict == "named" else []
+    for m in left:
+        say(f"  with it, {m.test} is still not fitted: {m.error:.2f} × the noise")
     return KCDiagnosis(best.hypothesis.cause if verdict == "named" else verdict, best, top + screened[VERIFIED:],
                        heldout, [t.name for t in layout.tests], errors, before, layout, scorer.noise,
                        base, extended_vehicle(vehicle, [best.hypothesis]) if verdict == "named" else None, found,
-                       time.perf_counter() - started)
+                       left, time.perf_counter() - started)
 
 
 def located_misfits(layout: Layout, scorer: _Scorer, predicted: np.ndarray, errors: np.ndarray) -> list[Misfit]:

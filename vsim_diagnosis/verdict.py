@@ -76,6 +76,23 @@ def misfit(error: float, chance: float, floor: float = 1.0) -> bool:
     return error > NOISE_FACTOR * floor or chance < MISFIT_CHANCE
 
 
+def explained(verdict: str, before: float, after: float, floor: float, misfit_left: bool = False
+              ) -> tuple[str, float]:
+    """How much of the mismatch a verdict explains: ``full``, ``partial`` or ``none``, and the share
+    of the baseline's excess over the noise (in variance, on the held-out tests) that the named
+    cause removes: 1 − excess_after² / excess_before². A named cause explains partly when the
+    held-out error it leaves is beyond NOISE_FACTOR times the noise ``floor`` or ``misfit_left``
+    (a test it still does not fit); "none" (nothing missing) is fully explained by the baseline,
+    "unexplained" not at all."""
+    if verdict == "none":
+        return "full", 1.0
+    if verdict == "unexplained":
+        return "none", 0.0
+    excess_before = before ** 2 - floor ** 2
+    share = 1.0 - max(after ** 2 - floor ** 2, 0.0) / excess_before if excess_before > 0.0 else 1.0
+    return ("partial" if after > NOISE_FACTOR * floor or misfit_left else "full"), share
+
+
 def decide(before: float, after: float, floor: float, misfit_elsewhere: bool = False) -> str:
     """``named``, ``none`` or ``unexplained`` from held-out errors before and after the best cause
     and the noise floor (all relative RMS); ``misfit_elsewhere``: the baseline does not fit some

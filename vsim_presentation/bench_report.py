@@ -15,7 +15,7 @@ from bushings.parameter_sets import save_parameter_set
 from vsim_diagnosis.bench_diagnosis import BenchDiagnosis, aggregate
 from vsim_diagnosis.verdict import MIN_GAIN
 from vsim_core.units import MM_PER_M
-from vsim_presentation.diagnosis_report import Report, ranking_chart
+from vsim_presentation.diagnosis_report import Report, partly_explained, ranking_chart
 from vsim_presentation.figures import save_figure
 
 #: Held-out records overlaid in the report (the largest baseline errors first).
@@ -54,6 +54,10 @@ def summary(d: BenchDiagnosis) -> dict[str, Any]:
         "noise_floor": aggregate(d.noise, d.heldout),
         "ranking": [{"cause": c.cause.id, "heldout_error": c.heldout_error, "score": c.score,
                      "n_parameters": len(c.cause.parameters), "parameters": c.values} for c in d.ranking],
+        "explained": d.explained[0],
+        "share_explained": d.explained[1],
+        "causes": [{"cause": d.verdict, "location": {"level": "bench", "part": d.part}, "parameters": _parameters(d),
+                    "share_explained": d.explained[1]}] if d.named else [],
         "tests": [{"name": n, "heldout": bool(h), "error_before": float(b),
                    "error_after": float(d.best.record_errors[k]) if d.named else float(b)}
                   for k, (n, h, b) in enumerate(zip(d.replay.names, d.heldout, d.baseline_errors))],
@@ -73,8 +77,11 @@ def verdict_sentence(d: BenchDiagnosis) -> str:
         partial = f"; the best catalogue cause, {best.cause.id}, only brings it to {best.heldout_error:.2%}" if best else ""
         return f"The mismatch is real ({before:.2%} held-out error) but no catalogue cause explains it{partial}."
     values = ", ".join(f"{k} = {v['value']:.4g} ± {v['std']:.2g} {v['unit']}" for k, v in _parameters(d).items())
-    return (f"Cause: **{d.verdict}** ({values}); held-out error {before:.2%} → {after:.2%} "
-            f"of the force range.")
+    sentence = f"Cause: **{d.verdict}** ({values}); held-out error {before:.2%} → {after:.2%} of the force range."
+    how, share = d.explained
+    if how == "partial":
+        sentence += partly_explained(share)
+    return sentence
 
 
 def write_extended_model(d: BenchDiagnosis, path: Path) -> Path | None:

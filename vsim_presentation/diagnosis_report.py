@@ -69,3 +69,11 @@ def ranking_chart(baseline: float, causes: Sequence[tuple[str, float]], floor: t
     ax.set_xlabel(xlabel)
     ax.legend(fontsize=7)
     return save_figure(fig, out)
+
+
+def partly_explained(share: float, left: str = "") -> str:
+    """The sentence that follows a cause that explains the mismatch only partly (``share`` of its
+    excess over the noise); ``left`` names what it still does not fit."""
+    still = f"; still not fitted: {left}" if left else ""
+    return (f" Partly explained: it removes {share:.0%} of the mismatch beyond the noise, and what it leaves is "
+            f"still significant{still}.")

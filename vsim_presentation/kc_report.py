@@ -14,9 +14,9 @@ from matplotlib.figure import Figure
 from vehicle.model.definition import VehicleDefinition
 from vsim_core.files import atomic_output
 from vsim_diagnosis.kc_catalogue import extended_vehicle_yaml, parameters
-from vsim_diagnosis.kc_diagnosis import KCDiagnosis
+from vsim_diagnosis.kc_diagnosis import KCDiagnosis, Misfit
 from vsim_diagnosis.verdict import MISFIT_CHANCE, NOISE_FACTOR
-from vsim_presentation.diagnosis_report import Report, ranking_chart
+from vsim_presentation.diagnosis_report import Report, partly_explained, ranking_chart
 from vsim_presentation.figures import save_figure
 
 #: Channels overlaid in the report (the largest baseline mismatch on held-out tests first).
@@ -50,12 +50,20 @@ def summary(d: KCDiagnosis) -> dict[str, Any]:
         "tests": [{"name": n, "heldout": bool(h), "error_before": float(b), "error_after": float(a),
                    "excess_before": excess(float(b))}
                   for n, h, b, a in zip(d.test_names, d.heldout, d.baseline_errors, after)],
-        "misfits": [{"test": m.test, "heldout": m.heldout, "error": m.error, "excess": excess(m.error),
-                     "noise_chance": m.chance, "start_s": m.start_s, "end_s": m.end_s, "channel": m.channel}
-                    for m in d.misfits],
+        "explained": d.explained[0],
+        "share_explained": d.explained[1],
+        "causes": [{"cause": d.verdict, "location": d.best.hypothesis.location_json(), "parameters": _parameters(d),
+                    "share_explained": d.explained[1]}] if d.named else [],
+        "misfits": [_misfit(m) for m in d.misfits],
+        "misfits_after": [_misfit(m) for m in d.misfits_after],
         "noise": {c: float(s) for c, s in zip(d.layout.channels, d.noise)},
         "wall_s": d.wall_s,
     }
+
+
+def _misfit(m: Misfit) -> dict[str, Any]:
+    return {"test": m.test, "heldout": m.heldout, "error": m.error, "excess": excess(m.error),
+            "noise_chance": m.chance, "start_s": m.start_s, "end_s": m.end_s, "channel": m.channel}
 
 
 def excess(error: float) -> float:
@@ -86,8 +94,12 @@ def verdict_sentence(d: KCDiagnosis) -> str:
                 f"it; the best, {best.hypothesis.label}, only brings it to {best.heldout_error:.2f}.")
     values = ", ".join(f"{k} = {v['value']:.4g} ± {v['std']:.2g} {v['unit']}" if v["fitted"] else
                        f"{k} = {v['value']:.4g} {v['unit']} (held at mid-range)" for k, v in _parameters(d).items())
-    return (f"Cause: **{d.verdict}** at {_where(d)} ({values}); held-out error {before:.2f} → {after:.2f} "
-            f"× the measurement noise.")
+    sentence = (f"Cause: **{d.verdict}** at {_where(d)} ({values}); held-out error {before:.2f} → {after:.2f} "
+                f"× the measurement noise.")
+    how, share = d.explained
+    if how == "partial":
+        sentence += partly_explained(share, ", ".join(m.test for m in d.misfits_after))
+    return sentence
 
 
 def _test_features(d: KCDiagnosis, measured: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -180,11 +192,13 @@ def write_report(d: KCDiagnosis, baseline: VehicleDefinition, out_dir: Path, dat
     report.table(("test", "held out", "error before", "excess over noise", "error after"),
                  [(t["name"], "yes" if t["heldout"] else "", f"{t['error_before']:.3f}", f"{t['excess_before']:.3f}",
                    f"{t['error_after']:.3f}") for t in result["tests"]])
-    if d.misfits:
-        report.section("Tests the baseline does not fit")
-        report.table(("test", "held out", "error", "chance from noise", "where (s of its input)", "worst channel"),
-                     [(m.test, "yes" if m.heldout else "", f"{m.error:.3f}", f"{m.chance:.1e}",
-                       f"{m.start_s:.2f} – {m.end_s:.2f}", m.channel) for m in d.misfits])
+    for title, misfits in ((f"Tests {d.verdict} does not fit either", d.misfits_after),
+                           ("Tests the baseline does not fit", d.misfits)):
+        if misfits:
+            report.section(title)
+            report.table(("test", "held out", "error", "chance from noise", "where (s of its input)", "worst channel"),
+                         [(m.test, "yes" if m.heldout else "", f"{m.error:.3f}", f"{m.chance:.1e}",
+                           f"{m.start_s:.2f} – {m.end_s:.2f}", m.channel) for m in misfits])
     report.section("Channels with the largest mismatch (held-out test with the largest baseline error)")
     report.picture("overlays.png")
     report.section("Error against amplitude and static load")
