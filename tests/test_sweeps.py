@@ -198,6 +198,31 @@ metrics: [front.toe_loop_width_deg]
     assert "DivergenceError" in rows[1][-1] and "deflection" in rows[1][-1] and rows[1][2] == "nan"
 
 
+def test_a_folder_another_sweep_is_writing_is_refused(serial_table, tmp_path):
+    """A second session on the folder a first one is writing (here: its lock held) stops before
+    touching anything; once the first is gone the folder is free."""
+    import subprocess
+    import sys
+
+    from vsim_core.files import LOCK_NAME
+
+    sweep, _ = serial_table
+    folder = tmp_path / "out"
+    folder.mkdir()
+    holder = subprocess.Popen([sys.executable, "-c", "import fcntl, sys, time; f = open(sys.argv[1], 'a'); "
+                               "fcntl.flock(f, fcntl.LOCK_EX); print('held', flush=True); time.sleep(60)",
+                               str(folder / LOCK_NAME)], stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline().strip() == "held"
+        with pytest.raises(InputError, match="another vsim sweep is writing this folder"):
+            run_sweep(load_sweep(sweep), folder, SerialExecutor())
+        assert sorted(p.name for p in folder.iterdir()) == [LOCK_NAME]   # nothing written
+    finally:
+        holder.kill()
+        holder.wait()
+    assert run_sweep(load_sweep(sweep), folder, SerialExecutor()).failed == 0
+
+
 def test_interrupted_sweep_leaves_a_valid_table_that_resume_completes(tmp_path):
     sweep = _sweep(tmp_path, LHS.replace("runs: 3", "runs: 4"))
     whole = tmp_path / "whole"

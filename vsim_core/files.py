@@ -4,6 +4,7 @@ version or the new one, never half of it."""
 from __future__ import annotations
 
 import contextlib
+import fcntl
 import os
 import shutil
 import tempfile
@@ -55,6 +56,28 @@ def _usual_permissions(path: str | Path, mode: int) -> None:
     umask = os.umask(0)
     os.umask(umask)
     os.chmod(path, mode & ~umask)
+
+
+#: The file a process holds to write a folder alone (:func:`exclusive_folder`).
+LOCK_NAME = ".lock"
+
+
+@contextlib.contextmanager
+def exclusive_folder(folder: Path, writer: str) -> Iterator[None]:
+    """Hold ``folder`` for this process's writing during the block: an advisory lock on
+    ``folder/.lock``, which the system drops if the process dies. InputError naming the folder if
+    another process (a ``writer``: "vsim sweep") holds it."""
+    folder.mkdir(parents=True, exist_ok=True)
+    with open(folder / LOCK_NAME, "a") as lock:
+        try:
+            fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            raise InputError(f"another {writer} is writing this folder: wait for it to end, or choose another folder",
+                             source=str(folder)) from None
+        try:
+            yield
+        finally:
+            fcntl.flock(lock, fcntl.LOCK_UN)
 
 
 @contextlib.contextmanager

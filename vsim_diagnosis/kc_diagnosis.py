@@ -24,7 +24,8 @@ channels. Full runs cost more and are right.
 
 The verdict follows :func:`vsim_diagnosis.verdict.decide` with the noise as the floor. Every test
 the baseline does not fit is found (the baseline fitted nothing: training tests count), with where
-in it the misfit sits; one confined to training tests makes the verdict "unexplained", not "none".
+in it the misfit sits; a misfit the held-out tests taken together do not show (confined to a
+training test, or to a stretch) makes the verdict "unexplained", not "none".
 """
 
 from __future__ import annotations
@@ -158,11 +159,11 @@ class Candidate:
 
 @dataclass(frozen=True)
 class Misfit:
-    """A test the baseline does not fit, and where in it (:func:`vsim_diagnosis.verdict.misfit_stretch`)."""
+    """A test a model does not fit, and where in it (:func:`vsim_diagnosis.verdict.misfit_stretch`)."""
 
     test: str
     heldout: bool
-    error: float          #: the baseline's RMS error on it (1 = the noise)
+    error: float          #: the model's RMS error on it (1 = the noise), each recording's zeros its medians
     chance: float         #: the chance that the noise alone shows a stretch as unlikely in the test
     start_s: float        #: the stretch of the test holding the excess: from, to [s of its input]
     end_s: float
@@ -219,23 +220,16 @@ class _Scorer:
         out = np.array([np.median([p for p, g in zip(per, family) if g == f]) for f in family])
         return np.maximum(out, 1e-9)
 
-    def residual(self, predicted: np.ndarray, rows: np.ndarray) -> np.ndarray:
-        """(measured − predicted) / noise on the selected rows (a boolean mask), each channel's mean
-        over the selected rows of each recording removed (its zero error)."""
+    def residual(self, predicted: np.ndarray, rows: np.ndarray, zero: Callable[..., np.ndarray] = np.mean
+                 ) -> np.ndarray:
+        """(measured − predicted) / noise on the selected rows (a boolean mask), each channel's
+        ``zero`` over the selected rows of each recording removed (its zero error): the mean, in
+        which the residual stays affine in the prediction (the fits), or the median, which a misfit
+        confined to a stretch does not move for the rest of its recording (the misfits' search)."""
         r = self.layout.measured[rows] - predicted[rows]
         rec = self.layout.recording[rows]
         for k in np.unique(rec):
-            r[rec == k] -= r[rec == k].mean(axis=0)
-        return r / self.noise
-
-    def robust_residual(self, predicted: np.ndarray) -> np.ndarray:
-        """(measured − predicted) / noise on every row, each channel's median in each recording
-        removed: a misfit confined to a stretch does not shift the zero of the rest of its recording,
-        as the mean would (the fits keep the mean, in which the residual stays affine)."""
-        r = self.layout.measured - predicted
-        rec = self.layout.recording
-        for k in np.unique(rec):
-            r[rec == k] -= np.median(r[rec == k], axis=0)
+            r[rec == k] -= zero(r[rec == k], axis=0)
         return r / self.noise
 
     def test_errors(self, predicted: np.ndarray) -> np.ndarray:
@@ -385,13 +379,13 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, executor: Execut
         top = sorted((min(a, b, key=lambda c: c.score) for a, b in zip(top, refit)), key=lambda c: c.score)
     best = top[0]
     errors = scorer.test_errors(base)
-    found = located_misfits(layout, scorer, base, errors)
+    found = located_misfits(layout, scorer, base)
     for m in found:
         say(f"the baseline does not fit {m.test}{' (held out)' if m.heldout else ''}: {m.error:.2f} × the noise, "
             f"most between {m.start_s:.2f} and {m.end_s:.2f} s of its input, in {m.channel}")
-    verdict = decide(before, best.heldout_error, 1.0, any(not m.heldout for m in found))
+    verdict = decide(before, best.heldout_error, 1.0, bool(found))
     say(f"{best.hypothesis.label}: held-out error {before:.3f} -> {best.heldout_error:.3f}: {verdict}")
-    left = located_misfits(layout, scorer, best.simulated, best.test_errors) if verdict == "named" else []
+    left = located_misfits(layout, scorer, best.simulated) if verdict == "named" else []
     for m in left:
         say(f"  with it, {m.test} is still not fitted: {m.error:.2f} × the noise")
     return KCDiagnosis(best.hypothesis.cause if verdict == "named" else verdict, best, top + screened[VERIFIED:],
@@ -400,17 +394,19 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, executor: Execut
                        left, time.perf_counter() - started)
 
 
-def located_misfits(layout: Layout, scorer: _Scorer, predicted: np.ndarray, errors: np.ndarray) -> list[Misfit]:
-    """The tests ``predicted`` does not fit (:func:`vsim_diagnosis.verdict.misfit`: its per-test
-    ``errors`` or a stretch beyond the noise; every test, training or held out), each with where."""
-    residual = scorer.robust_residual(predicted)
+def located_misfits(layout: Layout, scorer: _Scorer, predicted: np.ndarray) -> list[Misfit]:
+    """The tests ``predicted`` does not fit (:func:`vsim_diagnosis.verdict.misfit`: the RMS error
+    over a test or a stretch of it beyond the noise; every test, training or held out), each with
+    where; each recording's zeros taken as its medians, so that one misfit does not shift the tests
+    beside it."""
+    residual = scorer.residual(predicted, np.ones(len(predicted), dtype=bool), np.median)
     out = []
     for i, t in enumerate(layout.tests):
+        error = float(np.sqrt(np.mean(residual[t.rows] ** 2)))
         chance, first, last, channel = misfit_stretch(residual[t.rows])
-        if misfit(float(errors[i]), chance):
-            out.append(Misfit(t.name, bool(scorer.heldout[i]), float(errors[i]), chance,
-                              float(layout.input_time[t.rows[first]]), float(layout.input_time[t.rows[last]]),
-                              layout.channels[channel]))
+        if misfit(error, chance):
+            out.append(Misfit(t.name, bool(scorer.heldout[i]), error, chance, float(layout.input_time[t.rows[first]]),
+                              float(layout.input_time[t.rows[last]]), layout.channels[channel]))
     return out
 
 

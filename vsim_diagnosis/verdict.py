@@ -40,24 +40,30 @@ class Outcome:
 #: A stretch of a test is misfit when, in one channel, its mean squared residual is at least
 #: NOISE_FACTOR² (in units of the noise) and the chance that the noise alone shows such a stretch
 #: somewhere in the test is below this (χ² with as many degrees as samples in the window, times the
-#: test's independent windows: a scan over every window and channel).
+#: windows scanned in every channel). White noise is assumed, as the noise estimate does.
 MISFIT_CHANCE = 1e-6
 
 
 def misfit_stretch(residual: np.ndarray) -> tuple[float, int, int, int]:
     """The least likely stretch of a test's ``residual`` under its noise (rows: samples in order;
-    columns: channels; in units of their noise): (the chance that noise alone shows one as unlikely
-    somewhere in the test, first row, last row, channel). Windows of a twentieth of the test (at
-    least 10 samples) are scanned in every channel; the stretch is where the best window's channel
-    stays above half its peak."""
+    columns: channels; in units of their noise; NaN counted as no excess): (a bound on the chance
+    that noise alone shows one as unlikely somewhere in the test, first row, last row, channel).
+    Windows of a twentieth of the test (at least 10 samples) are scanned in every channel; the
+    chance of the least likely is multiplied by the number of windows scanned (overlapping windows
+    are alike: a bound, not an estimate); the stretch is where its channel stays above half its
+    peak."""
     n, channels = residual.shape
+    if n == 0:
+        return 1.0, 0, 0, 0
     width = min(n, max(10, n // 20))
-    squares = np.vstack([np.zeros((1, channels)), np.cumsum(residual ** 2, axis=0)])
+    squares = np.vstack([np.zeros((1, channels)), np.cumsum(np.nan_to_num(residual) ** 2, axis=0)])
     mean = (squares[width:] - squares[:-width]) / width                     # (windows, channels)
     # the chance of a mean of `width` unit-variance squares at least this large (χ²), where it matters
     tail = np.where(mean >= NOISE_FACTOR ** 2, gammaincc(0.5 * width, 0.5 * width * mean), 1.0)
-    k, channel = np.unravel_index(int(np.argmin(tail)), tail.shape)
-    chance = min(1.0, float(tail[k, channel]) * channels * n / width)
+    # beyond the floating-point range the tail is 0 for several windows: the largest mean among them
+    least = np.where(tail == tail.min(), mean, -np.inf)
+    k, channel = np.unravel_index(int(np.argmax(least)), tail.shape)
+    chance = min(1.0, float(tail[k, channel]) * channels * mean.shape[0])
     if chance >= 1.0:
         return 1.0, 0, n - 1, int(channel)
     above = mean[:, channel] >= 0.5 * mean[k, channel]
@@ -66,7 +72,7 @@ def misfit_stretch(residual: np.ndarray) -> tuple[float, int, int, int]:
         first -= 1
     while last < len(above) - 1 and above[last + 1]:
         last += 1
-    return chance, int(first), int(min(last + width - 1, n - 1)), int(channel)
+    return chance, int(first), int(last + width - 1), int(channel)
 
 
 def misfit(error: float, chance: float, floor: float = 1.0) -> bool:
@@ -90,16 +96,16 @@ def explained(verdict: str, before: float, after: float, floor: float, misfit_le
         return "none", 0.0
     excess_before = before ** 2 - floor ** 2
     share = 1.0 - max(after ** 2 - floor ** 2, 0.0) / excess_before if excess_before > 0.0 else 1.0
-    return ("partial" if after > NOISE_FACTOR * floor or misfit_left else "full"), share
+    return ("partial" if after > NOISE_FACTOR * floor or misfit_left else "full"), min(max(share, 0.0), 1.0)
 
 
-def decide(before: float, after: float, floor: float, misfit_elsewhere: bool = False) -> str:
+def decide(before: float, after: float, floor: float, misfit_seen: bool = False) -> str:
     """``named``, ``none`` or ``unexplained`` from held-out errors before and after the best cause
-    and the noise floor (all relative RMS); ``misfit_elsewhere``: the baseline does not fit some
-    training test (:func:`misfit`), which the held-out tests cannot judge a cause on: then a
-    baseline that fits the held-out tests is not "none" but "unexplained" (a local misfit)."""
+    and the noise floor (all relative RMS); ``misfit_seen``: the baseline does not fit some test
+    (:func:`misfit`, training or held out): then a baseline that fits the held-out tests taken
+    together is not "none" but "unexplained" (a local misfit, on which no cause can be judged)."""
     excess_before = math.sqrt(max(before ** 2 - floor ** 2, 0.0))
     excess_after = math.sqrt(max(after ** 2 - floor ** 2, 0.0))
     if after <= before * (1.0 - MIN_GAIN) and excess_after <= MAX_EXCESS_LEFT * excess_before:
         return "named"
-    return "none" if before <= NOISE_FACTOR * floor and not misfit_elsewhere else "unexplained"
+    return "none" if before <= NOISE_FACTOR * floor and not misfit_seen else "unexplained"

@@ -84,11 +84,12 @@ def verdict_sentence(d: KCDiagnosis) -> str:
                 f"noise) is at the noise or no cause of the catalogue reduces it.")
     best = d.ranking[0]
     if d.verdict == "unexplained" and before <= NOISE_FACTOR and d.misfits:
-        worst = max(d.misfits, key=lambda m: m.error)
-        return (f"A local misfit: the baseline fits the held-out tests ({before:.2f} × the noise) but not "
-                f"{len(d.misfits)} training test{'s' if len(d.misfits) > 1 else ''}, worst {worst.test} "
-                f"({worst.error:.2f} × the noise, most between {worst.start_s:.2f} and {worst.end_s:.2f} s of its "
-                f"input, in {worst.channel}); no catalogue cause can be judged on it.")
+        worst = min(d.misfits, key=lambda m: (m.chance, -m.error))
+        tests = f"{len(d.misfits)} tests on their own" if len(d.misfits) > 1 else "one test on its own"
+        return (f"A local misfit: the baseline fits the held-out tests taken together ({before:.2f} × the noise) "
+                f"but not {tests}, most of all {worst.test} ({worst.error:.2f} × the noise, most between "
+                f"{worst.start_s:.2f} and {worst.end_s:.2f} s of its input, in {worst.channel}); no catalogue cause "
+                f"can be judged on it.")
     if d.verdict == "unexplained":
         return (f"The mismatch is real ({before:.2f} × the noise on held-out tests) but no catalogue cause explains "
                 f"it; the best, {best.hypothesis.label}, only brings it to {best.heldout_error:.2f}.")
@@ -192,7 +193,7 @@ def write_report(d: KCDiagnosis, baseline: VehicleDefinition, out_dir: Path, dat
     report.table(("test", "held out", "error before", "excess over noise", "error after"),
                  [(t["name"], "yes" if t["heldout"] else "", f"{t['error_before']:.3f}", f"{t['excess_before']:.3f}",
                    f"{t['error_after']:.3f}") for t in result["tests"]])
-    for title, misfits in ((f"Tests {d.verdict} does not fit either", d.misfits_after),
+    for title, misfits in ((f"Tests the baseline with {d.verdict} does not fit", d.misfits_after),
                            ("Tests the baseline does not fit", d.misfits)):
         if misfits:
             report.section(title)

@@ -20,7 +20,7 @@ import numpy as np
 
 from vsim_cluster.executor import Executor
 from vsim_core.errors import InputError
-from vsim_core.files import atomic_output
+from vsim_core.files import atomic_output, exclusive_folder
 from vsim_sweeps.designs import design_points
 from vsim_sweeps.sensitivity import sobol_indices
 from vsim_sweeps.sweep_file import Sweep
@@ -84,10 +84,15 @@ def run_sweep(sweep: Sweep, folder: Path, executor: Executor, *, resume: bool = 
               progress: Callable[[SweepProgress], None] | None = None) -> SweepReport:
     """Make the runs of ``sweep`` that ``folder``'s table lacks on ``executor`` (module docstring).
     A cluster lost on the way raises :class:`vsim_cluster.executor.ClusterLost`, the table holding
-    the runs finished before."""
-    started = time.perf_counter()
+    the runs finished before; InputError if another process is sweeping into ``folder``."""
     folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
+    with exclusive_folder(folder, "vsim sweep"):   # two sessions on one table would interleave their rows
+        return _run_sweep(sweep, folder, executor, resume, overwrite, progress)
+
+
+def _run_sweep(sweep: Sweep, folder: Path, executor: Executor, resume: bool, overwrite: bool,
+               progress: Callable[[SweepProgress], None] | None) -> SweepReport:
+    started = time.perf_counter()
     points = design_points(sweep.design, np.array([p.low for p in sweep.parameters]),
                            np.array([p.high for p in sweep.parameters]))
     done = _prepared(sweep, folder, points, resume, overwrite)
