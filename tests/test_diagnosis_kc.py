@@ -140,7 +140,8 @@ def test_the_refit_fits_a_second_parameter_along_its_slope_and_keeps_it_in_bound
     k1, alpha = h.values["k1"], h.values["alpha"]
     for move, expected in ((0.05, alpha + 0.05), (0.8, parameters(h.cause)[1].bounds[1])):
         measured = 1.4 * shape + move * slope + 0.2 * rng.standard_normal(shape.shape)
-        layout = Layout(["c_x", "c_y"], measured, np.zeros(2000), np.zeros(2000, dtype=int), np.repeat([0, 1], 1000), tests)
+        layout = Layout(["c_x", "c_y"], measured, np.zeros(2000), np.zeros(2000, dtype=int), np.repeat([0, 1], 1000),
+                        tests)
         scorer = _Scorer(layout, np.zeros_like(shape), split(2))
         fitted = fit(h, shape, np.zeros_like(shape), scorer, slope)
         assert fitted.hypothesis.values["alpha"] == pytest.approx(expected, abs=3 * fitted.std["alpha"] + 1e-12)

@@ -1,7 +1,8 @@
 """What every mounting of the car shares (the K&C rig, :mod:`vehicle.simulation.rig`; the road,
 :mod:`vehicle.simulation.road`): the vehicle built with its springs' preloads, its MuJoCo state,
-the bushing coupling, the wheels, the columns of its measured vector and the suspension's part of it, the body's ride height, switching the
-bushing laws off while the car settles, and the time spent in the compiled stepping loop."""
+the bushing coupling, the wheels, the columns of its measured vector and the suspension's part of
+it, MuJoCo's resets, the body's ride height, switching the bushing laws off while the car
+settles, and the time spent in the compiled stepping loop."""
 
 from __future__ import annotations
 
@@ -66,6 +67,13 @@ class MountedCar:
         finally:
             forces.bank = laws
             self.coupling.reset()
+
+    def require_fixed_rows(self) -> None:
+        """ValueError unless the number of MuJoCo's constraint rows cannot change within a run of
+        steps (no contacts, no limits): the compiled measurement reads the rows through views."""
+        m = self.model
+        if not (m.opt.disableflags & mujoco.mjtDisableBit.mjDSBL_CONTACT) or m.jnt_limited.any() or m.tendon_limited.any():
+            raise ValueError("the car's measurement needs a model without MuJoCo contacts or limits")
 
     def was_reset(self) -> bool:
         """Whether MuJoCo has reset the state since the car was built (see :data:`RESET_WARNINGS`)."""

@@ -128,9 +128,9 @@ def suspension(out, qpos, qvel, ten_length, ten_velocity, efc_pos, bush, spring,
 def rig_wheels(out, xmat, site_xpos, xfrc, qpos, efc_force, wheel, centre_site, carriage, pad_row, pad_qpos, sign,
                design_z):
     """What the rig reads at its four wheels into ``out`` (the columns of
-    vehicle.simulation.outputs.RIG_WHEEL, in its order, for each wheel): wheel angles, half-track, travel (centre height from
-    ``design_z``) and centre from the wheel's pose; the pad's commanded Fx, Fy, its Fz (the drive
-    equality's force, row ``pad_row``), its height and aligning torque."""
+    vehicle.simulation.outputs.RIG_WHEEL, in its order, for each wheel): wheel angles, half-track,
+    travel (centre height from ``design_z``) and centre from the wheel's pose; the pad's commanded
+    Fx, Fy, its Fz (the drive equality's force, row ``pad_row``), its height and aligning torque."""
     for k in range(wheel.shape[0]):
         base = RIG_WHEEL_SIZE * k
         w, s, c = wheel[k], centre_site[k], carriage[k]

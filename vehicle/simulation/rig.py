@@ -44,9 +44,8 @@ class KCRig(MountedCar):
         self.columns = self.measured_columns((), RIG_WHEEL)
         # The compiled measurement reads the constraint rows through views taken here: valid while
         # MuJoCo allocates them alike every step, which holds when their number cannot change
-        # (no contacts, no limits: checked) and is verified after every measurement.
-        if not (m.opt.disableflags & mujoco.mjtDisableBit.mjDSBL_CONTACT) or m.jnt_limited.any() or m.tendon_limited.any():
-            raise ValueError("the rig's measurement needs a model without contacts or limits")
+        # (checked) and is verified after every measurement.
+        self.require_fixed_rows()
         mujoco.mj_forward(m, self.data)
         self._rows = self.equality_rows()
         self._efc_force, self._efc_pos = self.data.efc_force, self.data.efc_pos   # the views the probe reads
@@ -148,7 +147,8 @@ class KCRig(MountedCar):
         reset the state (:meth:`was_reset`): up to the first that follows the reset."""
         inputs = np.ascontiguousarray(inputs, dtype=float)
         if inputs.shape[0] not in (0, samples * every) or inputs.shape[1:] != _NO_INPUTS.shape[1:]:
-            raise ValueError(f"expected rig inputs of shape ({samples * every}, {_NO_INPUTS.shape[1]}), got {inputs.shape}")
+            raise ValueError(f"expected rig inputs of shape ({samples * every}, {_NO_INPUTS.shape[1]}), "
+                             f"got {inputs.shape}")
         m, d = self.model, self.data
         measured = np.empty((samples, self.columns.size))
         pos, quat = np.empty((samples, bodies.size, 3)), np.empty((samples, bodies.size, 4))
@@ -205,4 +205,4 @@ class KCRig(MountedCar):
         reads them (the views taken at construction)."""
         d = self.data
         if (d.nefc, d.efc_force.ctypes.data, d.efc_pos.ctypes.data) != self._efc:
-            raise RuntimeError("the rig's constraint rows moved: its measurement would read stale memory")
+            raise RuntimeError("the rig's constraint rows moved: its last measurement read stale memory")

@@ -108,9 +108,8 @@ class RoadCar(MountedCar):
         self.columns = self.measured_columns(ROAD_BODY, ROAD_WHEEL + tuple(SIGNALS))
         self._sign = np.array([SIDE_SIGN[c] for c in CORNERS], dtype=float)
         # the measurement reads the constraint rows through views taken before each call: valid
-        # while their number cannot change within it (no contacts, no limits: checked)
-        if not (m.opt.disableflags & mujoco.mjtDisableBit.mjDSBL_CONTACT) or m.jnt_limited.any() or m.tendon_limited.any():
-            raise ValueError("the road car's measurement needs a model without MuJoCo contacts or limits")
+        # while their number cannot change within it (checked)
+        self.require_fixed_rows()
 
     def _run(self, n: int, inputs: np.ndarray) -> None:
         m, d = self.model, self.data
@@ -185,7 +184,7 @@ class RoadCar(MountedCar):
                            self._tyre_args, self._driver, self.chassis, probe, bodies.astype(np.int64), d.xpos,
                            d.xquat, measured, pos, quat, d.warning.number, RESET_WARNINGS)
         if (d.nefc, d.efc_pos.ctypes.data) != efc:
-            raise RuntimeError("the road car's constraint rows moved: its measurement read stale memory")
+            raise RuntimeError("the road car's constraint rows moved: its last measurement read stale memory")
         return measured[:done], pos[:done], quat[:done]
 
     def measure(self) -> np.ndarray:

@@ -10,10 +10,10 @@ with the bushing laws switched on from their virgin state; 2, the input. Case k+
 follows case k's last one by one output interval.
 
 A run stops with :class:`DivergenceError` (time, bushing, direction, value) when the state turns
-non-finite, MuJoCo reports an unstable acceleration, a bushing deflects beyond the scenario's
-limits or a loop closure opens beyond its bound; the samples up to the one that shows it are
-yielded first, so that a recording keeps them (an unstable acceleration is seen at the end of its
-block, up to BLOCK_SAMPLES samples late).
+non-finite, MuJoCo resets it (a non-finite or huge position, velocity or acceleration: the block
+ends at the first sample after), a bushing deflects beyond the scenario's limits or a loop closure
+opens beyond its bound; the samples up to the one that shows it are yielded first, so that a
+recording keeps them.
 """
 
 from __future__ import annotations
