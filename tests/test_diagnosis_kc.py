@@ -91,16 +91,42 @@ def test_places_and_draws():
         for p in parameters(cause):
             lo, hi = p.draw
             x = abs(a.values[p.name])
-            assert lo <= x <= hi or (cause == "beam_torsion" and lo <= 1 / x <= hi)
+            assert lo <= x <= hi or (p.factor and lo <= 1 / x <= hi)
         first = parameters(cause)[0]
         for seed in range(50):   # the first parameter in the observable part of its range at its place
             h = draw(cause, np.random.default_rng(seed))
             x = abs(h.values[first.name])
-            x = max(x, 1 / x) if cause == "beam_torsion" else x
+            x = max(x, 1 / x) if first.factor else x
             low = max(first.draw[0], OBSERVABLE[cause][h.location])
             assert low * (1 - 1e-12) <= x <= first.draw[1] * (1 + 1e-12), (h, low)
     signs = {math.copysign(1.0, draw("asymmetry", np.random.default_rng(s)).values["asymmetry"]) for s in range(20)}
     assert signs == {1.0, -1.0}
+    # a design value off either way, on either axle it can sit in
+    rates = [draw("spring_rate", np.random.default_rng(s)) for s in range(20)]
+    assert {h.values["spring_rate_scale"] > 1.0 for h in rates} == {True, False}
+    assert {h.location for h in rates} == {("front",), ("rear",)} == set(locations(v, "spring_rate"))
+    assert locations(v, "anti_roll_bar") == [("front",)] and locations(v, "beam_torsion") == [()]
+
+
+def test_an_axle_factor_scales_its_design_value_in_the_vehicle_and_its_file(tmp_path):
+    """spring_rate, damper_force and anti_roll_bar multiply the axle's spring curve, damper curve
+    and bar rate, in the extended vehicle and in the file the diagnosis writes (which reads back as it)."""
+    v = load_vehicle()
+    hs = [Hypothesis("spring_rate", ("rear",), {"spring_rate_scale": 0.8}),
+          Hypothesis("damper_force", ("front",), {"damper_scale": 1.3}),
+          Hypothesis("anti_roll_bar", ("front",), {"anti_roll_bar_scale": 1.25})]
+    e = extended_vehicle(v, hs)
+    assert e.rear.spring.rate == pytest.approx(0.8 * v.rear.spring.rate, rel=1e-9)
+    assert e.front.spring.rate == v.front.spring.rate
+    assert e.front.damper.curve.y == tuple(1.3 * y for y in v.front.damper.curve.y)
+    assert e.front.damper.curve.x == v.front.damper.curve.x and e.rear.damper == v.rear.damper
+    assert e.front.anti_roll_rate == pytest.approx(1.25 * v.front.anti_roll_rate)
+    path = tmp_path / "extended.yaml"
+    path.write_text(extended_vehicle_yaml(v, hs, "test"))
+    back = load_vehicle(path)
+    assert back.rear.spring.rate == pytest.approx(e.rear.spring.rate, rel=1e-9)
+    assert back.front.damper.curve == e.front.damper.curve and back.front.anti_roll_rate == e.front.anti_roll_rate
+    assert Hypothesis("spring_rate", ("rear",), {}).location_json() == {"axle": "rear"}
 
 
 def test_the_screening_fit_scales_the_effect_and_clips_a_hopeless_one_at_its_bound():
@@ -205,7 +231,7 @@ def measure_truth(tmp: Path, h: Hypothesis | None, seed: int, *, duration_scale:
     effects = []
     if h is not None:
         entry = {"cause": h.cause, **h.values}
-        if len(h.location) == 2:
+        if len(h.location) in (1, 2):
             entry["location"] = ".".join(h.location)
         elif len(h.location) == 3:
             entry["location"], entry["directions"] = h.location[0], list(h.location[1:])

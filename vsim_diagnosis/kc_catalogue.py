@@ -2,9 +2,11 @@
 
 A *bushing* cause of :mod:`vsim_diagnosis.catalogue` sits in one bushing direction (the left
 one's, mirrored on the right as the vehicle mirrors every law) and extends that direction's law.
-The vehicle adds three causes of its own: ``coupling`` (a cross stiffness between two directions
-of one bushing), ``strut_friction`` (Coulomb friction of the strut rods) and ``beam_torsion`` (a
-factor on the twist beam's torsional stiffness). Outside the catalogue, the virtual rig can hide
+The vehicle adds causes of its own: ``coupling`` (a cross stiffness between two directions of one
+bushing), ``strut_friction`` (Coulomb friction of the strut rods), ``beam_torsion`` (a factor on
+the twist beam's torsional stiffness), and an axle's ``spring_rate``, ``damper_force`` and (front)
+``anti_roll_bar`` off their design values by a factor: the errors engineers find first when they
+correlate a model with a K&C rig, beside hardpoints (not screened yet). Outside the catalogue, the virtual rig can hide
 ``backlash`` (a dead band in one bushing direction, as a worn ball joint would give).
 
 ``self_heating`` is not a K&C cause: the rig's triangles at 0.1 Hz dissipate a few joules per cycle
@@ -15,13 +17,13 @@ endurance sines heat a part in minutes.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, Mapping
 
 import numpy as np
 
 from bushings.parameter_sets import ParameterSet, load_parameter_set
-from vehicle.model.definition import BushingDef, DirectionDef, VehicleDefinition
+from vehicle.model.definition import BushingDef, Curve, Damper, DirectionDef, VehicleDefinition
 from vehicle.model.vehicle_file import with_extensions
 from vsim_core.documents import Document, dump_yaml
 from vsim_core.errors import InputError
@@ -40,6 +42,13 @@ class VehicleCause(Entry):
     """A cause the vehicle holds outside its bushing laws."""
 
     located: bool            #: sits in one bushing (``coupling``) rather than in the whole axle
+    axles: tuple[str, ...] = ()   #: the axles it can sit in, one at a time (none: the place is fixed)
+
+
+def _scale(name: str, what: str) -> Parameter:
+    """A factor on an axle's design value, from a few to 40 per cent off (either way)."""
+    return Parameter(name, "-", (0.3, 3.0), (1.05, 1.4), log=True, factor=True,
+                     description=f"factor on the design {what} (drawn above or below 1)")
 
 
 VEHICLE_CAUSES: dict[str, VehicleCause] = {c.id: c for c in (
@@ -57,7 +66,18 @@ VEHICLE_CAUSES: dict[str, VehicleCause] = {c.id: c for c in (
                  (Parameter("beam_torsion_scale", "-", (0.2, 5.0), (1.3, 2.0), log=True, factor=True,
                             description="factor on the design torsional stiffness (drawn above or below 1)"),),
                  located=False),
+    VehicleCause("spring_rate", "an axle's coil springs are stiffer or softer than designed (wire, coils, supplier)",
+                 "pad-force gradients in pumping and roll off on one axle, loops unchanged",
+                 (_scale("spring_rate_scale", "spring rate"),), located=True, axles=("front", "rear")),
+    VehicleCause("anti_roll_bar", "the front anti-roll bar is stiffer or softer than designed",
+                 "roll stiffness and its front/rear split off, pumping unchanged",
+                 (_scale("anti_roll_bar_scale", "anti-roll bar rate"),), located=True, axles=("front",)),
+    VehicleCause("damper_force", "an axle's dampers give more or less force than their curve (valving, oil)",
+                 "loops that widen with the input's speed on one axle",
+                 (_scale("damper_scale", "damper curve's forces"),), located=True, axles=("front", "rear")),
 )}
+#: The vehicle file's place of each axle factor cause: (section, key) of the value it multiplies.
+AXLE_SCALES = {"spring_rate": "spring", "anti_roll_bar": "anti_roll_bar", "damper_force": "damper"}
 #: The model error in excess of the noise (RMS over the K&C campaign of the change of every compared
 #: channel, its mean per recording removed, in noise units: what the diagnosis must explain) that
 #: makes a cause observable: the baseline's held-out error is then √2 × the noise, well above the
@@ -69,9 +89,10 @@ MIN_EXCESS = 1.0
 #: The virtual rig's draws take these places, their magnitudes in the observable part of the
 #: realistic range; elsewhere a cause is still a hypothesis of the diagnosis. Kept: places whose
 #: floor leaves at least the top fifth of the range. Missing: viscoelasticity_excess (the 0.1 Hz
-#: triangles are too slow for the STVS dampers: floor 14.8 N of 5-15), preload (the car has no
-#: direction with a nonlinear elastic law for it to act on), and places such as the asymmetry of the
-#: front pivot's y direction (floor 0.26 of 0.05-0.15) where the campaign sees too little.
+#: triangles are too slow for the STVS dampers: floor 14.8 N of 5-15; damper_force likewise: floors
+#: 1.23 front, 1.17 rear of 1.05-1.4), preload (the car has no direction with a nonlinear elastic
+#: law for it to act on), and places such as the asymmetry of the front pivot's y direction (floor
+#: 0.26 of 0.05-0.15) where the campaign sees too little.
 OBSERVABLE: dict[str, dict[tuple[str, ...], float]] = {
     "viscoelasticity_missing": {("e1_front", "y"): 20.8},
     "asymmetry": {("e1_rear", "x"): 0.043},
@@ -80,6 +101,8 @@ OBSERVABLE: dict[str, dict[tuple[str, ...], float]] = {
     "coupling": {("e1_rear", "x", "y"): 27.6, ("e1_rear", "x", "z"): 43.6},
     "strut_friction": {(): 27.2},
     "beam_torsion": {(): 1.106},
+    "spring_rate": {("front",): 1.048, ("rear",): 1.060},
+    "anti_roll_bar": {("front",): 1.096},
     "backlash": {("e1_front", "y"): 0.049, ("e1_rear", "x"): 0.103, ("e1_rear", "y"): 0.057},
 }
 #: Outside the catalogue: a dead band in one bushing direction.
@@ -107,6 +130,8 @@ class Hypothesis:
             return {"bushing": self.location[0], "direction": self.location[1]}
         if len(self.location) == 3:
             return {"bushing": self.location[0], "directions": list(self.location[1:])}
+        if len(self.location) == 1:
+            return {"axle": self.location[0]}
         return {"axle": "front"} if self.cause == "strut_friction" else (
             {"axle": "rear"} if self.cause == "beam_torsion" else None)
 
@@ -125,8 +150,8 @@ def draw(cause: str, rng: np.random.Generator) -> Hypothesis:
     v = abs(values[first.name])
     v = low + ((math.log(v) if first.log else v) - lo) / (hi - lo) * (hi - low)
     values[first.name] = math.copysign(math.exp(v) if first.log else v, values[first.name])
-    if cause == "beam_torsion" and rng.random() < 0.5:
-        values["beam_torsion_scale"] = 1.0 / values["beam_torsion_scale"]
+    if cause in VEHICLE_CAUSES and first.factor and rng.random() < 0.5:   # a design value off either way
+        values[first.name] = 1.0 / values[first.name]
     return Hypothesis(cause, location, values)
 
 
@@ -167,11 +192,11 @@ def _bushing(vehicle: VehicleDefinition, name: str) -> BushingDef:
 
 def locations(vehicle: VehicleDefinition, cause: str) -> list[tuple[str, ...]]:
     """Every place ``cause`` can sit in ``vehicle``: bushing directions whose law it applies to, pairs
-    of translations of one bushing (coupling), or the axle (``()``)."""
+    of translations of one bushing (coupling), an axle (``("front",)``) or a fixed place (``()``)."""
     if cause == "coupling":
         return [(b.name, a, c) for b in vehicle.bushings for i, a in enumerate(DIRECTIONS) for c in DIRECTIONS[i + 1:]]
     if cause in VEHICLE_CAUSES:
-        return [()]
+        return [(a,) for a in VEHICLE_CAUSES[cause].axles] or [()]
     applies = CAUSES[cause].applies if cause in CAUSES else (lambda law: True)
     return [(b.name, d) for b in vehicle.bushings for d in DIRECTIONS if applies(direction_law(vehicle, b.name, d))]
 
@@ -192,6 +217,8 @@ def extended_vehicle(vehicle: VehicleDefinition, hypotheses: list[Hypothesis]) -
             strut = v["strut_friction"]
         elif h.cause == "beam_torsion":
             beam = v["beam_torsion_scale"]
+        elif h.cause in AXLE_SCALES:
+            continue   # set on the extended vehicle below
         elif h.cause == "coupling":
             name, a, b = h.location
             terms = coupling.setdefault(name, [{"directions": list(t.directions),
@@ -207,7 +234,24 @@ def extended_vehicle(vehicle: VehicleDefinition, hypotheses: list[Hypothesis]) -
             else:
                 law = CAUSES[h.cause].apply(law, v)
             laws[target] = law
-    return with_extensions(vehicle, strut_friction=strut, beam_torsion_scale=beam, laws=laws, coupling=coupling)
+    out = with_extensions(vehicle, strut_friction=strut, beam_torsion_scale=beam, laws=laws, coupling=coupling)
+    for h in hypotheses:
+        if h.cause in AXLE_SCALES:
+            out = _scaled_axle(out, h.cause, h.location[0], float(next(iter(h.values.values()))))
+    return out
+
+
+def _scaled_axle(vehicle: VehicleDefinition, cause: str, axle: str, factor: float) -> VehicleDefinition:
+    """``vehicle`` with the value of ``cause`` on ``axle`` multiplied by ``factor`` (:data:`AXLE_SCALES`)."""
+    a = getattr(vehicle, axle)
+    scaled = lambda c: Curve(tuple(c.x), tuple(y * factor for y in c.y))
+    if cause == "spring_rate":
+        a = replace(a, spring=replace(a.spring, curve=scaled(a.spring.curve)))
+    elif cause == "damper_force":
+        a = replace(a, damper=Damper(scaled(a.damper.curve)))
+    else:
+        a = replace(a, anti_roll_rate=a.anti_roll_rate * factor)
+    return replace(vehicle, **{axle: a})
 
 
 
@@ -227,6 +271,12 @@ def extended_vehicle_yaml(baseline: VehicleDefinition, hypotheses: list[Hypothes
         elif h.cause == "coupling":
             name, a, b = h.location
             entries[name].setdefault("coupling", []).append({"directions": [a, b], "stiffness": v["stiffness"]})
+        elif h.cause in AXLE_SCALES:
+            section, factor = data[h.location[0]][AXLE_SCALES[h.cause]], float(next(iter(v.values())))
+            if "rate" in section:
+                section["rate"] = float(section["rate"]) * factor
+            if "curve" in section:
+                section["curve"] = [[float(x), float(y) * factor] for x, y in section["curve"]]
         else:
             name, direction = h.location
             law = direction_law(extended, name, direction)

@@ -14,6 +14,7 @@ TRUTH.yaml (K&C level; paths relative to this file)::
       - {cause: coupling, location: e1_rear, directions: [x, z], stiffness: 70.0}   # N/mm
       - {cause: strut_friction, strut_friction: 200.0}                 # N, both struts
       - {cause: beam_torsion, beam_torsion_scale: 1.6}
+      - {cause: spring_rate, location: front, spring_rate_scale: 0.9}  # also anti_roll_bar (front), damper_force
       - {cause: backlash, location: e1_front.y, backlash: 0.2}          # mm, outside the catalogue
     measurement: {angle_noise_deg: 0.003, ...}       # MEASUREMENT_DEFAULTS keys
     seed: 0
@@ -129,7 +130,8 @@ def _location(entry: Mapping[str, Any], cause: str, baseline: VehicleDefinition,
     if location not in valid:
         choices = ", ".join(_label(loc) for loc in valid) if valid else \
             f"none: {cause} applies to no bushing direction of {baseline.name}"
-        raise InputError(f"{cause} cannot sit in {where!r}; expected bushing.direction, one of: {choices}",
+        form = "an axle" if all(len(loc) == 1 for loc in valid) else "bushing.direction"
+        raise InputError(f"{cause} cannot sit in {where!r}; expected {form}, one of: {choices}",
                          source=source, key=f"{key}.location")
     return location
 
