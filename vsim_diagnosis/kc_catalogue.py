@@ -76,7 +76,7 @@ VEHICLE_CAUSES: dict[str, VehicleCause] = {c.id: c for c in (
                  "loops that widen with the input's speed on one axle",
                  (_scale("damper_scale", "damper curve's forces"),), located=True, axles=("front", "rear")),
 )}
-#: The vehicle file's place of each axle factor cause: (section, key) of the value it multiplies.
+#: The vehicle file's section of each axle factor cause (its `rate` or its `curve`'s forces are multiplied).
 AXLE_SCALES = {"spring_rate": "spring", "anti_roll_bar": "anti_roll_bar", "damper_force": "damper"}
 #: The model error in excess of the noise (RMS over the K&C campaign of the change of every compared
 #: channel, its mean per recording removed, in noise units: what the diagnosis must explain) that
@@ -237,7 +237,7 @@ def extended_vehicle(vehicle: VehicleDefinition, hypotheses: list[Hypothesis]) -
     out = with_extensions(vehicle, strut_friction=strut, beam_torsion_scale=beam, laws=laws, coupling=coupling)
     for h in hypotheses:
         if h.cause in AXLE_SCALES:
-            out = _scaled_axle(out, h.cause, h.location[0], float(next(iter(h.values.values()))))
+            out = _scaled_axle(out, h.cause, h.location[0], float(h.values[parameters(h.cause)[0].name]))
     return out
 
 
@@ -272,7 +272,7 @@ def extended_vehicle_yaml(baseline: VehicleDefinition, hypotheses: list[Hypothes
             name, a, b = h.location
             entries[name].setdefault("coupling", []).append({"directions": [a, b], "stiffness": v["stiffness"]})
         elif h.cause in AXLE_SCALES:
-            section, factor = data[h.location[0]][AXLE_SCALES[h.cause]], float(next(iter(v.values())))
+            section, factor = data[h.location[0]][AXLE_SCALES[h.cause]], float(v[parameters(h.cause)[0].name])
             if "rate" in section:
                 section["rate"] = float(section["rate"]) * factor
             if "curve" in section:
