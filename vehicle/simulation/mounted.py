@@ -43,8 +43,8 @@ class MountedCar:
         self.rack_eq = eq("rack_drive")
         self.closure_eq = np.array([eq(n) for n in self.car.closures])
         self.closure_rows = np.array([3 if m.eq_type[i] != mujoco.mjtEq.mjEQ_TENDON else 1 for i in self.closure_eq])
-        #: Wall time spent in the compiled stepping loop so far [s] (the end-to-end benchmark's reference),
-        #: without the mounting's first, empty call, which compiles the loop or loads it from numba's cache.
+        #: Wall time spent in the compiled stepping loops so far [s] (the end-to-end benchmark's reference),
+        #: without the mounting's first, empty calls, which compile the loops or load them from numba's cache.
         self.stepping_s = 0.0
 
     def _timed(self, loop: Callable[..., Any], *args) -> Any:

@@ -39,7 +39,6 @@ class KCRig(MountedCar):
         self.centre_site = np.array([mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, self.car.corners[c]["centre_site"])
                                      for c in CORNERS])
         self._run(0, _NO_INPUTS, _INACTIVE)
-        self.stepping_s = 0.0
         #: Where each quantity sits in the rig's measured vector (:meth:`sampled`, :meth:`measure`).
         self.columns = self.measured_columns((), RIG_WHEEL)
         # The compiled measurement reads the constraint rows through views taken here: valid while
@@ -54,6 +53,8 @@ class KCRig(MountedCar):
         self.design_centre_z = self.data.site_xpos[self.centre_site, 2].copy()
         self._probe_bank: object = False   # the bank the probe's arguments were built for
         self._probe: tuple = ()
+        self.sampled(1, 0)   # compiles the sampling loop or loads it from numba's cache: no steps, no change
+        self.stepping_s = 0.0
 
     # -- inputs ------------------------------------------------------------------------------
     def set_pads(self, heights) -> None:

@@ -103,13 +103,14 @@ class RoadCar(MountedCar):
         self._design_z = np.array([getattr(self.vehicle, c.split("_")[0]).hardpoints["wheel_centre"][2]
                                    for c in CORNERS])
         self._run(0, _NO_INPUTS)
-        self.stepping_s = 0.0
         #: Where each quantity sits in the car's measured vector (:meth:`sampled`, :meth:`measure`).
         self.columns = self.measured_columns(ROAD_BODY, ROAD_WHEEL + tuple(SIGNALS))
         self._sign = np.array([SIDE_SIGN[c] for c in CORNERS], dtype=float)
         # the measurement reads the constraint rows through views taken before each call: valid
         # while their number cannot change within it (checked)
         self.require_fixed_rows()
+        self.sampled(1, 0)   # compiles the sampling loop or loads it from numba's cache: no steps, no change
+        self.stepping_s = 0.0
 
     def _run(self, n: int, inputs: np.ndarray) -> None:
         m, d = self.model, self.data
