@@ -68,6 +68,18 @@ class MountedCar:
             forces.bank = laws
             self.coupling.reset()
 
+    def _sampling(self, samples: int, every: int, inputs: np.ndarray, width: int, bodies: np.ndarray, what: str
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """For a subclass's ``sampled``: its ``inputs`` checked (``width`` columns, one row per step
+        or none; ValueError naming ``what`` else) and the buffers its compiled loop fills: measured
+        vectors (samples, columns), body positions (samples, bodies, 3) and orientations (samples,
+        bodies, 4)."""
+        inputs = np.ascontiguousarray(inputs, dtype=float)
+        if inputs.shape[0] not in (0, samples * every) or inputs.shape[1:] != (width,):
+            raise ValueError(f"expected {what} inputs of shape ({samples * every}, {width}), got {inputs.shape}")
+        return (inputs, np.empty((samples, self.columns.size)), np.empty((samples, bodies.size, 3)),
+                np.empty((samples, bodies.size, 4)))
+
     def require_fixed_rows(self) -> None:
         """ValueError unless the number of MuJoCo's constraint rows cannot change within a run of
         steps (no contacts, no limits): the compiled measurement reads the rows through views."""

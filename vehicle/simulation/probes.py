@@ -2,9 +2,9 @@
 :class:`vehicle.simulation.outputs.MeasuredColumns`): what the suspension's parts carry (springs,
 dampers, bushing directions, loop closures) and what the K&C rig reads at its wheels.
 
-The stepping loop calls :func:`rig_sample` at every output sample without coming back to Python
-(:func:`vehicle.simulation.stepping.run_sampled`); Python calls the same functions for one reading
-(:meth:`vehicle.simulation.rig.KCRig.measure`, the road car), so that there is one formula for
+The stepping loops call :func:`rig_sample` and :func:`road_sample` at every output sample without
+coming back to Python (:mod:`vehicle.simulation.stepping`); the coupling's readers
+(``BushingForces.forces``) call the same functions from Python, so that there is one formula for
 every measured quantity. All of them read MuJoCo's arrays after ``mj_forward``.
 """
 

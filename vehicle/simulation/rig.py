@@ -15,7 +15,7 @@ import numpy as np
 
 from vehicle.model.definition import CORNERS, SIDE_SIGN, VehicleDefinition
 from vehicle.model.elements import BuildOptions
-from vehicle.simulation import probes, stepping
+from vehicle.simulation import stepping
 from vehicle.simulation.mounted import RESET_WARNINGS, MountedCar
 from vehicle.simulation.outputs import RIG_WHEEL, RigOutputs, WheelOutputs
 
@@ -146,13 +146,8 @@ class KCRig(MountedCar):
         of the bodies ``bodies`` (ids) (samples, bodies, 3) and (samples, bodies, 4). ``inputs``:
         one row per step as :meth:`play` takes them, or none (held). Fewer samples when MuJoCo
         reset the state (:meth:`was_reset`): up to the first that follows the reset."""
-        inputs = np.ascontiguousarray(inputs, dtype=float)
-        if inputs.shape[0] not in (0, samples * every) or inputs.shape[1:] != _NO_INPUTS.shape[1:]:
-            raise ValueError(f"expected rig inputs of shape ({samples * every}, {_NO_INPUTS.shape[1]}), "
-                             f"got {inputs.shape}")
+        inputs, measured, pos, quat = self._sampling(samples, every, inputs, _NO_INPUTS.shape[1], bodies, "rig")
         m, d = self.model, self.data
-        measured = np.empty((samples, self.columns.size))
-        pos, quat = np.empty((samples, bodies.size, 3)), np.empty((samples, bodies.size, 4))
         rig = (m.eq_data, self.pad_eq, self.rack_eq, d.xfrc_applied, self.carriage_body, self.wheel_body)
         done = self._timed(stepping.run_sampled, every, inputs, _ALL_ACTIVE if inputs.shape[0] else _INACTIVE, rig,
                            m._address, d._address, m.opt.timestep, self.coupling.kernel_arrays(), self._probe_args(),
@@ -163,12 +158,8 @@ class KCRig(MountedCar):
 
     # -- outputs -----------------------------------------------------------------------------
     def measure(self) -> RigOutputs:
-        """The rig's outputs at the current state."""
-        mujoco.mj_forward(self.model, self.data)
-        self._check_rows()
-        v = np.empty(self.columns.size)
-        probes.rig_sample(v, *self._probe_args())
-        return self.outputs(v)
+        """The rig's outputs at the current state (one sample without steps)."""
+        return self.outputs(self.sampled(1, 0)[0][0])
 
     def outputs(self, v: np.ndarray) -> RigOutputs:
         """The :class:`RigOutputs` of one measured vector ``v`` (:attr:`columns`)."""

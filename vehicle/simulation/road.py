@@ -166,9 +166,7 @@ class RoadCar(MountedCar):
         one row per step as :meth:`play` takes them, or none (held, the speed controller idle).
         Fewer samples when MuJoCo reset the state (:meth:`was_reset`): up to the first that follows
         the reset."""
-        inputs = np.ascontiguousarray(inputs, dtype=float)
-        if inputs.shape[0] not in (0, samples * every) or inputs.shape[1:] != _NO_INPUTS.shape[1:]:
-            raise ValueError(f"expected road inputs of shape ({samples * every}, {N_INPUTS}), got {inputs.shape}")
+        inputs, measured, pos, quat = self._sampling(samples, every, inputs, N_INPUTS, bodies, "road")
         m, d = self.model, self.data
         # the constraint rows as they are now (the brakes add or remove some between calls)
         mujoco.mj_forward(m, d)
@@ -178,8 +176,6 @@ class RoadCar(MountedCar):
         wheels = (d.xmat, d.xipos, d.xpos, self.wheel_body.astype(np.int64), self.chassis, self._sign, self._design_z,
                   self.tyre_signals)
         probe = (body, wheels, self.suspension_data(), self.suspension_args(rows))
-        measured = np.empty((samples, self.columns.size))
-        pos, quat = np.empty((samples, bodies.size, 3)), np.empty((samples, bodies.size, 4))
         done = self._timed(stepping.run_road_sampled, every, inputs, (m.eq_data, self.rack_eq, self.spin_dof,
                            m.dof_frictionloss), m._address, d._address, m.opt.timestep, self.coupling.kernel_arrays(),
                            self._tyre_args, self._driver, self.chassis, probe, bodies.astype(np.int64), d.xpos,

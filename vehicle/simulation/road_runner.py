@@ -26,7 +26,7 @@ from vehicle.scenarios.road_scenario import RoadCase, RoadScenario, steering_and
 from vehicle.scenarios.schedule import ROAD_PHASES, CaseSchedule, Progress, output_interval
 from vehicle.simulation.outputs import MeasuredColumns, SampleBlock
 from vehicle.simulation.road import N_INPUTS, RoadCar
-from vehicle.simulation.runner import PlayedScenario, blocks_of
+from vehicle.simulation.runner import CaseSamples, PlayedScenario, blocks_of
 from vsim_core.units import DEG_PER_RAD
 
 #: The brake that holds the car while it settles [N·m per wheel] (far above what the slope of the
@@ -70,50 +70,33 @@ class RoadRun(PlayedScenario):
         :data:`~vehicle.simulation.runner.BLOCK_SAMPLES`."""
         dt, scenario = self.dt, self.scenario
         every = output_interval(scenario, dt)
-        names = tuple(ch.name for ch in car.car.channels)
-        name = f"{number} '{case.label}'"
-        input_start = sum(when.steps[:3])
+        blocks = CaseSamples(self, car, number, case.label, when, sum(when.steps[:3]))
         lifted = np.zeros(len(CORNERS))
-        step = 0
-
-        def measure(phase: int, samples: int, apart: int, inputs: np.ndarray, driver: np.ndarray
-                    ) -> Iterator[SampleBlock]:
-            """``samples`` samples ``apart`` steps apart, with ``inputs`` one row per step (none: the
-            rack, drive and brakes held); ``driver`` (samples, 2): the steering-wheel angle [rad] and
-            the target speed [m/s] at each."""
-            nonlocal step
-            measured, pos, quat = car.sampled(samples, apart, inputs, self.recorded_bodies)
-            steps = step + apart * np.arange(1, len(measured) + 1)   # fewer samples after a reset
-            step = int(steps[-1])
-            block = SampleBlock(when.start_s + steps * dt, number, phase, (steps - input_start) * dt,
-                                driver[:len(measured)], measured, pos, quat)
-            # at speed only: before, wheels touch down and the body's slip means nothing
-            also = (lambda b: road_divergence(b, car.columns, scenario, lifted, every * dt)) if phase >= 2 else (
-                lambda b: None)
-            yield from self._checked(block, car.columns, names, car, name, also)
-            self._report(number, case.label, phase, float(block.time_s[-1]))
+        # at speed only: before, wheels touch down and the body's slip means nothing
+        at_speed = lambda b: road_divergence(b, car.columns, scenario, lifted, every * dt)
 
         def hold(phase: int, speed: float) -> Iterator[SampleBlock]:
             for samples in blocks_of(when.steps[phase] // every):
                 held = math.isnan(speed)   # the throttle held: no inputs, the speed controller idle
                 u = _NO_INPUTS if held else car.drive_inputs(np.zeros(samples * every), np.full(samples * every, speed))
-                yield from measure(phase, samples, every, u, np.array([[0.0, speed]] * samples))
+                yield from blocks.measure(phase, samples, every, u, np.array([[0.0, speed]] * samples),
+                                          at_speed if phase >= 2 else None)
 
         car.set_brakes(SETTLE_BRAKE_NM)
         with car.bushing_laws_off():
-            yield from measure(0, 1, 0, _NO_INPUTS, np.array([[0.0, math.nan]]))
+            yield from blocks.measure(0, 1, 0, _NO_INPUTS, np.array([[0.0, math.nan]]))
             yield from hold(0, math.nan)
         yield from hold(1, math.nan)
         car.set_brakes(0.0)
         car.set_speed(case.speed_mps)
         yield from hold(2, case.speed_mps)
         for samples in blocks_of(when.steps[3] // every):
-            t = (step - input_start + np.arange(1, samples * every + 1)) * dt / self.duration_scale
+            t = (blocks.step - blocks.input_start + np.arange(1, samples * every + 1)) * dt / self.duration_scale
             steering, speed = steering_and_speed(case, t, scenario.throttle)
             ahead = case.steering(t + car.rack_lead_s / self.duration_scale)
             at_samples = slice(every - 1, None, every)
-            yield from measure(3, samples, every, car.drive_inputs(ahead, speed),
-                               np.column_stack([steering[at_samples], speed[at_samples]]))
+            yield from blocks.measure(3, samples, every, car.drive_inputs(ahead, speed),
+                                      np.column_stack([steering[at_samples], speed[at_samples]]), at_speed)
 
 
 _NO_INPUTS = np.zeros((0, N_INPUTS))

@@ -150,23 +150,46 @@ class PlayedScenario:
             finally:
                 self.stepping_s += car.stepping_s
 
-    def _checked(self, block: SampleBlock, columns: MeasuredColumns, names: tuple[str, ...], car: MountedCar,
-                 case: str, also: Callable[[SampleBlock], tuple[int, str] | None] = lambda block: None
-                 ) -> Iterator[SampleBlock]:
-        """``block``; if the car left its valid range in it (:func:`divergence`, then ``also``),
-        its rows up to the first that shows it, then DivergenceError."""
-        found = [f for f in (divergence(block, columns, names, car, self.scenario), also(block)) if f is not None]
-        if found:
-            row, what = min(found, key=lambda f: f[0])   # the suspension's reason first at one row
-            yield block.upto(row)
-            raise DivergenceError(float(block.time_s[row]), case, what)
-        yield block
-
     def _report(self, number: int, label: str, phase: int, time_s: float) -> None:
         """Tell ``progress`` (if any) where the run is."""
         if self.progress is not None:
             self.progress(Progress(number, len(self.scenario.cases), label, phase, self.phases[phase], time_s,
                                    self.total_s))
+
+
+class CaseSamples:
+    """The blocks of one case of ``play`` on its ``car``: each :meth:`measure` samples the car (its
+    ``sampled``), places the samples on the run's time axis, checks them and reports progress."""
+
+    def __init__(self, play: PlayedScenario, car: Any, number: int, label: str, when: CaseSchedule,
+                 input_start: int):
+        """``input_start``: the case's step at which its input starts."""
+        self.play, self.car, self.number, self.label, self.when = play, car, number, label, when
+        self.input_start = input_start
+        self.names = tuple(ch.name for ch in car.car.channels)
+        #: Steps the case has made so far.
+        self.step = 0
+
+    def measure(self, phase: int, samples: int, apart: int, inputs: np.ndarray, recorded: np.ndarray,
+                also: Callable[[SampleBlock], tuple[int, str] | None] | None = None) -> Iterator[SampleBlock]:
+        """``samples`` samples ``apart`` steps apart, with ``inputs`` one row per step (none: held),
+        ``recorded`` (samples, inputs) the block's inputs at each sample. If the car left its valid
+        range (:func:`divergence`, then ``also``), the rows up to the first that shows it, then
+        DivergenceError."""
+        dt, car = self.play.dt, self.car
+        measured, pos, quat = car.sampled(samples, apart, inputs, self.play.recorded_bodies)
+        steps = self.step + apart * np.arange(1, len(measured) + 1)   # fewer samples after a reset
+        self.step = int(steps[-1])
+        block = SampleBlock(self.when.start_s + steps * dt, self.number, phase, (steps - self.input_start) * dt,
+                            recorded[:len(measured)], measured, pos, quat)
+        found = [f for f in (divergence(block, car.columns, self.names, car, self.play.scenario),
+                             also and also(block)) if f is not None]
+        if found:
+            row, what = min(found, key=lambda f: f[0])   # the suspension's reason first at one row
+            yield block.upto(row)
+            raise DivergenceError(float(block.time_s[row]), f"{self.number} '{self.label}'", what)
+        yield block
+        self.play._report(self.number, self.label, phase, float(block.time_s[-1]))
 
 
 class ScenarioRun(PlayedScenario):
@@ -180,37 +203,24 @@ class ScenarioRun(PlayedScenario):
     def _case(self, rig: KCRig, case: Case, number: int, when: CaseSchedule) -> Iterator[SampleBlock]:
         """The samples of one case from a fresh rig, one every output interval, in blocks of at most
         :data:`BLOCK_SAMPLES` measured in compiled code."""
-        dt, scenario = self.dt, self.scenario
-        every = output_interval(scenario, dt)
-        names = tuple(ch.name for ch in rig.car.channels)
-        name = f"{number} '{case.label}'"
-        input_start = sum(when.steps[:2])
-        step = 0
-
-        def measure(phase: int, samples: int, apart: int, inputs: np.ndarray) -> Iterator[SampleBlock]:
-            """``samples`` samples ``apart`` steps apart, with ``inputs`` one row per step (none: held)."""
-            nonlocal step
-            measured, pos, quat = rig.sampled(samples, apart, inputs, self.recorded_bodies)
-            steps = step + apart * np.arange(1, len(measured) + 1)   # fewer samples after a reset
-            step = int(steps[-1])
-            held = np.zeros((len(measured), len(INPUT_CHANNELS)))
-            block = SampleBlock(when.start_s + steps * dt, number, phase, (steps - input_start) * dt,
-                                inputs[apart - 1::apart][:len(measured)] if len(inputs) else held, measured, pos, quat)
-            yield from self._checked(block, rig.columns, names, rig, name)
-            self._report(number, case.label, phase, float(block.time_s[-1]))
+        dt = self.dt
+        every = output_interval(self.scenario, dt)
+        blocks = CaseSamples(self, rig, number, case.label, when, sum(when.steps[:2]))
+        held = lambda samples: np.zeros((samples, len(INPUT_CHANNELS)))
 
         def hold(phase: int) -> Iterator[SampleBlock]:
             for samples in blocks_of(when.steps[phase] // every):
-                yield from measure(phase, samples, every, _HELD)
+                yield from blocks.measure(phase, samples, every, _HELD, held(samples))
 
         rig.set_inputs(np.zeros(len(INPUT_CHANNELS)))
         with rig.bushing_laws_off():
-            yield from measure(0, 1, 0, _HELD)
+            yield from blocks.measure(0, 1, 0, _HELD, held(1))
             yield from hold(0)
         yield from hold(1)
         for samples in blocks_of(when.steps[2] // every):
-            t = (step - input_start + np.arange(1, samples * every + 1)) * dt / self.duration_scale
-            yield from measure(2, samples, every, case.inputs(t))
+            t = (blocks.step - blocks.input_start + np.arange(1, samples * every + 1)) * dt / self.duration_scale
+            u = case.inputs(t)
+            yield from blocks.measure(2, samples, every, u, u[every - 1::every])
 
 
 _HELD = np.zeros((0, len(INPUT_CHANNELS)))
