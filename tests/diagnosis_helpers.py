@@ -14,7 +14,8 @@ from typing import Callable
 
 import numpy as np
 
-from vsim_diagnosis.catalogue import CAUSES, draw
+from bushings.parameter_sets import load_parameter_set
+from vsim_diagnosis.catalogue import CAUSES, applicable, draw
 from vsim_diagnosis.virtual_bench import OUTSIDE, measure_bench, parse_truth
 
 
@@ -34,8 +35,10 @@ def _slow_seeds(spec: str) -> range:
 #: Seeds of the slow suites' success-rate tests, 20 per cause (VSIM_SLOW_SEEDS, see _slow_seeds, runs
 #: a part of them; the issue's figure is the full 20).
 SLOW_SEEDS = _slow_seeds(os.environ.get("VSIM_SLOW_SEEDS", "20"))
-#: The success rate over all draws that the slow suites require.
+#: The success rate over all draws that the slow suites require (of a single cause).
 MIN_SUCCESS_RATE = 0.9
+#: The rate at which both causes of a pair must be named (issue 29).
+MIN_PAIR_SUCCESS_RATE = 0.8
 #: The user property in which a success-rate test records its tally (cause, right, draws, wrong seeds).
 TALLY = "diagnosis_tally"
 #: The bench baseline each cause is hidden in: the viscoelastic causes need an STS or RT baseline.
@@ -56,9 +59,24 @@ def hidden_truth(cause: str, seed: int) -> tuple[str, list[dict]]:
     return baseline, [{"cause": cause, **draw(CAUSES[cause], rng)}]
 
 
+#: The kind of truth :func:`measure` draws two causes for (:func:`hidden_pair`).
+PAIR = "pair"
+
+
+def hidden_pair(seed: int) -> tuple[str, list[dict]]:
+    """(baseline set, effects): a baseline drawn among the catalogue's three ladder laws and two
+    different causes that apply to it, each with its magnitude drawn in its realistic range."""
+    rng = np.random.default_rng([seed, sum(map(ord, PAIR))])
+    baseline = str(rng.choice(sorted({*BASELINES.values(), DEFAULT_BASELINE})))
+    fits = applicable(load_parameter_set(baseline))
+    first, second = rng.choice(len(fits), size=2, replace=False)
+    return baseline, [{"cause": fits[k].id, **draw(fits[k], rng)} for k in (first, second)]
+
+
 def measure(tmp: Path, cause: str, seed: int) -> tuple[str, list[dict], Path]:
-    """Measure a drawn truth into ``tmp/measured``; the noise and zero errors come from the seed too."""
-    baseline, effects = hidden_truth(cause, seed)
+    """Measure a drawn truth into ``tmp/measured`` (``cause``: a catalogue or OUTSIDE id, ``none``,
+    or PAIR for two causes at once); the noise and zero errors come from the seed too."""
+    baseline, effects = hidden_pair(seed) if cause == PAIR else hidden_truth(cause, seed)
     truth = parse_truth({"level": "bench", "baseline": baseline, "effects": effects, "seed": seed}, "<test truth>")
     out = measure_bench(truth, tmp / "rig_output")
     copy = tmp / "measured"
@@ -78,9 +96,9 @@ def diagnose_fresh(directory: Path, baseline: str, report: Path | None = None) -
 
 
 def assert_success_rate(cause: str, seeds: range, tmp: Path, attempt: Callable[[Path, int], None],
-                        record: Callable[[str, object], None]) -> None:
+                        record: Callable[[str, object], None], min_rate: float = MIN_SUCCESS_RATE) -> None:
     """``attempt(directory, seed)`` for every seed, in a fresh directory each: an AssertionError is a
-    wrong diagnosis (printed with its seed as it comes); the rate must reach MIN_SUCCESS_RATE.
+    wrong diagnosis (printed with its seed as it comes); the rate must reach ``min_rate``.
     ``record`` is pytest's ``record_property``: the tally goes to the run's summary (tests/conftest.py),
     which ``pytest -n`` does not swallow as it does what tests print."""
     right, wrong = 0, []
@@ -97,4 +115,4 @@ def assert_success_rate(cause: str, seeds: range, tmp: Path, attempt: Callable[[
     record(TALLY, {"cause": cause, "right": right, "draws": len(seeds), "wrong": wrong})
     rate = right / len(seeds)
     print(f"\n{cause}: {right}/{len(seeds)} diagnosed right ({rate:.0%})")
-    assert rate >= MIN_SUCCESS_RATE
+    assert rate >= min_rate

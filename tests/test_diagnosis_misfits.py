@@ -9,8 +9,9 @@ import numpy as np
 import pytest
 
 from vehicle.scenarios.scenario import Scenario
-from vsim_diagnosis import kc_diagnosis
-from vsim_diagnosis.kc_diagnosis import Job, Layout, _Scorer, located_misfits
+from vsim_diagnosis.kc_diagnosis import located_misfits
+from vsim_diagnosis.kc_layout import Job, Layout, Test
+from vsim_diagnosis.kc_fits import Scorer
 from scipy.special import gammaincc
 
 from vsim_diagnosis.verdict import MISFIT_CHANCE, decide, explained, misfit, misfit_stretch, split
@@ -29,7 +30,7 @@ def synthetic(rng: np.random.Generator, bump: bool) -> tuple[Layout, np.ndarray,
     tests, start = [], 0
     dummy = Job(Scenario.__new__(Scenario), None, 1.0, tuple(CHANNELS))
     for i, n in enumerate(lengths):
-        tests.append(kc_diagnosis.Test(f"test {i}", dummy, np.arange(start, start + n)))
+        tests.append(Test(f"test {i}", dummy, np.arange(start, start + n)))
         start += n
     baseline = np.cumsum(rng.normal(0.0, 0.05, (start, len(CHANNELS))), axis=0)   # any smooth prediction
     recording = np.concatenate([np.full(n, i // 2) for i, n in enumerate(lengths)])
@@ -56,7 +57,7 @@ def synthetic(rng: np.random.Generator, bump: bool) -> tuple[Layout, np.ndarray,
 def test_a_local_misfit_is_found_in_its_test_stretch_and_channel(seed: int) -> None:
     layout, baseline, (t, first, last, channel) = synthetic(np.random.default_rng(seed), bump=True)
     heldout = split(len(layout.tests))
-    scorer = _Scorer(layout, baseline, heldout)
+    scorer = Scorer(layout, baseline, heldout)
     errors = scorer.test_errors(baseline)
     found = located_misfits(layout, scorer, baseline)
     assert [m.test for m in found] == [f"test {t}"], errors
@@ -76,7 +77,7 @@ def test_a_local_misfit_is_found_in_its_test_stretch_and_channel(seed: int) -> N
 @pytest.mark.parametrize("seed", range(40))
 def test_noise_alone_is_never_a_misfit(seed: int) -> None:
     layout, baseline, _ = synthetic(np.random.default_rng(1000 + seed), bump=False)
-    scorer = _Scorer(layout, baseline, split(len(layout.tests)))
+    scorer = Scorer(layout, baseline, split(len(layout.tests)))
     errors = scorer.test_errors(baseline)
     residual = scorer.residual(baseline, np.ones(len(baseline), dtype=bool), np.median)
     for t, e in zip(layout.tests, errors):

@@ -29,4 +29,4 @@ def test_tallies_are_summed_up_per_file_under_xdist(pytester, monkeypatch):
                                   r"test_rates.py  asymmetry +9/10 +wrong: seeds 103$",
                                   r"test_rates.py  mullins +10/10$",
                                   r"test_rates.py  none +8/10 +wrong: seeds 100, 101$",
-                                  r"test_rates.py  all draws +27/30 +\(90%; required at least 90%\)$"])
+                                  r"test_rates.py  all single draws +27/30 +\(90%; required at least 90%\)$"])

@@ -31,7 +31,8 @@ from vsim_cluster.executor import TaskFailed, executor
 from vsim_core.shipped import DEFAULT_VEHICLE
 from vsim_diagnosis.kc_catalogue import (BUSHING_CAUSES, MIN_EXCESS, VEHICLE_CAUSES, Hypothesis, extended_vehicle,
                                          locations, parameters)
-from vsim_diagnosis.kc_diagnosis import COMPARED, _nominal
+from vsim_diagnosis.kc_layout import COMPARED
+from vsim_diagnosis.kc_fits import nominal
 from vsim_diagnosis.virtual_kc_rig import DEFAULT_SCENARIOS, MEASUREMENT_DEFAULTS, sensor
 from vsim_recordings.recorder import simulate
 
@@ -40,7 +41,7 @@ def weak(cause: str) -> list[dict[str, float]]:
     """The cause's values at the weak end of its range: the first parameter at the low end of its
     draw (of either sign, for a sided cause), the others mid-range."""
     first = parameters(cause)[0]
-    return [{**_nominal(cause), first.name: sign * first.draw[0]} for sign in first.signs]
+    return [{**nominal(cause), first.name: sign * first.draw[0]} for sign in first.signs]
 
 
 def floor(cause: str, excess_at_weak_end: float) -> float:

@@ -1,7 +1,9 @@
 """Diagnosis of a bushing-bench dataset (spec measured-data §2): replay the measured deflections
 through the baseline law, quantify the mismatch, fit every applicable cause of the catalogue on
 half of the tests, score it on the other half, and name the cause that explains the mismatch, or
-say that nothing significant is missing, or that the mismatch is real but unexplained.
+say that nothing significant is missing, or that the mismatch is real but unexplained. When the
+best cause leaves a mismatch beyond the noise, every pair of causes is fitted the same way, and
+two are named when the pair removes most of what the best one left.
 
 The measured deflection drives the simulation (as a bench drives the part), record after record
 with the rests between them, so that the part's state carries over as on the rig. A constant
@@ -10,6 +12,7 @@ load-cell zero error is a nuisance fitted in closed form for every model alike.
 
 from __future__ import annotations
 
+import itertools
 import math
 import os
 import time
@@ -23,12 +26,17 @@ from scipy.optimize import least_squares
 
 from bushings.extended_bank import ExtendedBank
 from bushings.parameter_sets import ParameterSet
-from vsim_diagnosis.catalogue import Cause, applicable
-from vsim_diagnosis.verdict import Outcome, decide, explained, split
+from vsim_diagnosis.catalogue import PAIR_SEPARATOR, Cause, applicable, combined, parts
+from vsim_diagnosis.verdict import (Outcome, decide, explained, pair_named, pair_shares, second_cause_wanted,
+                                    split)
 from vsim_recordings.bench_dataset import BenchDataset
 
 #: Penalty per fitted parameter on the held-out error used for ranking.
 PARAMETER_PENALTY = 0.02
+#: Function evaluations of a pair's fit, which starts from its two causes' own fits or the best
+#: corner of their range (less than half a single cause's 15: each evaluation of a 4-parameter pair
+#: costs 5 replays, and the pair stage fits up to 15 pairs).
+PAIR_NFEV = 6
 #: Longest step used to simulate a rest between tests [s].
 REST_STEP_S = 0.05
 #: Ladder solver tolerance of the replays [m]: force errors below 0.3 N, under a load cell's noise.
@@ -126,22 +134,26 @@ class Candidate:
     #: uncertainty of ``final``: the larger of the linearised standard error and the shift from ``values``
     std: dict[str, float] = field(default_factory=dict)
     model: ParameterSet | None = None                       #: the extended baseline with ``final``
+    fit_s: float = 0.0                 #: wall time of its fit and score [s] (to schedule the longest first)
 
 
 @dataclass
 class BenchDiagnosis(Outcome):
     """The outcome: a cause (or none, or unexplained) with its evidence."""
 
-    verdict: str                        #: a catalogue id, "none" or "unexplained"
+    verdict: str                        #: a catalogue id, two joined by "+", "none" or "unexplained"
     baseline: ParameterSet
     replay: Replay
     heldout: np.ndarray                 #: boolean mask of held-out records
     baseline_errors: np.ndarray         #: per-record relative error of the baseline
     noise: np.ndarray                   #: per-record relative noise floor
     ranking: list[Candidate]
-    best: Candidate | None
+    best: Candidate | None              #: the named cause or pair; else the best single cause
     part: str
     wall_s: float = 0.0
+    #: the second stage (:func:`vsim_diagnosis.verdict.second_cause_wanted`): every pair of causes,
+    #: best first; empty when the best single cause left nothing beyond the noise
+    pairs: list[Candidate] = field(default_factory=list)
 
     @property
     def heldout_error_before(self) -> float:
@@ -159,6 +171,19 @@ class BenchDiagnosis(Outcome):
         (:func:`vsim_diagnosis.verdict.explained`; the tests judged together)."""
         return explained(self.verdict, self.heldout_error_before, self.heldout_error_after,
                          aggregate(self.noise, self.heldout))
+
+    @property
+    def shares(self) -> list[float]:
+        """Per named cause, the share of the mismatch it explains; of two, each cause's gain averaged
+        over the two orders of adding them (:func:`vsim_diagnosis.verdict.pair_shares`)."""
+        if not self.named:
+            return []
+        if PAIR_SEPARATOR not in self.verdict:
+            return [self.explained[1]]
+        floor = aggregate(self.noise, self.heldout)
+        alone = {c.cause.id: c.heldout_error for c in self.ranking}
+        return list(pair_shares(self.heldout_error_before, [alone[c.id] for c in parts(self.verdict)],
+                                self.heldout_error_after, floor))
 
 
 class _Objective:
@@ -206,6 +231,11 @@ def _grid(cause: Cause) -> np.ndarray:
         if len(cause.parameters) == 1:
             pts = np.array([pts.mean()])
         axes.append(np.r_[-pts[::-1], pts] if p.signed else pts)
+    return _points(axes)
+
+
+def _points(axes: list[np.ndarray]) -> np.ndarray:
+    """Every combination of the values on each axis, one point a row."""
     return np.array(np.meshgrid(*axes, indexing="ij")).reshape(len(axes), -1).T
 
 
@@ -213,17 +243,33 @@ def _to_fit(cause: Cause, values: dict[str, float]) -> np.ndarray:
     return np.array([math.log(values[p.name]) if p.log else values[p.name] for p in cause.parameters])
 
 
+def _sides(cause: Cause, values: dict[str, float]) -> np.ndarray:
+    """Starting points from ``values``, with every sided parameter also on its other side (a
+    least-squares fit cannot cross zero to the other effect; at zero, both sides at the weak end of
+    its realistic range)."""
+    axes = []
+    for p, z in zip(cause.parameters, _to_fit(cause, values)):
+        if p.sided:
+            z = z if abs(z) > 1e-12 else p.draw[0]
+            axes.append(np.array([z, -z]))
+        else:
+            axes.append(np.array([z]))
+    return _points(axes)
+
+
 def fit_cause(replay: Replay, base: ParameterSet, cause: Cause, train: np.ndarray,
-              start: dict[str, float] | None = None, max_nfev: int = 15) -> tuple[dict[str, float], dict[str, float]]:
-    """Least-squares fit of a cause's parameters on the training records, from ``start`` or the
-    best of a few starting points; returns the values and their standard uncertainties
-    (linearised, from the Jacobian and the residual variance)."""
+              start: dict[str, float] | None = None, max_nfev: int = 15, corners: bool = False
+              ) -> tuple[dict[str, float], dict[str, float]]:
+    """Least-squares fit of a cause's parameters on the training records, from ``start``, or from the
+    best of a few starting points: the corners of the realistic range (no ``start``), or, with
+    ``corners``, those and ``start`` with every sided parameter on either side; returns the values
+    and their standard uncertainties (linearised, from the Jacobian and the residual variance)."""
     obj = _Objective(replay, base, cause, train)
     if start is None:
         grid = _grid(cause)
-        z0 = grid[int(np.argmin((obj.residuals(grid) ** 2).sum(axis=1)))] if len(grid) > 1 else grid[0]
     else:
-        z0 = _to_fit(cause, start)
+        grid = np.vstack([_sides(cause, start), _grid(cause)]) if corners else _to_fit(cause, start)[None]
+    z0 = grid[int(np.argmin((obj.residuals(grid) ** 2).sum(axis=1)))] if len(grid) > 1 else grid[0]
     lo, hi = _coordinates(cause)
     sol = least_squares(obj.fun, np.clip(z0, lo + 1e-9, hi - 1e-9), jac=obj.jac, bounds=(lo, hi),
                         x_scale=1.0, max_nfev=max_nfev, method="trf", ftol=1e-6, xtol=1e-6)
@@ -258,23 +304,37 @@ def diagnose_bench(data: BenchDataset, baseline: ParameterSet,
     base_errors = replay.record_errors(base_res)
     noise = replay.noise_floor(base_res)
 
-    def score(cause: Cause) -> Candidate:
-        values, _ = fit_cause(replay, baseline, cause, train)
+    def score(cause: Cause, start: dict[str, float] | None = None) -> Candidate:
+        began = time.perf_counter()
+        values, _ = fit_cause(replay, baseline, cause, train, start, PAIR_NFEV if start else 15, corners=True)
         res = replay.residuals(replay.simulate([cause.apply(baseline, values)]), train)[0]
         errors = replay.record_errors(res)
         err = aggregate(errors, heldout)
         say(f"{cause.id}: held-out error {err:.4f} (baseline {aggregate(base_errors, heldout):.4f})")
-        return Candidate(cause, values, err, errors, err * (1.0 + PARAMETER_PENALTY * len(cause.parameters)))
+        return Candidate(cause, values, err, errors, err * (1.0 + PARAMETER_PENALTY * len(cause.parameters)),
+                         fit_s=time.perf_counter() - began)
 
     causes = applicable(baseline)
     say(f"fitting {len(causes)} causes on {int(train.sum())} tests, scoring each on the {int(heldout.sum())} held out")
     # The replays release the GIL: one fit per core.
     with ThreadPoolExecutor(max_workers=min(len(causes), os.cpu_count() or 1) or 1) as pool:
         ranking = sorted(pool.map(score, causes), key=lambda c: c.score)
-    before = aggregate(base_errors, heldout)
-    floor = aggregate(noise, heldout)
-    best = ranking[0] if ranking else None
-    verdict = decide(before, best.heldout_error if best else before, floor)
+        before = aggregate(base_errors, heldout)
+        floor = aggregate(noise, heldout)
+        best = ranking[0] if ranking else None
+        verdict = decide(before, best.heldout_error if best else before, floor)
+        pairs: list[Candidate] = []
+        if best is not None and second_cause_wanted(best.heldout_error, floor):
+            say(f"{best.cause.id} leaves {best.heldout_error:.4f} (noise {floor:.4f}): fitting every pair of causes")
+            # the better-ranked cause of a pair first; from the two causes' own fits or the corners of their
+            # range (two effects that hide each other fit badly alone)
+            # the pairs whose causes took longest alone first, so that no long fit runs alone at the end
+            combos = sorted(itertools.combinations(ranking, 2), key=lambda ab: -(ab[0].fit_s + ab[1].fit_s))
+            pairs = sorted(pool.map(lambda ab: score(combined(ab[0].cause, ab[1].cause),
+                                                     {**ab[0].values, **ab[1].values}), combos),
+                           key=lambda c: (c.score, c.cause.id))
+            if pairs and pair_named(before, best.heldout_error, pairs[0].heldout_error, floor):
+                best, verdict = pairs[0], "named"
     if verdict == "named":
         say(f"refitting {best.cause.id} on every test")
         best.final, linearised = fit_cause(replay, baseline, best.cause, everything, start=best.values, max_nfev=6)
@@ -284,4 +344,4 @@ def diagnose_bench(data: BenchDataset, baseline: ParameterSet,
                                       source=f"{baseline.name} extended by {best.cause.id}, fitted by vsim diagnose "
                                              f"on {data.path.name} ({len(replay.names)} bench tests)")
     return BenchDiagnosis(best.cause.id if verdict == "named" else verdict, baseline, replay, heldout,
-                          base_errors, noise, ranking, best, data.part, time.perf_counter() - started)
+                          base_errors, noise, ranking, best, data.part, time.perf_counter() - started, pairs)

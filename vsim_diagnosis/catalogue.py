@@ -169,6 +169,28 @@ CAUSES: dict[str, Cause] = {c.id: c for c in (
 )}
 
 
+#: Every parameter name belongs to one cause, so that two causes' values can share one mapping.
+assert len({p.name for c in CAUSES.values() for p in c.parameters}) == sum(len(c.parameters) for c in CAUSES.values())
+#: Joins the ids of two causes found together (ids use only letters and underscores).
+PAIR_SEPARATOR = "+"
+
+
+def combined(first: Cause, second: Cause) -> Cause:
+    """Two causes at once, as one cause: the baseline extended by ``first``, then by ``second``, with
+    both causes' parameters (id ``first+second``; :func:`parts` splits it back)."""
+    def extend(params: dict, effects: dict, v: Mapping[str, float]) -> tuple[dict, dict]:
+        return second.extend(*first.extend(params, effects, v), v)
+
+    return Cause(f"{first.id}{PAIR_SEPARATOR}{second.id}", f"{first.physics}; and {second.physics}",
+                 f"{first.signature}; and {second.signature}", first.parameters + second.parameters,
+                 lambda b: first.applies(b) and second.applies(b), extend)
+
+
+def parts(cause_id: str) -> list[Cause]:
+    """The catalogue causes a (possibly combined, :func:`combined`) cause id names, in order."""
+    return [CAUSES[i] for i in cause_id.split(PAIR_SEPARATOR)]
+
+
 def applicable(base: ParameterSet) -> list[Cause]:
     """The causes that can extend this baseline (e.g. missing viscoelasticity only on an STS)."""
     return [c for c in CAUSES.values() if c.applies(base)]

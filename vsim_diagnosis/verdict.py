@@ -6,6 +6,7 @@ is missing, or the mismatch is real but unexplained."""
 from __future__ import annotations
 
 import math
+from typing import Sequence
 
 import numpy as np
 from scipy.special import gammaincc
@@ -27,13 +28,14 @@ def split(n_tests: int) -> np.ndarray:
 
 
 class Outcome:
-    """What a diagnosis concluded: ``verdict`` is a catalogue id, ``none`` or ``unexplained``."""
+    """What a diagnosis concluded: ``verdict`` is a catalogue id (two joined by "+" when two causes
+    are named), ``none`` or ``unexplained``."""
 
     verdict: str
 
     @property
     def named(self) -> bool:
-        """True when a catalogue cause is named (then the outcome's ``best`` is it)."""
+        """True when a catalogue cause (or two) is named."""
         return self.verdict not in NOT_NAMED
 
 
@@ -94,9 +96,7 @@ def explained(verdict: str, before: float, after: float, floor: float, misfit_le
         return "full", 1.0
     if verdict == "unexplained":
         return "none", 0.0
-    excess_before = before ** 2 - floor ** 2
-    share = 1.0 - max(after ** 2 - floor ** 2, 0.0) / excess_before if excess_before > 0.0 else 1.0
-    return ("partial" if after > NOISE_FACTOR * floor or misfit_left else "full"), min(max(share, 0.0), 1.0)
+    return ("partial" if after > NOISE_FACTOR * floor or misfit_left else "full"), share(before, after, floor)
 
 
 def decide(before: float, after: float, floor: float, misfit_seen: bool = False) -> str:
@@ -109,3 +109,37 @@ def decide(before: float, after: float, floor: float, misfit_seen: bool = False)
     if after <= before * (1.0 - MIN_GAIN) and excess_after <= MAX_EXCESS_LEFT * excess_before:
         return "named"
     return "none" if before <= NOISE_FACTOR * floor and not misfit_seen else "unexplained"
+
+
+def second_cause_wanted(after: float, floor: float, misfit_left: bool = False) -> bool:
+    """Whether to look for two causes at once: the best single one leaves a held-out error ``after``
+    beyond NOISE_FACTOR times the noise ``floor``, or a test it still does not fit (whether or not
+    it explains anything: two effects can hide each other, e.g. a preload and an asymmetry of
+    opposite sides)."""
+    return after > NOISE_FACTOR * floor or misfit_left
+
+
+def pair_named(before: float, single: float, pair: float, floor: float) -> bool:
+    """Whether two causes are named: the pair's held-out error ``pair`` beats the best single
+    cause's ``single`` as a cause must beat the baseline (:func:`decide`: what the second cause
+    removes is most of what the first left, not a fit of the noise), and the pair explains the
+    baseline's mismatch ``before`` as one cause must."""
+    return decide(single, pair, floor) == "named" and decide(before, pair, floor) == "named"
+
+
+def share(before: float, after: float, floor: float) -> float:
+    """The share of the excess over the noise ``floor`` (in variance) that takes the error from
+    ``before`` to ``after``: 1 − excess_after² / excess_before², within [0, 1]."""
+    excess_before = before ** 2 - floor ** 2
+    if excess_before <= 0.0:
+        return 1.0
+    return min(max(1.0 - max(after ** 2 - floor ** 2, 0.0) / excess_before, 0.0), 1.0)
+
+
+def pair_shares(before: float, alone: Sequence[float], pair: float, floor: float) -> tuple[float, float]:
+    """Each of two causes' share of the mismatch: its gain averaged over the two orders of adding
+    them (from the held-out errors ``before``, with each cause ``alone`` and with the ``pair``); the
+    two add up to the pair's share. Two effects that hide each other share the whole alike."""
+    whole = share(before, pair, floor)
+    a, b = (share(before, e, floor) for e in alone)
+    return 0.5 * (a + whole - b), 0.5 * (b + whole - a)

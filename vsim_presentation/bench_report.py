@@ -12,7 +12,8 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from bushings.parameter_sets import save_parameter_set
-from vsim_diagnosis.bench_diagnosis import BenchDiagnosis, aggregate
+from vsim_diagnosis.bench_diagnosis import BenchDiagnosis, Candidate, aggregate
+from vsim_diagnosis.catalogue import PAIR_SEPARATOR, Cause, parts
 from vsim_diagnosis.verdict import MIN_GAIN
 from vsim_core.units import MM_PER_M
 from vsim_presentation.diagnosis_report import Report, partly_explained, ranking_chart
@@ -36,11 +37,17 @@ def record_features(d: BenchDiagnosis) -> list[dict[str, float]]:
     return out
 
 
-def _parameters(d: BenchDiagnosis) -> dict[str, Any]:
+def _parameters(d: BenchDiagnosis, cause: Cause | None = None) -> dict[str, Any]:
+    """The named causes' fitted values (of ``cause`` only, one of them, if given)."""
     if not d.named:
         return {}
     return {p.name: {"value": d.best.final[p.name], "std": d.best.std.get(p.name, math.nan), "unit": p.unit}
-            for p in d.best.cause.parameters}
+            for p in (cause or d.best.cause).parameters}
+
+
+def _candidates(candidates: list[Candidate]) -> list[dict[str, Any]]:
+    return [{"cause": c.cause.id, "heldout_error": c.heldout_error, "score": c.score,
+             "n_parameters": len(c.cause.parameters), "parameters": c.values} for c in candidates]
 
 
 def summary(d: BenchDiagnosis) -> dict[str, Any]:
@@ -48,16 +55,16 @@ def summary(d: BenchDiagnosis) -> dict[str, Any]:
     return {
         "cause": d.verdict,
         "location": {"level": "bench", "part": d.part} if d.named else None,
-        "parameters": _parameters(d),
+        "parameters": _parameters(d, parts(d.verdict)[0]) if d.named else {},
         "heldout_error_before": d.heldout_error_before,
         "heldout_error_after": d.heldout_error_after,
         "noise_floor": aggregate(d.noise, d.heldout),
-        "ranking": [{"cause": c.cause.id, "heldout_error": c.heldout_error, "score": c.score,
-                     "n_parameters": len(c.cause.parameters), "parameters": c.values} for c in d.ranking],
+        "ranking": _candidates(d.ranking),
+        "pairs": _candidates(d.pairs),
         "explained": d.explained[0],
         "share_explained": d.explained[1],
-        "causes": [{"cause": d.verdict, "location": {"level": "bench", "part": d.part}, "parameters": _parameters(d),
-                    "share_explained": d.explained[1]}] if d.named else [],
+        "causes": [{"cause": c.id, "location": {"level": "bench", "part": d.part}, "parameters": _parameters(d, c),
+                    "share_explained": share} for c, share in zip(parts(d.verdict), d.shares)] if d.named else [],
         "tests": [{"name": n, "heldout": bool(h), "error_before": float(b),
                    "error_after": float(d.best.record_errors[k]) if d.named else float(b)}
                   for k, (n, h, b) in enumerate(zip(d.replay.names, d.heldout, d.baseline_errors))],
@@ -76,8 +83,11 @@ def verdict_sentence(d: BenchDiagnosis) -> str:
         best = d.ranking[0] if d.ranking else None
         partial = f"; the best catalogue cause, {best.cause.id}, only brings it to {best.heldout_error:.2%}" if best else ""
         return f"The mismatch is real ({before:.2%} held-out error) but no catalogue cause explains it{partial}."
-    values = ", ".join(f"{k} = {v['value']:.4g} ± {v['std']:.2g} {v['unit']}" for k, v in _parameters(d).items())
-    sentence = f"Cause: **{d.verdict}** ({values}); held-out error {before:.2%} → {after:.2%} of the force range."
+    named = " and ".join(f"**{c.id}** (" + ", ".join(f"{k} = {v['value']:.4g} ± {v['std']:.2g} {v['unit']}"
+                                                     for k, v in _parameters(d, c).items()) + ")"
+                         for c in parts(d.verdict))
+    sentence = (f"Cause{'s' if PAIR_SEPARATOR in d.verdict else ''}: {named}; held-out error {before:.2%} → "
+                f"{after:.2%} of the force range.")
     how, share = d.explained
     if how == "partial":
         sentence += partly_explained(share)
@@ -162,6 +172,13 @@ def write_report(d: BenchDiagnosis, out_dir: Path) -> list[Path]:
                  + [(c.cause.id, str(len(c.cause.parameters)), f"{c.heldout_error:.3%}", f"{c.score:.3%}",
                      ", ".join(f"{p.name} = {c.values[p.name]:.4g} {p.unit}" for p in c.cause.parameters))
                     for c in d.ranking])
+    if d.pairs:
+        report.paragraph(f"Second stage: {d.ranking[0].cause.id} left a mismatch beyond the noise; every pair of "
+                         f"causes fitted (two are named when the pair removes most of what the best one left):")
+        report.table(("causes", "parameters", "held-out error", "fitted values"),
+                     [(c.cause.id, str(len(c.cause.parameters)), f"{c.heldout_error:.3%}",
+                       ", ".join(f"{p.name} = {c.values[p.name]:.4g} {p.unit}" for p in c.cause.parameters))
+                      for c in d.pairs])
     report.picture("ranking.png")
     report.section("Tests")
     report.table(("test", "held out", "amplitude [mm]", "static [mm]", "speed [mm/s]", "error before", "error after"),

@@ -13,8 +13,10 @@ from matplotlib.figure import Figure
 
 from vehicle.model.definition import VehicleDefinition
 from vsim_core.files import atomic_output
-from vsim_diagnosis.kc_catalogue import extended_vehicle_yaml, parameters
+from vsim_diagnosis.catalogue import PAIR_SEPARATOR
+from vsim_diagnosis.kc_catalogue import Hypothesis, extended_vehicle_yaml, parameters
 from vsim_diagnosis.kc_diagnosis import KCDiagnosis, Misfit
+from vsim_diagnosis.kc_fits import Candidate
 from vsim_diagnosis.verdict import MISFIT_CHANCE, NOISE_FACTOR
 from vsim_presentation.diagnosis_report import Report, partly_explained, ranking_chart
 from vsim_presentation.figures import save_figure
@@ -23,37 +25,57 @@ from vsim_presentation.figures import save_figure
 OVERLAYS = 4
 
 
-def _parameters(d: KCDiagnosis) -> dict[str, Any]:
-    """The named cause's parameters, each with its uncertainty if it was fitted: the screening fits
-    only the first, with a second held at mid-range (``"fitted": false``, no uncertainty); the refit
-    fits both."""
+def _parameters(d: KCDiagnosis, c: Candidate | None = None) -> dict[str, Any]:
+    """A named cause's parameters (the first's, or ``c``'s), each with its uncertainty if it was
+    fitted: the screening fits only the first, with a second held at mid-range (``"fitted": false``,
+    no uncertainty); the refit fits both."""
     if not d.named:
         return {}
-    return {p.name: {"value": d.best.hypothesis.values[p.name], "std": d.best.std.get(p.name), "unit": p.unit,
-                     "fitted": p.name in d.best.std} for p in parameters(d.best.hypothesis.cause)}
+    c = c or d.best
+    return {p.name: {"value": c.hypothesis.values[p.name], "std": c.std.get(p.name), "unit": p.unit,
+                     "fitted": p.name in c.std} for p in parameters(c.hypothesis.cause)}
+
+
+def _candidate(c: Candidate) -> dict[str, Any]:
+    return {"cause": c.hypothesis.cause, "location": c.hypothesis.location_json(),
+            "heldout_error": c.heldout_error if c.verified else None, "training_error": c.screened_error,
+            "score": c.score, "n_parameters": len(parameters(c.hypothesis.cause)),
+            "parameters": dict(c.hypothesis.values)}
+
+
+def _run_with(d: KCDiagnosis, c: Candidate) -> list[Hypothesis]:
+    """The hypotheses a second-stage candidate was run with: the first cause (refitted with it, if it
+    was) and its own."""
+    return [(c.beside or d.best).hypothesis, c.hypothesis]
+
+
+def _pair(d: KCDiagnosis, c: Candidate) -> dict[str, Any]:
+    """A second-stage candidate: the pair run, both causes with the values it was run with."""
+    both = _run_with(d, c)
+    return {"cause": PAIR_SEPARATOR.join(h.cause for h in both), "heldout_error": c.heldout_error,
+            "training_error": c.screened_error, "score": c.score,
+            "causes": [{"cause": h.cause, "location": h.location_json(), "parameters": dict(h.values)} for h in both]}
 
 
 def summary(d: KCDiagnosis) -> dict[str, Any]:
     """The machine-readable verdict (``vsim diagnose --json``)."""
-    after = d.best.test_errors if d.named else d.baseline_errors
+    after = d.final.test_errors if d.named else d.baseline_errors
     return {
         "cause": d.verdict,
-        "location": d.best.hypothesis.location_json() if d.named else None,
-        "parameters": _parameters(d),
+        "location": d.causes[0].hypothesis.location_json() if d.named else None,
+        "parameters": _parameters(d, d.causes[0]) if d.named else {},
         "heldout_error_before": d.heldout_error_before,
         "heldout_error_after": d.heldout_error_after,
         "noise_floor": 1.0,
-        "ranking": [{"cause": c.hypothesis.cause, "location": c.hypothesis.location_json(),
-                     "heldout_error": c.heldout_error if c.verified else None, "training_error": c.screened_error,
-                     "score": c.score, "n_parameters": len(parameters(c.hypothesis.cause)),
-                     "parameters": dict(c.hypothesis.values)} for c in d.ranking],
+        "ranking": [_candidate(c) for c in d.ranking],
+        "pairs": [_pair(d, c) for c in d.pairs],
         "tests": [{"name": n, "heldout": bool(h), "error_before": float(b), "error_after": float(a),
                    "excess_before": excess(float(b))}
                   for n, h, b, a in zip(d.test_names, d.heldout, d.baseline_errors, after)],
         "explained": d.explained[0],
         "share_explained": d.explained[1],
-        "causes": [{"cause": d.verdict, "location": d.best.hypothesis.location_json(), "parameters": _parameters(d),
-                    "share_explained": d.explained[1]}] if d.named else [],
+        "causes": [{"cause": c.hypothesis.cause, "location": c.hypothesis.location_json(),
+                    "parameters": _parameters(d, c), "share_explained": share} for c, share in zip(d.causes, d.shares)],
         "misfits": [_misfit(m) for m in d.misfits],
         "misfits_after": [_misfit(m) for m in d.misfits_after],
         "noise": {c: float(s) for c, s in zip(d.layout.channels, d.noise)},
@@ -71,8 +93,8 @@ def excess(error: float) -> float:
     return math.sqrt(max(error ** 2 - 1.0, 0.0))
 
 
-def _where(d: KCDiagnosis) -> str:
-    loc = d.best.hypothesis.location_json() or {}
+def _where(c: Candidate) -> str:
+    loc = c.hypothesis.location_json() or {}
     return ", ".join(f"{k} {'/'.join(v) if isinstance(v, list) else v}" for k, v in loc.items())
 
 
@@ -93,9 +115,12 @@ def verdict_sentence(d: KCDiagnosis) -> str:
     if d.verdict == "unexplained":
         return (f"The mismatch is real ({before:.2f} × the noise on held-out tests) but no catalogue cause explains "
                 f"it; the best, {best.hypothesis.label}, only brings it to {best.heldout_error:.2f}.")
-    values = ", ".join(f"{k} = {v['value']:.4g} ± {v['std']:.2g} {v['unit']}" if v["fitted"] else
-                       f"{k} = {v['value']:.4g} {v['unit']} (held at mid-range)" for k, v in _parameters(d).items())
-    sentence = (f"Cause: **{d.verdict}** at {_where(d)} ({values}); held-out error {before:.2f} → {after:.2f} "
+    named = " and ".join(
+        f"**{c.hypothesis.cause}** at {_where(c)} (" + ", ".join(
+            f"{k} = {v['value']:.4g} ± {v['std']:.2g} {v['unit']}" if v["fitted"] else
+            f"{k} = {v['value']:.4g} {v['unit']} (held at mid-range)" for k, v in _parameters(d, c).items()) + ")"
+        for c in d.causes)
+    sentence = (f"Cause{'s' if len(d.causes) > 1 else ''}: {named}; held-out error {before:.2f} → {after:.2f} "
                 f"× the measurement noise.")
     how, share = d.explained
     if how == "partial":
@@ -126,7 +151,7 @@ def _overlays(d: KCDiagnosis, out: Path) -> Path:
         x = np.arange(len(rows))
         ax.plot(x, m, "k.", ms=1.5, label="measured")
         for sim, style, label in ((d.baseline, "C3-", "baseline"),
-                                  (d.best.simulated if d.named else None, "C0-", f"+ {d.verdict}")):
+                                  (d.final.simulated if d.named else None, "C0-", f"+ {d.verdict}")):
             if sim is not None:
                 ax.plot(x, sim[rows, c] + np.median(m - sim[rows, c]), style, lw=0.8, label=label)
         ax.set_xlabel("sample of the input phase")
@@ -143,7 +168,7 @@ def _residuals(d: KCDiagnosis, out: Path) -> Path:
         ax = fig.add_subplot(1, 2, i + 1)
         ax.scatter(x, d.baseline_errors, c="C3", s=14, label="baseline")
         if d.named:
-            ax.scatter(x, d.best.test_errors, c="C0", marker="s", s=14, label=f"+ {d.verdict}")
+            ax.scatter(x, d.final.test_errors, c="C0", marker="s", s=14, label=f"+ {d.verdict}")
         ax.axhline(1.0, color="k", ls="--", lw=0.8, label="noise")
         ax.set_xlabel(label)
         ax.set_ylabel("RMS error [× noise]")
@@ -169,10 +194,11 @@ def write_report(d: KCDiagnosis, baseline: VehicleDefinition, out_dir: Path, dat
                     f"the data), each channel's zero in each recording removed: 1 is a perfect model.")
     if d.named:
         model = out_dir / "extended_vehicle.yaml"
-        note = (f"{baseline.path} extended by {d.best.hypothesis.label} {dict(d.best.hypothesis.values)}, fitted by "
-                f"vsim diagnose on {dataset}.")
+        hypotheses = [c.hypothesis for c in d.causes]
+        note = (f"{baseline.path} extended by " + " and ".join(f"{h.label} {dict(h.values)}" for h in hypotheses)
+                + f", fitted by vsim diagnose on {dataset}.")
         with atomic_output(model) as tmp:
-            tmp.write_text(extended_vehicle_yaml(baseline, [d.best.hypothesis], note))
+            tmp.write_text(extended_vehicle_yaml(baseline, hypotheses, note))
         written.append(model)
         report.paragraph(f"Extended model: [`{model.name}`]({model.name}) (a vehicle file: `vsim run` uses it "
                          f"through a scenario's `vehicle:` key).")
@@ -184,6 +210,15 @@ def write_report(d: KCDiagnosis, baseline: VehicleDefinition, out_dir: Path, dat
                  + [(c.hypothesis.label, str(len(parameters(c.hypothesis.cause))),
                      f"{c.heldout_error:.3f}" if c.verified else "(not run)", f"{c.screened_error:.3f}",
                      ", ".join(f"{k} = {v:.4g}" for k, v in c.hypothesis.values.items())) for c in d.ranking[:12]])
+    if d.pairs:
+        report.paragraph(f"Second stage: {d.best.hypothesis.label} left a mismatch beyond the noise or a test it "
+                         f"does not fit; every other hypothesis was fitted beside it, the best run with it on every "
+                         f"test, both magnitudes refitted together (two causes are named when the pair removes most "
+                         f"of what the first left):")
+        report.table(("pair", "held-out error", "fitted values"),
+                     [(" + ".join(h.label for h in both), f"{c.heldout_error:.3f}",
+                       "; ".join(", ".join(f"{k} = {v:.4g}" for k, v in h.values.items()) for h in both))
+                      for c, both in ((c, _run_with(d, c)) for c in d.pairs)])
     report.picture("ranking.png")
     report.section("Tests")
     report.paragraph("Every test is checked, training ones included (the baseline fitted nothing): a test is "

@@ -30,7 +30,7 @@ import numpy as np
 from processes import run_measured
 from vsim_cluster.executor import executor
 from vsim_core.shipped import DEFAULT_VEHICLE
-from vsim_diagnosis.kc_diagnosis import Layout, run_job
+from vsim_diagnosis.kc_layout import Layout, run_job
 from vsim_recordings.kc_dataset import read_kc_dataset
 from vsim_sweeps.designs import design_points
 from vsim_sweeps.sweep import run_sweep

@@ -1,0 +1,213 @@
+"""Scoring and fitting hypotheses on a K&C campaign's compared rows (:mod:`vsim_diagnosis.kc_diagnosis`):
+residuals in units of the measured noise, each recording's zero errors removed; a hypothesis's
+magnitude fitted with its effect taken proportional to it from a vehicle run (one cause, a second
+parameter along one more run, or two causes together); candidates verified by full runs."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+from typing import Callable
+
+import numpy as np
+
+from vsim_diagnosis.catalogue import Parameter
+from vsim_diagnosis.kc_catalogue import Hypothesis, parameters
+from vsim_diagnosis.kc_layout import Layout
+
+#: Relative increase of the held-out score per fitted parameter.
+PARAMETER_PENALTY = 0.02
+
+
+@dataclass
+class Candidate:
+    """A hypothesis fitted on the training tests and scored on the held-out ones."""
+
+    hypothesis: Hypothesis
+    heldout_error: float                      #: noise-normalised RMS on held-out tests (1 = the noise)
+    std: dict[str, float] = field(default_factory=dict)
+    screened_error: float = math.nan          #: RMS on the training tests after the screening's fit
+    test_errors: np.ndarray | None = None     #: per test, from the full vehicle run
+    simulated: np.ndarray | None = None       #: the full vehicle run's rows (verified candidates)
+    #: a second cause's: the first cause as refitted together with it (:func:`fit_pair`); the run
+    #: and errors above are then the pair's
+    beside: "Candidate | None" = None
+
+    @property
+    def verified(self) -> bool:
+        """Scored on the held-out tests by a full vehicle run."""
+        return self.simulated is not None
+
+    def penalised(self, error: float) -> float:
+        """``error`` raised by the parameter penalty of this hypothesis's cause."""
+        return error * (1.0 + PARAMETER_PENALTY * len(parameters(self.hypothesis.cause)))
+
+    @property
+    def score(self) -> float:
+        """Penalised held-out error (verified) or training error (screened only); lower is better."""
+        return self.penalised(self.heldout_error if self.verified else self.screened_error)
+
+
+class Scorer:
+    """Residuals in noise units, each channel's zero error in each recording removed; errors per test."""
+
+    def __init__(self, layout: Layout, baseline: np.ndarray, heldout: np.ndarray):
+        self.layout, self.heldout = layout, heldout
+        self.held_rows = heldout[layout.test]
+        self.noise = self._noise(layout.measured - baseline)
+
+    def _noise(self, residual: np.ndarray) -> np.ndarray:
+        """Per channel: the white noise of the residual from its sample-to-sample differences within
+        each test (robust: median absolute deviation), which a smooth model error hardly affects;
+        channels of one quantity share their median."""
+        d = np.vstack([np.diff(residual[t.rows], axis=0) for t in self.layout.tests])
+        per = 1.4826 * np.median(np.abs(d - np.median(d, axis=0)), axis=0) / math.sqrt(2.0)
+        family = [c.rsplit("_", 1)[0] for c in self.layout.channels]
+        out = np.array([np.median([p for p, g in zip(per, family) if g == f]) for f in family])
+        return np.maximum(out, 1e-9)
+
+    def residual(self, predicted: np.ndarray, rows: np.ndarray, zero: Callable[..., np.ndarray] = np.mean
+                 ) -> np.ndarray:
+        """(measured − predicted) / noise on the selected rows (a boolean mask), each channel's
+        ``zero`` over the selected rows of each recording removed (its zero error): the mean, in
+        which the residual stays affine in the prediction (the fits), or the median, which a misfit
+        confined to a stretch does not move for the rest of its recording (the misfits' search)."""
+        r = self.layout.measured[rows] - predicted[rows]
+        rec = self.layout.recording[rows]
+        for k in np.unique(rec):
+            r[rec == k] -= zero(r[rec == k], axis=0)
+        return r / self.noise
+
+    def test_errors(self, predicted: np.ndarray) -> np.ndarray:
+        """Per test, the RMS residual (1 = the noise)."""
+        r2 = (self.residual(predicted, np.ones(len(predicted), dtype=bool)) ** 2).mean(axis=1)
+        return np.array([math.sqrt(r2[t.rows].mean()) for t in self.layout.tests])
+
+    def heldout_error(self, predicted: np.ndarray) -> float:
+        """The RMS residual on the held-out tests (1 = the noise)."""
+        r = self.residual(predicted, np.ones(len(predicted), dtype=bool))[self.held_rows]
+        return float(math.sqrt(np.mean(r ** 2)))
+
+
+def nominal(cause: str) -> dict[str, float]:
+    """Mid-range values of a cause's parameters (geometric mean for log parameters)."""
+    return {p.name: (math.sqrt(p.draw[0] * p.draw[1]) if p.log else 0.5 * (p.draw[0] + p.draw[1]))
+            for p in parameters(cause)}
+
+
+def fit(h: Hypothesis, signature: np.ndarray, base: np.ndarray, scorer: Scorer,
+        slope: np.ndarray | None = None) -> Candidate:
+    """Fit ``h`` on the training tests: its first parameter with the effect taken proportional to it
+    (to its logarithm for a factor) from the ``signature`` (the rows of a vehicle run with
+    ``h.values`` minus the baseline's); given ``slope`` (the rows' derivative with respect to the
+    second parameter at ``h.values``), the second too, linearly along it. Each parameter fitted gets
+    its uncertainty in ``std``; the candidate is scored by its training error (``screened_error``)."""
+    params = parameters(h.cause)
+    first = params[0]
+    at = dict(h.values)
+    train = ~scorer.held_rows
+    mismatch = scorer.residual(base, train).ravel()
+    # the signature and the slope in noise units (the residual is affine in the prediction)
+    columns = [mismatch - scorer.residual(base + d, train).ravel() for d in (signature, slope) if d is not None]
+    gram = np.array([[float(np.dot(a, b)) for b in columns] for a in columns])
+    if len(columns) == 2 and np.linalg.det(gram) <= 1e-9 * gram[0, 0] * gram[1, 1]:
+        columns, gram = columns[:1], gram[:1, :1]   # the second parameter changes nothing the first does not
+    coef = np.linalg.solve(gram, [float(np.dot(c, mismatch)) for c in columns]) if gram[0, 0] > 0.0 \
+        else np.zeros(len(columns))
+    std = {}
+    if len(columns) == 2:
+        second = params[1]
+        moved = float(np.clip(at[second.name] + coef[1], *second.bounds))
+        coef[1] = moved - at[second.name]
+        coef[0] = float(np.dot(columns[0], mismatch - coef[1] * columns[1])) / gram[0, 0]
+        at[second.name] = moved
+    var = _variances(mismatch - sum(c * x for c, x in zip(coef, columns)), gram)
+    if len(columns) == 2:
+        std[params[1].name] = math.sqrt(var[1])
+    value, std[first.name], scale = _magnitude(first, at[first.name], coef[0], math.sqrt(var[0]))
+    rest = sum(c * x for c, x in zip(coef[1:], columns[1:]))
+    trained = float(math.sqrt(np.mean((mismatch - scale * columns[0] - rest) ** 2)))
+    return Candidate(replace(h, values={**at, first.name: value}), math.nan, std, screened_error=trained)
+
+
+def fit_pair(first: Candidate, second: Candidate, base: np.ndarray, scorer: Scorer) -> Candidate | None:
+    """Both causes' magnitudes (first parameters) refitted together on the training tests, each effect
+    taken proportional to its magnitude from the runs (``first``'s alone, ``second``'s beside it):
+    the second cause with the first, as refitted, ``beside`` it; None when the two effects are alike
+    on the campaign (nothing to refit)."""
+    train = ~scorer.held_rows
+    mismatch = scorer.residual(base, train).ravel()
+    columns = [mismatch - scorer.residual(rows, train).ravel() for rows in (first.simulated, second.simulated)]
+    columns[1] = columns[1] - columns[0]     # the second's own effect
+    gram = np.array([[float(np.dot(a, b)) for b in columns] for a in columns])
+    if np.linalg.det(gram) <= 1e-9 * gram[0, 0] * gram[1, 1]:
+        return None                          # the two act alike on the campaign: nothing to refit
+    coef = np.linalg.solve(gram, [float(np.dot(c, mismatch)) for c in columns])
+    sd = np.sqrt(_variances(mismatch - coef @ np.array(columns), gram))
+    out, scales = [], []
+    for c, k, s in zip((first, second), coef, sd):
+        p = parameters(c.hypothesis.cause)[0]
+        at = c.hypothesis.values[p.name]
+        value, std, scale = _magnitude(p, at, float(k), float(s))
+        # the first's uncertainty at least its shift (the second's: :func:`kept`)
+        out.append(Candidate(replace(c.hypothesis, values={**c.hypothesis.values, p.name: value}), math.nan,
+                             {**c.std, p.name: max(std, abs(value - at)) if c is first else std}))
+        scales.append(scale)
+    left = mismatch - scales[0] * columns[0] - scales[1] * columns[1]
+    out[1].screened_error = float(math.sqrt(np.mean(left ** 2)))
+    out[1].beside = out[0]
+    return out[1]
+
+
+def _variances(residual: np.ndarray, gram: np.ndarray) -> np.ndarray:
+    """The fitted coefficients' variances from the ``residual`` left and the columns' ``gram`` matrix,
+    the residual variance inflated for sample-to-sample correlation (a smooth model error is not
+    white noise: n samples are worth n(1 − ρ)/(1 + ρ))."""
+    r = residual
+    rho = float(np.clip(np.dot(r[1:], r[:-1]) / max(np.dot(r, r), 1e-300), 0.0, 0.999))
+    s2 = float(np.dot(r, r)) / max(len(r) - len(gram), 1) * (1.0 + rho) / (1.0 - rho)
+    return np.diag(np.linalg.inv(gram)) * s2 if gram[0, 0] > 0.0 else np.full(len(gram), math.inf)
+
+
+def _magnitude(p: Parameter, at: float, coef: float, sd: float) -> tuple[float, float, float]:
+    """A first parameter's value when its effect at ``at`` is scaled by ``coef`` (standard deviation
+    ``sd``), kept within its bounds and on its side: the value, its uncertainty, and the scale of the
+    effect it gives."""
+    x0 = p.effect(at)
+    lo, hi = p.bounds
+    if not p.signed or (p.sided and x0 > 0.0):
+        lo = max(lo, 0.0)
+    if p.sided and x0 < 0.0:
+        hi = min(hi, 0.0)
+    # clipped before from_effect: a hypothesis with almost no effect gets a huge coefficient (a factor's exp overflowed)
+    value = float(np.clip(p.from_effect(min(coef * x0, p.effect(hi))), lo, hi))
+    scale = p.effect(value) / x0 if x0 != 0.0 else 0.0   # at no effect (clipped to it): none from here
+    return value, (abs(value * x0) if p.factor else abs(x0)) * sd, scale
+
+
+def nudged(h: Hypothesis) -> tuple[Hypothesis, float]:
+    """``h`` with its second parameter moved by a quarter of its realistic range (inwards from a
+    bound), and the move: the run that gives the rows' slope along that parameter."""
+    second = parameters(h.cause)[1]
+    value, step = h.values[second.name], 0.25 * (second.draw[1] - second.draw[0])
+    if value + step > second.bounds[1]:
+        step = -step
+    return replace(h, values={**h.values, second.name: value + step}), step
+
+
+def kept(first: list[Candidate], refit: list[Candidate], simulated: list[np.ndarray], scorer: Scorer
+          ) -> list[Candidate]:
+    """Of each candidate and its refit (whose runs are ``simulated``), the better, best first; a
+    refit's uncertainty at least its shift (the linearised one ignores the model's nonlinearity)."""
+    for a, b in zip(first, refit):
+        b.std = {k: max(s, abs(b.hypothesis.values[k] - a.hypothesis.values[k])) for k, s in b.std.items()}
+    verify(refit, simulated, scorer)
+    return sorted((min(a, b, key=lambda c: c.score) for a, b in zip(first, refit)), key=lambda c: c.score)
+
+
+def verify(candidates: list[Candidate], simulated: list[np.ndarray], scorer: Scorer) -> None:
+    """Give each candidate its full vehicle run's rows (``simulated``) and their errors."""
+    for c, rows in zip(candidates, simulated):
+        c.simulated = rows
+        c.heldout_error = scorer.heldout_error(rows)
+        c.test_errors = scorer.test_errors(rows)
