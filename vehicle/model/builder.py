@@ -96,7 +96,10 @@ class _Builder:
         opt = self.spec.option
         opt.timestep = options.timestep
         opt.integrator = mujoco.mjtIntegrator.mjINT_DISCRETE
-        opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT
+        # no MuJoCo contacts (the road's tyres are our own), and no island discovery: joints and
+        # closures tie every body into one island, and searching for others cost 8 % of a rig step
+        # (47.9 -> 44.2 µs with STVS on all 36 directions; results move by round-off only)
+        opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT | mujoco.mjtDisableBit.mjDSBL_ISLAND
         opt.gravity = [0.0, 0.0, -9.81]
         self.poses: dict[str, tuple[np.ndarray, np.ndarray]] = {"world": (np.zeros(3), np.eye(3))}
         self.bodies: dict[str, mujoco.MjsBody] = {"world": self.spec.worldbody}
