@@ -324,11 +324,12 @@ def diagnose_bench(data: BenchDataset, baseline: ParameterSet,
         best = ranking[0] if ranking else None
         verdict = decide(before, best.heldout_error if best else before, floor)
         pairs: list[Candidate] = []
-        if best is not None and second_cause_wanted(best.heldout_error, floor):
+        # what the best single cause leaves, or the baseline's mismatch if it makes things worse
+        if best is not None and second_cause_wanted(min(best.heldout_error, before), floor):
             say(f"{best.cause.id} leaves {best.heldout_error:.4f} (noise {floor:.4f}): fitting every pair of causes")
-            # the better-ranked cause of a pair first; from the two causes' own fits or the corners of their
-            # range (two effects that hide each other fit badly alone)
-            # the pairs whose causes took longest alone first, so that no long fit runs alone at the end
+            # each pair (the better-ranked cause first) starts from its causes' own fits or the corners of
+            # their ranges (two effects that hide each other fit badly alone); the pairs whose causes took
+            # longest alone go first, so that no long fit runs alone at the end
             combos = sorted(itertools.combinations(ranking, 2), key=lambda ab: -(ab[0].fit_s + ab[1].fit_s))
             pairs = sorted(pool.map(lambda ab: score(combined(ab[0].cause, ab[1].cause),
                                                      {**ab[0].values, **ab[1].values}), combos),

@@ -195,10 +195,13 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, executor: Execut
                  for c, m in zip(top, moves)]
         top = kept(top, refit, rows([extended_vehicle(vehicle, [c.hypothesis]) for c in refit], every), scorer)
         best = top[0]
+        found = located_misfits(layout, scorer, base)
         left = located_misfits(layout, scorer, best.simulated)
         pairs: list[Candidate] = []
         second, alone = None, math.nan
-        if second_cause_wanted(best.heldout_error, 1.0, bool(left)):
+        # what the best single cause leaves, or the baseline's mismatch if it makes things worse
+        gained = best.heldout_error < before
+        if second_cause_wanted(min(best.heldout_error, before), 1.0, bool(left if gained else found)):
             say(f"{best.hypothesis.label} leaves {best.heldout_error:.3f} × the noise"
                 f"{' and tests it does not fit' if left else ''}: every other hypothesis beside it")
             others = [(h, sig) for h, sig in zip(candidates, signatures)
@@ -207,13 +210,12 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, executor: Execut
                                   lambda hs, tests: rows([extended_vehicle(vehicle, h) for h in hs], tests), every)
             if pairs and pair_named(before, best.heldout_error, pairs[0].heldout_error, 1.0):
                 second = pairs[0]
-                alone = _alone(second.hypothesis, top + screened[VERIFIED:])
-                if not alone.verified:   # its single fit, run on every test as the first cause's was
-                    alone = replace(alone)
-                    verify([alone], rows([extended_vehicle(vehicle, [alone.hypothesis])], every), scorer)
-                alone = alone.heldout_error
+                single = _alone(second.hypothesis, top + screened[VERIFIED:])
+                if not single.verified:   # its single fit, run on every test as the first cause's was
+                    single = replace(single)
+                    verify([single], rows([extended_vehicle(vehicle, [single.hypothesis])], every), scorer)
+                alone = single.heldout_error
     errors = scorer.test_errors(base)
-    found = located_misfits(layout, scorer, base)
     for m in found:
         say(f"the baseline does not fit {m.test}{' (held out)' if m.heldout else ''}: {m.error:.2f} × the noise, "
             f"most between {m.start_s:.2f} and {m.end_s:.2f} s of its input, in {m.channel}")

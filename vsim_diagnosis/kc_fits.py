@@ -196,7 +196,7 @@ def nudged(h: Hypothesis) -> tuple[Hypothesis, float]:
 
 
 def kept(first: list[Candidate], refit: list[Candidate], simulated: list[np.ndarray], scorer: Scorer
-          ) -> list[Candidate]:
+         ) -> list[Candidate]:
     """Of each candidate and its refit (whose runs are ``simulated``), the better, best first; a
     refit's uncertainty at least its shift (the linearised one ignores the model's nonlinearity)."""
     for a, b in zip(first, refit):
