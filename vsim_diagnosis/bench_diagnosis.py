@@ -324,8 +324,7 @@ def diagnose_bench(data: BenchDataset, baseline: ParameterSet,
         best = ranking[0] if ranking else None
         verdict = decide(before, best.heldout_error if best else before, floor)
         pairs: list[Candidate] = []
-        # what the best single cause leaves, or the baseline's mismatch if it makes things worse
-        if best is not None and second_cause_wanted(min(best.heldout_error, before), floor):
+        if best is not None and second_cause_wanted(before, best.heldout_error, floor):
             say(f"{best.cause.id} leaves {best.heldout_error:.4f} (noise {floor:.4f}): fitting every pair of causes")
             # each pair (the better-ranked cause first) starts from its causes' own fits or the corners of
             # their ranges (two effects that hide each other fit badly alone); the pairs whose causes took

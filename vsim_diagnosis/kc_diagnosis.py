@@ -199,9 +199,9 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, executor: Execut
         left = located_misfits(layout, scorer, best.simulated)
         pairs: list[Candidate] = []
         second, alone = None, math.nan
-        # what the best single cause leaves, or the baseline's mismatch if it makes things worse
-        gained = best.heldout_error < before
-        if second_cause_wanted(min(best.heldout_error, before), 1.0, bool(left if gained else found)):
+        # the tests not fitted by the best single cause, or by the baseline if that cause makes things worse
+        unfitted = left if best.heldout_error < before else found
+        if second_cause_wanted(before, best.heldout_error, 1.0, bool(unfitted)):
             say(f"{best.hypothesis.label} leaves {best.heldout_error:.3f} × the noise"
                 f"{' and tests it does not fit' if left else ''}: every other hypothesis beside it")
             others = [(h, sig) for h, sig in zip(candidates, signatures)

@@ -109,8 +109,8 @@ def fit(h: Hypothesis, signature: np.ndarray, base: np.ndarray, scorer: Scorer,
     mismatch = scorer.residual(base, train).ravel()
     # the signature and the slope in noise units (the residual is affine in the prediction)
     columns = [mismatch - scorer.residual(base + d, train).ravel() for d in (signature, slope) if d is not None]
-    gram = np.array([[float(np.dot(a, b)) for b in columns] for a in columns])
-    if len(columns) == 2 and np.linalg.det(gram) <= 1e-9 * gram[0, 0] * gram[1, 1]:
+    gram = _gram(columns)
+    if len(columns) == 2 and _alike(gram):
         columns, gram = columns[:1], gram[:1, :1]   # the second parameter changes nothing the first does not
     coef = np.linalg.solve(gram, [float(np.dot(c, mismatch)) for c in columns]) if gram[0, 0] > 0.0 \
         else np.zeros(len(columns))
@@ -139,8 +139,8 @@ def fit_pair(first: Candidate, second: Candidate, base: np.ndarray, scorer: Scor
     mismatch = scorer.residual(base, train).ravel()
     columns = [mismatch - scorer.residual(rows, train).ravel() for rows in (first.simulated, second.simulated)]
     columns[1] = columns[1] - columns[0]     # the second's own effect
-    gram = np.array([[float(np.dot(a, b)) for b in columns] for a in columns])
-    if np.linalg.det(gram) <= 1e-9 * gram[0, 0] * gram[1, 1]:
+    gram = _gram(columns)
+    if _alike(gram):
         return None                          # the two act alike on the campaign: nothing to refit
     coef = np.linalg.solve(gram, [float(np.dot(c, mismatch)) for c in columns])
     sd = np.sqrt(_variances(mismatch - coef @ np.array(columns), gram))
@@ -157,6 +157,17 @@ def fit_pair(first: Candidate, second: Candidate, base: np.ndarray, scorer: Scor
     out[1].screened_error = float(math.sqrt(np.mean(left ** 2)))
     out[1].beside = out[0]
     return out[1]
+
+
+def _gram(columns: list[np.ndarray]) -> np.ndarray:
+    """The columns' dot products with each other (the normal equations' matrix)."""
+    return np.array([[float(np.dot(a, b)) for b in columns] for a in columns])
+
+
+def _alike(gram: np.ndarray) -> bool:
+    """Whether two columns (their ``gram`` matrix) are parallel to within round-off: the second
+    changes nothing the first does not, and the two cannot be fitted apart."""
+    return bool(np.linalg.det(gram) <= 1e-9 * gram[0, 0] * gram[1, 1])
 
 
 def _variances(residual: np.ndarray, gram: np.ndarray) -> np.ndarray:

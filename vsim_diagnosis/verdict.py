@@ -111,12 +111,12 @@ def decide(before: float, after: float, floor: float, misfit_seen: bool = False)
     return "none" if before <= NOISE_FACTOR * floor and not misfit_seen else "unexplained"
 
 
-def second_cause_wanted(after: float, floor: float, misfit_left: bool = False) -> bool:
-    """Whether to look for two causes at once: the best single one leaves a held-out error ``after``
-    beyond NOISE_FACTOR times the noise ``floor``, or a test it still does not fit (whether or not
-    it explains anything: two effects can hide each other, e.g. a preload and an asymmetry of
-    opposite sides)."""
-    return after > NOISE_FACTOR * floor or misfit_left
+def second_cause_wanted(before: float, after: float, floor: float, misfit_left: bool = False) -> bool:
+    """Whether to look for two causes at once: what the best single cause leaves (its held-out error
+    ``after``, or the baseline's ``before`` if it makes things worse) is beyond NOISE_FACTOR times
+    the noise ``floor``, or a test is still not fitted (whether or not the cause explains anything:
+    two effects can hide each other, e.g. a preload and an asymmetry of opposite sides)."""
+    return min(after, before) > NOISE_FACTOR * floor or misfit_left
 
 
 def pair_named(before: float, single: float, pair: float, floor: float) -> bool:
