@@ -38,9 +38,8 @@ from vehicle.model.builder import build
 from vehicle.model.elements import BuildOptions
 from vehicle.model.statics import resolve_preloads
 from vehicle.model.vehicle_file import load_vehicle
-from vehicle.scenarios.scenario import RIG_TIMESTEP_S
 from vehicle.scenarios.scenario_file import load_scenario
-from vehicle.scenarios.schedule import schedule
+from vehicle.scenarios.schedule import schedule, timestep
 from vsim_core.errors import InputError
 from vsim_core.shipped import BENCH_DIR, DEFAULT_VEHICLE, PARAMETER_SET_DIR, SCENARIO_DIR, SWEEP_DIR
 from vsim_recordings.bench_dataset import read_bench_dataset
@@ -230,7 +229,7 @@ SWEEPS = sorted(SWEEP_DIR.glob("*.yaml"))
 def test_scenarios(folder: Path, case: tuple[str, bool], scale: float) -> None:
     text, must_refuse = case
     path = write(folder / "scenario.yaml", text)
-    check("scenario", outcome(lambda: schedule(load_scenario(path), scale, RIG_TIMESTEP_S)), must_refuse, text)
+    check("scenario", outcome(lambda: schedule(scenario := load_scenario(path), scale, timestep(scenario))), must_refuse, text)
 
 
 @fuzz("sweep")

@@ -61,7 +61,7 @@ def test_every_shipped_road_scenario_validates(name: str) -> None:
     ("rise_time_s: 0.1", "rise_time_s: 0.2", r":4: defaults\.rise_time_s: expected a steering ramp of at most 0\.15 s \(ISO 7401\), got 0\.2"),
     ("speed_kmh: 80", "speed_kmh: 400", r":4: defaults\.speed_kmh: expected at most 250 km/h in magnitude, got 400"),
     ("steering_wheel_deg: 34}", "steering_wheel_deg: 0}", r":6: cases\[0\]\.steering_wheel_deg: expected a non-zero number, got 0"),
-    ("output_rate_hz: 200", "output_rate_hz: 300", r":3: output_rate_hz: expected a whole divisor of 1000 Hz"),
+    ("output_rate_hz: 200", "output_rate_hz: 3000", r":3: output_rate_hz: expected at most 1000 Hz"),
     ("output_rate_hz: 200", "axles: [front]", r":3: axles: unknown key 'axles' in a road scenario"),
     ("settle: {at_rest_s: 0.5", "settle: {at_rest_s: 90", r":2: settle\.at_rest_s: expected at most 60 s"),
 ])
@@ -246,7 +246,7 @@ def test_the_understeer_gradient_is_the_bicycle_models_with_the_rigs_compliances
     kc = vehicle_kc(vehicle, BuildOptions())
     car = RoadCar(vehicle)
     car.set_brakes(500.0)
-    car.step(3000)
+    car.step(round(3.0 / car.model.opt.timestep))
     fz, gamma = car.tyre_signals[:, 0], car.tyre_signals[:, 7]
     tyre = car.tyres[0]
     fy = lambda f, a, g: float(mf.evaluate(tyre, f, 0.0, a, g, 22.2)["Fy"])

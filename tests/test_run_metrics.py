@@ -32,7 +32,7 @@ from vsim_recordings.recorder import run_scenario
 from vsim_recordings.run_format import Run, RunMetadata, SignalSpec
 from vsim_recordings.run_reader import load_run
 
-SCALE = 0.5        #: duration scale of the short runs
+SCALE = 1.0        #: duration scale of the runs (at vsim kc's rates)
 TOLERANCE = 0.02   #: relative agreement of gradients with `vsim kc`
 #: scenario type → (kc test, case line: kc's amplitude and rate in the file's units)
 KC_CASES = {

@@ -19,7 +19,6 @@ import mujoco
 import numpy as np
 
 from vehicle.model.definition import VehicleDefinition
-from vehicle.model.elements import BuildOptions
 from vehicle.model.vehicle_file import load_vehicle
 from vehicle.scenarios.road_scenario import RoadScenario
 from vehicle.scenarios.scenario import Scenario
@@ -61,7 +60,7 @@ def _suspension(car: MountedCar) -> tuple[list[str], list[str], list[str]]:
 
 
 def _play(scenario: Scenario | RoadScenario, vehicle: VehicleDefinition, duration_scale: float,
-          progress: Callable[[Progress], None] | None, timestep_s: float = BuildOptions.timestep, poses: bool = True
+          progress: Callable[[Progress], None] | None, timestep_s: float | None = None, poses: bool = True
           ) -> tuple[ScenarioRun | RoadRun, SignalLayout | RoadSignalLayout, RunMetadata]:
     """The run of ``scenario`` on ``vehicle`` (on the rig or on the road, as its type says; with the
     bodies' ``poses`` or not), the signals it records and its metadata."""
@@ -106,12 +105,12 @@ def run_scenario(scenario: Scenario | RoadScenario, output: Path, *, bushing_mod
 
 
 def simulate(scenario: Scenario | RoadScenario, vehicle: VehicleDefinition | None = None, *, duration_scale: float = 1.0,
-             progress: Callable[[Progress], None] | None = None, timestep_s: float = BuildOptions.timestep) -> Run:
+             progress: Callable[[Progress], None] | None = None, timestep_s: float | None = None) -> Run:
     """Run every case of ``scenario`` on ``vehicle`` (default: the scenario's file) in memory.
 
     The result is the :class:`Run` that :func:`run_scenario` would record, without the body poses:
     the same signals, units and metadata (``vehicle_yaml`` the definition's text, empty for one
-    changed in code); ``timestep_s`` the car's time step.
+    changed in code); ``timestep_s`` the car's time step (default the scenario's).
     """
     play, layout, metadata = _play(scenario, load_vehicle(scenario.vehicle) if vehicle is None else vehicle,
                                    duration_scale, progress, timestep_s, poses=False)

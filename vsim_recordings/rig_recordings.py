@@ -16,8 +16,8 @@ from typing import Any, Callable, Mapping
 import numpy as np
 
 from vehicle.scenarios.channels import INPUT_CHANNELS
-from vehicle.scenarios.scenario import RIG_TIMESTEP_S, Scenario
-from vehicle.scenarios.schedule import CaseSchedule, schedule
+from vehicle.scenarios.scenario import Scenario
+from vehicle.scenarios.schedule import CaseSchedule, schedule, timestep
 from vsim_core.units import plausible
 from vsim_core.errors import InputError
 from vsim_core.files import atomic_output
@@ -177,11 +177,12 @@ def write_rig_recording(path: str | os.PathLike[str], scenario: Scenario, t_s: n
         raise InputError(f"missing required channel(s) {', '.join(missing)}; expected every input the scenario "
                          f"drives, camber and toe of one wheel, and the x signal of every wheel output given "
                          f"(data/README.md)", source=source, key="channels")
-    plan = schedule(scenario, duration_scale, RIG_TIMESTEP_S)
-    _check_time(t, plan[-1].end_s(RIG_TIMESTEP_S), source, where)
+    dt = timestep(scenario)
+    plan = schedule(scenario, duration_scale, dt)
+    _check_time(t, plan[-1].end_s(dt), source, where)
 
-    values.update(_schedule_signals(t, plan, RIG_TIMESTEP_S))
-    metadata = run_metadata(scenario, plan, duration_scale, RIG_TIMESTEP_S)
+    values.update(_schedule_signals(t, plan, dt))
+    metadata = run_metadata(scenario, plan, duration_scale, dt)
     metadata.extra["rig"] = {"sample_rate_hz": 1.0 / float(np.median(np.diff(t))), **rig}
     table = np.column_stack([values[s.name] for s in specs])
     with atomic_output(path) as tmp, RunWriter(tmp, signals=specs, bodies=[], geometry=[], metadata=metadata,

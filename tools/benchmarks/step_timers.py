@@ -52,7 +52,7 @@ def timers(h: float) -> dict[str, object]:
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--json", action="store_true", help="print one JSON object (default: a table)")
-    parser.add_argument("--timestep", type=float, default=1e-3, help="time step H [s] (default: %(default)s)")
+    parser.add_argument("--timestep", type=float, default=BuildOptions.timestep, help="time step H [s] (default: %(default)s)")
     args = parser.parse_args()
     result = timers(args.timestep)
     if args.json:

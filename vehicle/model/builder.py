@@ -43,8 +43,12 @@ from vsim_core.errors import InputError
 
 #: Stiffness of a "rigid" bushing translation [N/m] (kinematics mode).
 RIGID_TRANSLATION = 1e9
-#: Loop closures and rig drives: time constant at the refsafe floor (2 h) and impedance close to
-#: 1, which keeps the closure error of a 3 kN load in the 10 µm range (measured, see tests).
+#: Loop closures, rig drives, strut friction and brakes: impedance close to 1 and a time constant
+#: [s] fixed, not MuJoCo's refsafe floor (2 h), so that they do not soften as h rises. 2 ms, the
+#: floor at a 1 ms step, keeps the compliance every figure was measured with; at h = 2 ms the rear
+#: camber loop is then 8.1e-5° against 7.6e-5° at h ≤ 0.5 ms (1.6e-4° with the floor), the front
+#: within 0.3 %, the pumping's closure error 7.7 µm (4.4 µm at 1 ms); tools/benchmarks/vehicle_speed.py.
+CLOSURE_SOLREF = (2e-3, 1.0)
 CLOSURE_SOLIMP = (0.9999, 0.9999, 0.001, 0.5, 2.0)
 SLEEVE_MASS = 0.4          #: mass of a closed bushing's sleeve [kg], taken from its part's mass
 BEAM_CENTRE_MASS = 1.0    #: share of each arm's mass carried by the beam-centre body [kg]
@@ -96,10 +100,12 @@ class _Builder:
         opt = self.spec.option
         opt.timestep = options.timestep
         opt.integrator = mujoco.mjtIntegrator.mjINT_DISCRETE
-        # no MuJoCo contacts (the road's tyres are our own), and no island discovery: joints and
+        # no MuJoCo contacts (the road's tyres are our own); no island discovery: joints and
         # closures tie every body into one island, and searching for others cost 8 % of a rig step
-        # (47.9 -> 44.2 µs with STVS on all 36 directions; results move by round-off only)
-        opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT | mujoco.mjtDisableBit.mjDSBL_ISLAND
+        # (47.9 -> 44.2 µs with STVS on all 36 directions; results move by round-off only); no
+        # refsafe floor, which would soften CLOSURE_SOLREF to 2 h
+        disable = mujoco.mjtDisableBit
+        opt.disableflags |= disable.mjDSBL_CONTACT | disable.mjDSBL_ISLAND | disable.mjDSBL_REFSAFE
         opt.gravity = [0.0, 0.0, -9.81]
         self.poses: dict[str, tuple[np.ndarray, np.ndarray]] = {"world": (np.zeros(3), np.eye(3))}
         self.bodies: dict[str, mujoco.MjsBody] = {"world": self.spec.worldbody}
@@ -152,7 +158,7 @@ class _Builder:
         return eq
 
     def _stiff(self, eq):
-        eq.solref = [2.0 * self.o.timestep, 1.0]
+        eq.solref = list(CLOSURE_SOLREF)
         eq.solimp = list(CLOSURE_SOLIMP)
 
     def drive(self, name: str, joint: str):
@@ -259,7 +265,7 @@ class _Builder:
         j.frictionloss = f.strut_friction[0 if sign > 0 else 1]
         # friction as stiff as the loop closures: at MuJoCo's default (0.02 s) the regularised friction
         # let the rod creep through 200 N at 2 mm/s (pad-force loop 7 N wide instead of 2·200 N·MR)
-        j.solref_friction, j.solimp_friction = [2.0 * self.o.timestep, 1.0], list(CLOSURE_SOLIMP)
+        j.solref_friction, j.solimp_friction = list(CLOSURE_SOLREF), list(CLOSURE_SOLIMP)
         self.capsule(rod, hp["strut_lower"], hp["strut_top"], 0.01, (0.8, 0.8, 0.8, 1))
         self._spring_damper_joint(j, f"front_{side}", f.spring, f.damper.curve)
         self.closure(f"top_mount_{side}", mujoco.mjtEq.mjEQ_CONNECT, rod, "chassis", hp["strut_top"])
@@ -361,7 +367,7 @@ class _Builder:
         self.body(parent, name, centre, rot, t.wheel_mass, centre, [i_diam, i_spin, i_diam])
         hinge = self.bodies[name].add_joint(name=f"spin_{corner}", type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 1, 0])
         if self.o.road:  # the brake is the hinge's dry friction, as stiff as the closures (the default creeps)
-            hinge.solref_friction, hinge.solimp_friction = [2.0 * self.o.timestep, 1.0], list(CLOSURE_SOLIMP)
+            hinge.solref_friction, hinge.solimp_friction = list(CLOSURE_SOLREF), list(CLOSURE_SOLIMP)
         self.bodies[name].add_geom(type=mujoco.mjtGeom.mjGEOM_CYLINDER, size=[t.radius, 0.095, 0],
                                    quat=_quat(frame_from(np.array([0, 1.0, 0]), np.array([1.0, 0, 0]))),
                                    rgba=[0.1, 0.1, 0.1, 0.6], **_NO_COLLISION)

@@ -14,8 +14,6 @@ from dataclasses import dataclass
 
 import numba as nb
 import numpy as np
-from scipy.optimize import brentq, fsolve
-from scipy.spatial.transform import Rotation
 
 from vehicle.model.definition import VehicleDefinition
 from vehicle.model.geometry import wheel_axis
@@ -32,9 +30,51 @@ class Motion:
         return self.rot @ np.asarray(p, float) + self.shift
 
 
+#: Largest residual of a solved pose [m] (its equations are lengths and heights).
+SOLVED_M = 1e-10
+
+
+def rotation(rotvec) -> np.ndarray:
+    """The rotation matrix of a rotation vector [rad] (Rodrigues; series near zero)."""
+    v = np.asarray(rotvec, float)
+    k = np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+    a2 = float(v @ v)
+    a = math.sqrt(a2)
+    sin_a, one_minus_cos = ((1.0 - a2 / 6.0, 0.5 - a2 / 24.0) if a < 1e-6 else
+                            (math.sin(a) / a, (1.0 - math.cos(a)) / a2))
+    return np.eye(3) + sin_a * k + one_minus_cos * (k @ k)
+
+
+def newton(residual, x0: np.ndarray, what: str, iterations: int = 50) -> np.ndarray:
+    """The root of ``residual`` (n equations, n unknowns) from ``x0``: Newton steps on a central-
+    difference Jacobian, halved while they do not reduce the residual; RuntimeError naming
+    ``what`` if the residual stays above SOLVED_M. Kept off scipy.optimize, whose import alone
+    cost a third of a second of every run (the statics call it)."""
+    x = np.array(x0, float)
+    r = residual(x)
+    for _ in range(iterations):
+        if np.abs(r).max() <= 1e-14:
+            break
+        h = 1e-7 * np.maximum(1.0, np.abs(x))
+        jac = np.column_stack([(residual(x + e) - residual(x - e)) / (2.0 * e[i])
+                               for i, e in enumerate(np.diag(h))])
+        step = np.linalg.lstsq(jac, -r, rcond=None)[0]
+        for _ in range(30):
+            trial = residual(x + step)
+            if np.abs(trial).max() < np.abs(r).max():
+                break
+            step = step / 2.0
+        else:
+            break
+        x, r = x + step, trial
+    if not np.abs(r).max() <= SOLVED_M:
+        raise RuntimeError(f"{what} did not converge: residual {np.abs(r).max():.3g} m")
+    return x
+
+
 def about(point, axis, angle: float) -> Motion:
     """Rotation by ``angle`` [rad] about the line through ``point`` along ``axis``."""
-    rot = Rotation.from_rotvec(np.asarray(axis) / np.linalg.norm(axis) * angle).as_matrix()
+    rot = rotation(np.asarray(axis) / np.linalg.norm(axis) * angle)
     point = np.asarray(point, float)
     return Motion(rot, point - rot @ point)
 
@@ -96,7 +136,7 @@ def front_corner(v: VehicleDefinition, travel: float, rack: float = 0.0,
 
     def parts(x):
         wishbone = about(e1, e1 - e2, x[0])
-        rot = Rotation.from_rotvec(x[1:4]).as_matrix()
+        rot = rotation(x[1:4])
         knuckle = Motion(rot, wishbone(lbj) - rot @ lbj)
         rod = Motion(rot, knuckle.shift + rot @ e0 * x[4])
         return {"wishbone": wishbone, "knuckle": knuckle, "rod": rod}
@@ -110,11 +150,7 @@ def front_corner(v: VehicleDefinition, travel: float, rack: float = 0.0,
              k(contact)[2] - contact[2] - travel]])
 
     x0 = np.zeros(5) if guess is None else guess
-    x, _, _, msg = fsolve(residual, x0, full_output=True, xtol=1e-13)
-    # judged by the residual, not by fsolve's flag: near round-off the flag depends on the CPU's
-    # rounding ("not making good progress" on a solution whose residual is below 1e-15)
-    if not np.abs(residual(x)).max() <= 1e-10:
-        raise RuntimeError(f"front kinematics did not converge at travel {travel}: {msg}")
+    x = newton(residual, x0, f"front kinematics at travel {travel} m, rack {rack} m")
     p = parts(x)
     toe, camber = wheel_angles(p["knuckle"].rot @ spin)
     return CornerState(travel, p, float(x[4]), toe, camber, p["knuckle"](hp["wheel_centre"])), x
@@ -127,7 +163,8 @@ def rear_heave(v: VehicleDefinition, travel: float) -> CornerState:
     spin = wheel_axis(v.rear.static_toe, v.rear.static_camber, 1.0)
     contact = contact_point(hp["wheel_centre"], spin, v.tyre.radius)
     arm = lambda angle: about(pivot, [0.0, 1.0, 0.0], angle)
-    angle = brentq(lambda a: arm(a)(contact)[2] - contact[2] - travel, -0.5, 0.5, xtol=1e-15)
+    angle = newton(lambda a: np.array([arm(a[0])(contact)[2] - contact[2] - travel]), np.zeros(1),
+                   f"rear kinematics at travel {travel} m")[0]
     m = arm(angle)
     toe, camber = wheel_angles(m.rot @ spin)
     return CornerState(travel, {"arm": m}, 0.0, toe, camber, m(hp["wheel_centre"]))

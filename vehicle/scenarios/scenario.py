@@ -21,10 +21,15 @@ BISINE_INPUTS = (*SIGNAL_TYPES, "rack")
 TYPES = (*SIGNAL_TYPES, "rack_step", "double_rack_step", "bisine", "csv")
 SHAPES = ("triangle", "sine")
 
-#: The rig's time step [s]; output rates must divide 1/step.
-RIG_TIMESTEP_S = BuildOptions().timestep
-#: Largest sine frequency accepted [Hz]: 20 rig steps per period.
-MAX_FREQUENCY_HZ = 1.0 / (20 * RIG_TIMESTEP_S)
+#: The longest time step [s] of a run; each run takes the longest at most this that divides its
+#: output interval and resolves its inputs (vehicle.scenarios.schedule.timestep).
+MAX_TIMESTEP_S = BuildOptions().timestep
+#: Time steps per sine period and per waypoint interval of an input, at least.
+STEPS_PER_PERIOD, STEPS_PER_WAYPOINT = 20, 5
+#: Largest sine frequency accepted [Hz] (its run steps at 1 ms, 20 steps a period).
+MAX_FREQUENCY_HZ = 50.0
+#: Largest output rate [Hz] (a run then steps at 1 ms).
+MAX_OUTPUT_RATE_HZ = 1000.0
 #: Longest input of one case and longest rest phase [s] of simulated time (about 4 min and 4 s of
 #: wall time at the car's 15× real time): longer is a typing error.
 MAX_INPUT_S, MAX_SETTLE_S = 3600.0, 60.0
@@ -47,6 +52,13 @@ class Waveform:
     def duration_s(self) -> float:
         """Time of the last waypoint [s]."""
         return self.times_s[-1]
+
+    def longest_step_s(self) -> float:
+        """The longest time step [s] that resolves the waveform: STEPS_PER_PERIOD steps per sine period
+        and STEPS_PER_WAYPOINT per interval between waypoints (inf for a constant)."""
+        gaps = np.diff(self.times_s)
+        steps = [float(gaps[gaps > 0].min()) / STEPS_PER_WAYPOINT] if np.any(gaps > 0) else []
+        return min(steps + [1.0 / (STEPS_PER_PERIOD * f) for _, f in self.sines], default=math.inf)
 
     def __call__(self, t_s: np.ndarray) -> np.ndarray:
         t = np.minimum(np.asarray(t_s, dtype=float), self.duration_s)

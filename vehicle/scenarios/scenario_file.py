@@ -66,7 +66,7 @@ def _frequency(f: Fields) -> float:
     """The ``frequency_hz`` of ``f`` [Hz], positive and at most MAX_FREQUENCY_HZ."""
     frequency = f.number("frequency_hz", positive=True)
     if frequency > MAX_FREQUENCY_HZ:
-        raise f.fail("frequency_hz", f"expected at most {MAX_FREQUENCY_HZ} Hz (20 rig steps per period), "
+        raise f.fail("frequency_hz", f"expected at most {MAX_FREQUENCY_HZ:g} Hz (a K&C rig input), "
                                      f"got {frequency}")
     return frequency
 
@@ -87,7 +87,7 @@ def _periodic(f: Fields, kind: str) -> tuple[Waveform, int]:
         period = 4.0 * amplitude / (f.number(speed_key, positive=True) * si)
         if period * MAX_FREQUENCY_HZ < 1.0:
             raise f.fail(speed_key, f"a triangle of period {period:.3g} s (4 × amplitude / speed); expected at "
-                                    f"most {MAX_FREQUENCY_HZ:g} Hz (20 rig steps per period)")
+                                    f"most {MAX_FREQUENCY_HZ:g} Hz (a K&C rig input)")
     else:
         period = 1.0 / _frequency(f)
     if cycles * period > MAX_INPUT_S:   # checked before a triangle lists its corners

@@ -8,7 +8,7 @@ import math
 from dataclasses import astuple, dataclass
 
 from vehicle.scenarios.road_scenario import RoadScenario
-from vehicle.scenarios.scenario import Scenario
+from vehicle.scenarios.scenario import MAX_TIMESTEP_S, Scenario
 from vsim_core.errors import InputError
 
 #: Largest factor on a scenario's durations (slower runs than that are typing errors).
@@ -64,6 +64,16 @@ def schedule(scenario: Scenario | RoadScenario, duration_scale: float, dt: float
         out.append(CaseSchedule(steps, start))
         start += (sum(steps) + every) * dt
     return out
+
+
+def timestep(scenario: Scenario | RoadScenario, longest_s: float = MAX_TIMESTEP_S) -> float:
+    """The run's time step [s]: the longest at most ``longest_s`` that divides the output interval
+    and resolves every case's input as written (:meth:`Waveform.longest_step_s`; a duration scale
+    shortens a quick run, not its step). 50 Hz outputs step at 2 ms, 200 Hz at 5/3 ms."""
+    interval = 1.0 / scenario.output_rate_hz
+    longest = min([longest_s] + [case.waveform.longest_step_s() for case in scenario.cases
+                                 if case.waveform is not None])
+    return interval / math.ceil(round(interval / longest, 9))
 
 
 def output_interval(scenario: Scenario | RoadScenario, dt: float) -> int:

@@ -80,12 +80,12 @@ class RoadCar(MountedCar):
         #: Rack travel per radian of steering-wheel angle [m/rad], signed so that + steers left.
         self.rack_per_rad = ahead * self.vehicle.front.rack_travel_per_rev / (2.0 * math.pi)
         # MuJoCo's soft equality pulls the rack's velocity to zero: a ramped target is followed
-        # b/k = 2·d·timeconst·dampratio² late (4 ms at 1 ms steps, so the response times would move
-        # by 2 ms when the step halves); the target is taken that much ahead instead (continuous,
+        # b/k = 2·d·timeconst·dampratio² late (4 ms: the response times would be that late); the
+        # target is taken that much ahead instead (continuous,
         # unlike a lead of that time times the rate, which jumps at a ramp's corners).
         (timeconst, damping), impedance = m.eq_solref[self.rack_eq], m.eq_solimp[self.rack_eq, 1]
         #: How far ahead the rack's target is taken from the steering wheel [s] (the constraint's ramp lag).
-        self.rack_lead_s = 2.0 * impedance * max(timeconst, 2.0 * m.opt.timestep) * damping ** 2
+        self.rack_lead_s = 2.0 * impedance * timeconst * damping ** 2   # no refsafe floor: see builder
         #: The overall steering ratio at straight ahead (kinematic) and the wheelbase [m].
         self.steering_ratio = steering_ratio(self.vehicle)
         self.wheelbase = float(hp["wheel_centre"][0] - self.vehicle.rear.hardpoints["wheel_centre"][0])

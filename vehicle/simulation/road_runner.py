@@ -21,7 +21,6 @@ from typing import Callable, Iterator
 import numpy as np
 
 from vehicle.model.definition import CORNERS, VehicleDefinition
-from vehicle.model.elements import BuildOptions
 from vehicle.scenarios.road_scenario import RoadCase, RoadScenario, steering_and_speed
 from vehicle.scenarios.schedule import ROAD_PHASES, CaseSchedule, Progress, output_interval
 from vehicle.simulation.outputs import MeasuredColumns, SampleBlock
@@ -60,7 +59,7 @@ class RoadRun(PlayedScenario):
     phases = ROAD_PHASES
 
     def __init__(self, scenario: RoadScenario, vehicle: VehicleDefinition, duration_scale: float = 1.0,
-                 progress: Callable[[Progress], None] | None = None, timestep_s: float = BuildOptions.timestep,
+                 progress: Callable[[Progress], None] | None = None, timestep_s: float | None = None,
                  poses: bool = True):
         super().__init__(scenario, vehicle, duration_scale, progress, lambda v, o: RoadCar(v, options=o), timestep_s,
                          poses)

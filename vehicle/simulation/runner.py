@@ -30,7 +30,7 @@ from vehicle.model.statics import resolve_preloads
 from vehicle.scenarios.channels import INPUT_CHANNELS
 from vehicle.scenarios.road_scenario import RoadScenario
 from vehicle.scenarios.scenario import Case, Scenario
-from vehicle.scenarios.schedule import PHASES, CaseSchedule, Progress, output_interval, schedule
+from vehicle.scenarios.schedule import PHASES, CaseSchedule, Progress, output_interval, schedule, timestep
 from vehicle.simulation.mounted import MountedCar
 from vehicle.simulation.outputs import MeasuredColumns, SampleBlock
 from vehicle.simulation.rig import KCRig
@@ -110,7 +110,7 @@ class PlayedScenario:
     the first case's car (``mount(vehicle, options)``), the simulated time and the time spent in
     the compiled stepping loop. ``duration_scale`` multiplies every duration (settle phases,
     periods, holds) for quick runs; ``progress`` is called after every block with a :class:`Progress`;
-    ``timestep_s`` is the car's time step (its convergence is measured in tools/benchmarks);
+    ``timestep_s`` is the car's time step (default the scenario's: :func:`~vehicle.scenarios.schedule.timestep`);
     ``poses`` whether the blocks carry the bodies' poses (a recording's replay needs them)."""
 
     #: Names of a case's phases (the ``phase`` signal is the index).
@@ -118,11 +118,12 @@ class PlayedScenario:
 
     def __init__(self, scenario: Scenario | RoadScenario, vehicle: VehicleDefinition, duration_scale: float,
                  progress: Callable[[Progress], None] | None, mount: Callable[[VehicleDefinition, BuildOptions], Any],
-                 timestep_s: float = BuildOptions.timestep, poses: bool = True):
+                 timestep_s: float | None = None, poses: bool = True):
         # the preloads resolved once for every case's car (each build would solve the kinematics again)
         self.scenario, self.vehicle, self.duration_scale = scenario, resolve_preloads(vehicle), duration_scale
         self.progress, self._mount = progress, mount
-        self.options = BuildOptions(bushing_model=scenario.bushing_model, timestep=timestep_s)
+        self.options = BuildOptions(bushing_model=scenario.bushing_model,
+                                    timestep=timestep(scenario) if timestep_s is None else timestep_s)
         self.dt = self.options.timestep
         self.plan = schedule(scenario, duration_scale, self.dt)   # checks the scale before the build
         #: The first case's car (each later case builds its own).
@@ -196,7 +197,7 @@ class ScenarioRun(PlayedScenario):
     """The cases of a scenario played one after the other on ``vehicle``, each on a fresh rig."""
 
     def __init__(self, scenario: Scenario, vehicle: VehicleDefinition, duration_scale: float = 1.0,
-                 progress: Callable[[Progress], None] | None = None, timestep_s: float = BuildOptions.timestep,
+                 progress: Callable[[Progress], None] | None = None, timestep_s: float | None = None,
                  poses: bool = True):
         super().__init__(scenario, vehicle, duration_scale, progress, KCRig, timestep_s, poses)
 
