@@ -34,7 +34,11 @@ class Effects:
     preload: float = 0.0          #: operating point of the mounted part on its law [m or rad]
     asymmetry: float = 0.0        #: extra tangent fraction per unit deflection on one side [1/m or 1/rad];
     #: > 0 stiffens compression (x < 0), < 0 tension: F_asym = |a|·K0·x·|x|/2 on that side
-    mullins: float = 0.0          #: softening μ below the largest |x| seen: η = 1 − μ(1 − |x|/x_max)
+    asymmetry_step: float = 0.0   #: extra tangent fraction from zero deflection on one side [-] (a kink
+    #: in the law), signs as ``asymmetry``: F_asym += |s|·K0·x on that side
+    mullins: float = 0.0          #: softening μ below the largest |x| seen: η = 1 − μ(1 − (|x|/x_max)^p)
+    mullins_shape: float = 1.0    #: p, the shape of the recovery towards x_max (1: linear; > 1: the part
+    #: stays soft further up, < 1: it recovers early)
     heating: float = 0.0          #: softening per joule of heat held, κ = β/C_th [1/J]: η = 1/(1 + κQ)
     heating_tau_s: float = 300.0  #: thermal time constant of the heat held Q [s]
     backlash: float = 0.0         #: half-width of a dead band in series with the part [m or rad]
@@ -42,9 +46,11 @@ class Effects:
     @property
     def active(self) -> bool:
         """True when any effect is switched on."""
-        return any(getattr(self, f.name) != 0.0 for f in fields(self) if f.name != "heating_tau_s")
+        return any(getattr(self, f.name) != 0.0 for f in fields(self) if f.name not in _SETTINGS)
 
 
+#: Fields that shape an effect but switch none on.
+_SETTINGS = ("heating_tau_s", "mullins_shape")
 NO_EFFECTS = Effects()
 
 #: Parameter-set ``effects`` keys -> (Effects field, power of the length unit, unit for translations,
@@ -52,7 +58,9 @@ NO_EFFECTS = Effects()
 EFFECT_KEYS: dict[str, tuple[str, int, str, str, float]] = {
     "preload": ("preload", 1, "mm", "deg", -math.inf),
     "asymmetry": ("asymmetry", -1, "1/mm", "1/deg", -math.inf),
+    "asymmetry_step": ("asymmetry_step", 0, "-", "-", -math.inf),
     "mullins": ("mullins", 0, "-", "-", 0.0),
+    "mullins_shape": ("mullins_shape", 0, "-", "-", 1e-3),
     "heating": ("heating", 0, "1/kJ", "1/kJ", 0.0),
     "heating_tau_s": ("heating_tau_s", 0, "s", "s", 1e-9),
     "backlash": ("backlash", 1, "mm", "deg", 0.0),

@@ -16,8 +16,8 @@ from bushings.parameters import ChannelParams
 from vsim_core.compiled_cache import follow
 
 # Columns of the effect parameter matrix (one row per channel) and of the effect state.
-E_PRELOAD, E_ASYM, E_MULLINS, E_HEAT, E_HEAT_TAU, E_BACKLASH, E_TARE = range(7)
-N_ECOLS = 7
+E_PRELOAD, E_ASYM, E_ASYM_STEP, E_MULLINS, E_MULLINS_SHAPE, E_HEAT, E_HEAT_TAU, E_BACKLASH, E_TARE = range(9)
+N_ECOLS = 9
 S_XMAX, S_HEAT, S_DISS = range(3)
 N_SCOLS = 3
 #: Duration and steps of the quasi-static mounting ramp to the preload deflection.
@@ -50,14 +50,22 @@ def _effects_out(h, e, X, EP, ES, P, diss, F, K, Fout, Kout):
             k0 = P[c, kn.P_K0]
             f += abs(a) * k0 * x * abs(x) * 0.5
             k += abs(a) * k0 * abs(x)
+        s = EP[c, E_ASYM_STEP]
+        if s != 0.0 and (x < 0.0) == (s > 0.0):
+            k0 = P[c, kn.P_K0]
+            f += abs(s) * k0 * x
+            k += abs(s) * k0
         mu = EP[c, E_MULLINS]
         if mu > 0.0:
             if abs(x) > ES[c, S_XMAX]:
                 ES[c, S_XMAX] = abs(x)
             xmax = ES[c, S_XMAX]
             if xmax > 0.0:
-                eta = 1.0 - mu * (1.0 - abs(x) / xmax)
-                k = eta * k + f * mu * (1.0 if x >= 0.0 else -1.0) / xmax
+                p = EP[c, E_MULLINS_SHAPE]
+                r = abs(x) / xmax
+                eta = 1.0 - mu * (1.0 - r ** p)
+                slope = mu * p * r ** (p - 1.0) / xmax if r > 0.0 else (mu / xmax if p == 1.0 else 0.0)
+                k = eta * k + f * slope * (1.0 if x >= 0.0 else -1.0)
                 f *= eta
         kappa = EP[c, E_HEAT]
         if kappa > 0.0:
@@ -112,7 +120,8 @@ class ExtendedBank:
         M = self.bank.size
         self.EP = np.zeros((M, N_ECOLS))
         for c, fx in enumerate(self.effects):
-            self.EP[c, :E_TARE] = (fx.preload, fx.asymmetry, fx.mullins, fx.heating, fx.heating_tau_s, fx.backlash)
+            self.EP[c, :E_TARE] = (fx.preload, fx.asymmetry, fx.asymmetry_step, fx.mullins, fx.mullins_shape,
+                                   fx.heating, fx.heating_tau_s, fx.backlash)
         self.ES = np.zeros((M, N_SCOLS))
         self._X = np.zeros(M)
         self.force = np.zeros(M)

@@ -15,7 +15,8 @@ from typing import Callable
 import numpy as np
 
 from bushings.parameter_sets import load_parameter_set
-from vsim_diagnosis.catalogue import CAUSES, applicable, draw
+from vsim_diagnosis.catalogue import CAUSES, applicable, draw, draw_parameters
+from vsim_diagnosis.truth_forms import FORMS
 from vsim_diagnosis.virtual_bench import OUTSIDE, measure_bench, parse_truth
 
 
@@ -48,7 +49,8 @@ DEFAULT_BASELINE = "fig5_9_progressive"
 
 def hidden_truth(cause: str, seed: int) -> tuple[str, list[dict]]:
     """(baseline set, effects) with the cause's magnitude drawn from the seed in its realistic range;
-    ``none`` hides nothing; an OUTSIDE effect (e.g. backlash) is drawn in its range likewise."""
+    ``none`` hides nothing; an OUTSIDE effect (e.g. backlash) or another form of a catalogued effect
+    (truth_forms.FORMS) is drawn in its range likewise."""
     rng = np.random.default_rng([seed, sum(map(ord, cause))])
     baseline = BASELINES.get(cause, DEFAULT_BASELINE)
     if cause == "none":
@@ -56,6 +58,8 @@ def hidden_truth(cause: str, seed: int) -> tuple[str, list[dict]]:
     if cause in OUTSIDE:
         p = OUTSIDE[cause]
         return baseline, [{"cause": cause, p.name: float(rng.uniform(*p.draw))}]
+    if cause in FORMS:
+        return baseline, [{"cause": cause, **draw_parameters(FORMS[cause].parameters, rng)}]
     return baseline, [{"cause": cause, **draw(CAUSES[cause], rng)}]
 
 

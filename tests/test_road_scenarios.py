@@ -18,6 +18,7 @@ from vehicle.model.kinematics import steering_ratio
 from vehicle.model.vehicle_file import load_vehicle
 from vehicle.scenarios.road_scenario import ROAD_TYPES, RoadScenario
 from vehicle.scenarios.scenario_file import load_scenario
+from vehicle.scenarios.schedule import timestep
 from vehicle.simulation.rig import KCRig
 from vehicle.simulation.road import RoadCar
 from vehicle.simulation.runner import DivergenceError
@@ -200,7 +201,7 @@ def test_bushings_on_road_compares_the_cars_and_writes_its_report(tmp_path: Path
 
 def test_the_step_responses_converge_as_the_time_step_halves(tmp_path: Path) -> None:
     s = scenario(tmp_path, SHORT.replace("      - {label: right, steering_wheel_deg: -34}\n", ""))
-    coarse, fine = (road_metrics(simulate(s, timestep_s=h))[1] for h in (1e-3, 5e-4))
+    coarse, fine = (road_metrics(simulate(s, timestep_s=h))[1] for h in (timestep(s), timestep(s) / 2))
     for key in ("yaw_rate_response_time_s", "lateral_acceleration_response_time_s", "yaw_rate_peak_response_time_s"):
         assert coarse[key] == pytest.approx(fine[key], abs=1e-3), key      # < 1 ms (issue 26)
     assert coarse["steady_lateral_acceleration_mps2"] == pytest.approx(fine["steady_lateral_acceleration_mps2"], rel=1e-3)

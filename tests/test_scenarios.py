@@ -12,9 +12,9 @@ import pytest
 
 from vehicle.model.definition import CORNERS
 from vehicle.scenarios.channels import CORNER_TAGS, INPUT_CHANNELS, csv_columns
-from vehicle.scenarios.scenario import MAX_TIMESTEP_S
+from vehicle.scenarios.scenario import MAX_TIMESTEP_S, MIN_TIMESTEP_S
 from vehicle.scenarios.scenario_file import load_scenario, parse_scenario
-from vehicle.scenarios.schedule import output_interval, timestep
+from vehicle.scenarios.schedule import check_timestep, output_interval, timestep
 from vsim_core.errors import InputError
 from vsim_core.shipped import DEFAULT_VEHICLE
 
@@ -152,6 +152,22 @@ def test_a_run_steps_at_the_longest_step_that_divides_its_outputs_and_resolves_i
         assert round(steps) == 1 or interval / (round(steps) - 1) > bound, (rate, frequency, shape, h)
     shipped = {name: timestep(load_scenario(name)) for name in ("pumping", "rack_step")}
     assert shipped == pytest.approx({"pumping": 2e-3, "rack_step": 5e-3 / 3}, rel=1e-12)   # 50 and 200 Hz
+
+
+def test_the_step_resolves_a_table_and_a_fast_ramp_down_to_its_floor(tmp_path: Path) -> None:
+    """A CSV input sampled every 0.5 ms steps at 0.5 ms (a one-sample spike is not stepped over);
+    a 1 µs ramp steps at the floor MIN_TIMESTEP_S, not at 0.2 µs; a step that does not divide
+    the output interval is refused."""
+    times = np.arange(0.0, 0.02, 5e-4)
+    rows = "\n".join(f"{t:.4f},{5.0 if abs(t - 0.0100) < 1e-9 else 0.0},0,0" for t in times)
+    (tmp_path / "in.csv").write_text("t_s,pad_z_fl_mm,pad_fy_rr_daN,rack_mm\n" + rows + "\n")
+    table = load_scenario(write(tmp_path, "type: csv\noutput_rate_hz: 100\ncases: [{path: in.csv}]\n"))
+    assert timestep(table) == pytest.approx(5e-4, rel=1e-12)
+    fast = load_scenario(write(tmp_path, "type: rack_step\ncases: [{rack_mm: 5, hold_s: 1, rise_time_s: 1.0e-6}]\n",
+                               "fast.yaml"))
+    assert timestep(fast) == pytest.approx(MIN_TIMESTEP_S, rel=1e-12)   # 100 Hz: 100 steps of the floor
+    with pytest.raises(ValueError, match="does not divide"):
+        check_timestep(table, 3e-3)
 
 
 BASE = """\

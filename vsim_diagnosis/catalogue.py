@@ -14,7 +14,7 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
-from bushings.effects import BROAD_TAUS_S, broad_relaxation_branches
+from bushings.effects import BROAD_TAUS_S, NO_EFFECTS, broad_relaxation_branches
 from bushings.parameter_sets import ParameterSet
 
 
@@ -33,6 +33,8 @@ class Parameter:
     factor: bool = False               #: a factor on a design value (1: no effect), whose effect grows
     #: with its logarithm (a log parameter otherwise has no effect at 0 and an effect growing with it)
     description: str = ""
+    default: float | None = None       #: a family's shape parameter: its value in the family's first
+    #: form, taken when a truth file leaves it out
 
     @property
     def signs(self) -> tuple[float, ...]:
@@ -112,6 +114,17 @@ def _effect(key: str, parameter: str) -> Callable[[dict, dict, Mapping[str, floa
     return extend
 
 
+# A family's shape parameter left out (a hypothesis written before the family had it) is its first form.
+def _asymmetry(params: dict, effects: dict, v: Mapping[str, float]) -> tuple[dict, dict]:
+    step = v.get("asymmetry_step", NO_EFFECTS.asymmetry_step)
+    return params, _add(_add(dict(effects), "asymmetry", v["asymmetry"]), "asymmetry_step", step)
+
+
+def _mullins(params: dict, effects: dict, v: Mapping[str, float]) -> tuple[dict, dict]:
+    shape = v.get("mullins_shape", NO_EFFECTS.mullins_shape)
+    return params, {**_add(dict(effects), "mullins", v["mullins"]), "mullins_shape": shape}
+
+
 def _heating(params: dict, effects: dict, v: Mapping[str, float]) -> tuple[dict, dict]:
     return params, {**_add(dict(effects), "heating", v["heating"]), "heating_tau_s": v["heating_tau_s"]}
 
@@ -140,17 +153,28 @@ CAUSES: dict[str, Cause] = {c.id: c for c in (
           (Parameter("preload", "mm", (-5.0, 5.0), (1.5, 3.0), signed=True, sided=True,
                      description="deflection of the mounted part at the rig's zero (2-4 kN of static load)"),),
           _elastic_law, _effect("preload", "preload")),
+    # a family of two forms (issue 29): an elastomer stiffens progressively as it is compressed, and
+    # a part with a stop, a void or a rate-limiting sleeve takes its extra stiffness at once from
+    # zero deflection (a kink in its law; e.g. voided bushings, Kadlowec et al. 2003)
     Cause("asymmetry",
-          "tension/compression asymmetry beyond the elastic law: one side progressively stiffer",
+          "tension/compression asymmetry beyond the elastic law: one side stiffer, at once from zero deflection "
+          "(a kink) and progressively",
           "loops not point-symmetric about their centre",
           (Parameter("asymmetry", "1/mm", (-1.0, 1.0), (0.05, 0.15), signed=True, sided=True,
-                     description="extra tangent fraction of K0 per mm; > 0 stiffens compression"),),
-          lambda b: b.values.get("K0", 0.0) > 0.0, _effect("asymmetry", "asymmetry")),
+                     description="extra tangent fraction of K0 per mm; > 0 stiffens compression"),
+           Parameter("asymmetry_step", "-", (-1.0, 1.0), (0.03, 0.10), signed=True, sided=True, default=0.0,
+                     description="extra tangent fraction of K0 from zero deflection; > 0 stiffens compression")),
+          lambda b: b.values.get("K0", 0.0) > 0.0, _asymmetry),
+    # the recovery's shape (issue 29): a power of |x|/x_max, 1 the linear recovery, as the families of
+    # Ogden & Roxburgh (1999) and Dorfmann & Ogden (2004) bend it with the past maximum's energy
     Cause("mullins",
-          "Mullins softening: the virgin part softens below the largest deflection it has seen",
+          "Mullins softening: the virgin part softens below the largest deflection it has seen, recovering "
+          "towards it as a power of the deflection",
           "first cycle stiffer than the next; softening only below the previous maximum",
-          (Parameter("mullins", "-", (0.0, 0.8), (0.08, 0.25), description="softening fraction at zero deflection"),),
-          lambda b: True, _effect("mullins", "mullins")),
+          (Parameter("mullins", "-", (0.0, 0.8), (0.08, 0.25), description="softening fraction at zero deflection"),
+           Parameter("mullins_shape", "-", (0.2, 5.0), (0.7, 1.4), log=True, default=1.0,
+                     description="power p of the recovery: softening mu*(1 - (|x|/x_max)^p)")),
+          lambda b: True, _mullins),
     Cause("self_heating",
           "dissipated energy heats the part; stiffness and viscous parameters fall with temperature",
           "slow drift of loops over many cycles, growing with amplitude x frequency",
@@ -202,10 +226,16 @@ def draw(cause: Cause, rng: np.random.Generator) -> dict[str, float]:
 
 
 def draw_parameters(parameters: tuple[Parameter, ...], rng: np.random.Generator) -> dict[str, float]:
-    """Parameter values drawn uniformly (log-uniformly for log parameters) in the realistic range."""
-    out = {}
+    """Parameter values drawn uniformly (log-uniformly for log parameters) in the realistic range;
+    either sign for a signed parameter, one side for all the sided parameters of a family."""
+    out: dict[str, float] = {}
+    side = None
     for p in parameters:
         lo, hi = p.draw
         value = float(np.exp(rng.uniform(np.log(lo), np.log(hi)))) if p.log else float(rng.uniform(lo, hi))
-        out[p.name] = value * (float(rng.choice([-1.0, 1.0])) if p.signed else 1.0)
+        sign = 1.0
+        if p.signed:
+            sign = side if p.sided and side is not None else float(rng.choice([-1.0, 1.0]))
+            side = sign if p.sided else side
+        out[p.name] = value * sign
     return out

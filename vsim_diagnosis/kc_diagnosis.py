@@ -132,12 +132,12 @@ class KCDiagnosis(Outcome):
 
 def hypotheses(vehicle: VehicleDefinition) -> list[Hypothesis]:
     """Every catalogue cause at every place it can sit in ``vehicle``, at mid-range values; a sided
-    cause once per sign."""
+    cause once per side (all its sided parameters on it)."""
     out = []
     for c in (*BUSHING_CAUSES, *VEHICLE_CAUSES):
-        first, values = parameters(c)[0], nominal(c)
-        out += [Hypothesis(c, loc, {**values, first.name: sign * values[first.name]})
-                for loc in locations(vehicle, c) for sign in first.signs]
+        params, values = parameters(c), nominal(c)
+        out += [Hypothesis(c, loc, {**values, **{p.name: sign * values[p.name] for p in params if p.sided}})
+                for loc in locations(vehicle, c) for sign in params[0].signs]
     return out
 
 

@@ -4,7 +4,7 @@ rig's defaults, and a sensor's quantisation."""
 from __future__ import annotations
 
 import math
-from typing import Any, Mapping
+from typing import Any, Mapping, Sequence
 
 import numpy as np
 
@@ -19,6 +19,18 @@ def truth_number(value: Any, source: str, key: str, *, lower: float = -math.inf,
         expected = "> 0" if positive else f">= {lower:g}" if lower > -math.inf else ""
         raise InputError(f"expected a finite number {expected}".rstrip() + f", got {value!r}", source=source, key=key)
     return float(value)
+
+
+def truth_values(entry: Mapping[str, Any], params: Sequence[Any], source: str, key: str) -> dict[str, float]:
+    """The values of a truth file's cause ``entry`` for its catalogue ``params``: finite numbers; a
+    family's shape parameter left out takes its default (the family's first form)."""
+    return {p.name: truth_number(entry[p.name], source, f"{key}.{p.name}") if p.name in entry else float(p.default)
+            for p in params}
+
+
+def required(params: Sequence[Any]) -> list[str]:
+    """The names of ``params`` a truth file must give (those without a default)."""
+    return [p.name for p in params if p.default is None]
 
 
 def parse_measurement(raw: Any, defaults: Mapping[str, float], source: str) -> dict[str, float]:

@@ -9,7 +9,8 @@ TRUTH.yaml (bench level)::
     baseline: fig5_9_progressive      # parameter set, by name or path relative to this file
     part: "E1 front bushing, radial x"
     effects:                          # catalogue causes with their parameters (parameter-set units),
-      - {cause: mullins, mullins: 0.15}   # or `backlash` (outside the catalogue: a dead band, mm)
+      - {cause: mullins, mullins: 0.15}   # or `backlash` (outside the catalogue: a dead band, mm),
+                                          # or another form of a catalogued effect (truth_forms.FORMS)
     measurement: {force_noise_n: 1.0, displacement_noise_mm: 0.0005, force_offset_n: 2.0,
                   displacement_offset_mm: 0.002, force_resolution_n: 0.05, displacement_resolution_mm: 0.0001}
     seed: 0
@@ -30,7 +31,8 @@ from bushings.extended_bank import ExtendedBank
 from bushings.parameter_sets import ParameterSet, load_parameter_set
 from vsim_core.errors import InputError
 from vsim_diagnosis.catalogue import CAUSES, Parameter
-from vsim_diagnosis.measurement import parse_measurement, quantise, truth_number
+from vsim_diagnosis.truth_forms import FORMS
+from vsim_diagnosis.measurement import parse_measurement, quantise, required, truth_values
 from vsim_recordings.bench_dataset import BenchTestRecord, write_bench_dataset
 from vsim_core.units import MM, MM_PER_M
 
@@ -73,9 +75,12 @@ class Truth:
 
 
 def truth_model(baseline: ParameterSet, effects: list[tuple[str, dict[str, float]]]) -> ParameterSet:
-    """The baseline set with every listed effect switched on (catalogue causes, then outside ones)."""
+    """The baseline set with every listed effect switched on (catalogue causes, then outside ones);
+    other forms (:data:`~vsim_diagnosis.truth_forms.FORMS`) act on its measured force instead."""
     model = baseline
     for cause, values in effects:
+        if cause in FORMS:
+            continue
         if cause in CAUSES:
             model = CAUSES[cause].apply(model, values)
         else:
@@ -114,17 +119,17 @@ def parse_truth(data: Any, source: str, base_dir: Path | None = None) -> Truth:
     for i, entry in enumerate(raw):
         key = f"effects[{i}]"
         cause = entry.get("cause") if isinstance(entry, Mapping) else None
-        if cause not in CAUSES and cause not in OUTSIDE:
-            raise InputError(f"unknown cause {cause!r}; expected one of {', '.join([*CAUSES, *OUTSIDE])}",
+        if cause not in CAUSES and cause not in OUTSIDE and cause not in FORMS:
+            raise InputError(f"unknown cause {cause!r}; expected one of {', '.join([*CAUSES, *OUTSIDE, *FORMS])}",
                              source=source, key=f"{key}.cause")
-        params = [OUTSIDE[cause]] if cause in OUTSIDE else list(CAUSES[cause].parameters)
+        params = [OUTSIDE[cause]] if cause in OUTSIDE else list((FORMS.get(cause) or CAUSES[cause]).parameters)
         names = {p.name for p in params}
         extra = sorted(set(entry) - names - {"cause"})
-        missing = sorted(names - set(entry))
+        missing = sorted(set(required(params)) - set(entry))
         if extra or missing:
             raise InputError(f"{'unknown' if extra else 'missing'} parameter {(extra or missing)[0]!r} for {cause}; "
                              f"expected {', '.join(sorted(names))}", source=source, key=f"{key}.{(extra or missing)[0]}")
-        values = {p.name: truth_number(entry[p.name], source, f"{key}.{p.name}") for p in params}
+        values = truth_values(entry, params, source, key)
         if cause in CAUSES and not CAUSES[cause].applies(baseline):
             raise InputError(f"{cause} does not apply to baseline {baseline.name} ({baseline.model})", source=source,
                              key=f"{key}.cause")
@@ -150,7 +155,9 @@ def measure_bench(truth: Truth, output: Path, *, overwrite: bool = False, tests:
     force_offset = rng.uniform(-1.0, 1.0) * m["force_offset_n"]
     e_offset_mm = rng.uniform(-1.0, 1.0) * m["displacement_offset_mm"]
     model = truth.model
-    bank = ExtendedBank([model.channel()], [model.effects_si()])
+    channel = model.channel()
+    bank = ExtendedBank([channel], [model.effects_si()])
+    forms = [(FORMS[cause], values, {}) for cause, values in truth.effects if cause in FORMS]
     records = []
     for i, test in enumerate(tests):
         if progress is not None:
@@ -158,6 +165,8 @@ def measure_bench(truth: Truth, output: Path, *, overwrite: bool = False, tests:
         rest_before(bank, test.rest_before_s)
         t_fine, e_fine = test.signal(test.dt_s / OVERSAMPLING)
         force = bank.run(e_fine, test.dt_s / OVERSAMPLING)[:, 0]
+        for form, values, state in forms:
+            force = form.change(e_fine, force, channel.K0, values, state)
         t, e, F = t_fine[::OVERSAMPLING], e_fine[::OVERSAMPLING], force[::OVERSAMPLING]
         e_mm = quantise(e * MM_PER_M + e_offset_mm + rng.normal(0.0, m["displacement_noise_mm"], len(e)),
                          m["displacement_resolution_mm"])

@@ -44,7 +44,7 @@ from vsim_core.files import atomic_directory, is_file
 from vsim_core.shipped import DEFAULT_VEHICLE, KC_SCENARIO_DIR
 from vsim_diagnosis.kc_catalogue import (BUSHING_CAUSES, DIRECTIONS, VEHICLE_CAUSES, Hypothesis, extended_vehicle,
                                          locations, parameters)
-from vsim_diagnosis.measurement import parse_measurement, quantise, truth_number
+from vsim_diagnosis.measurement import parse_measurement, quantise, required, truth_number, truth_values
 from vsim_recordings.kc_dataset import write_kc_rig_yaml
 from vsim_recordings.recorder import simulate
 from vsim_recordings.rig_recordings import measured_channels, write_rig_recording
@@ -150,19 +150,20 @@ def _effect(entry: Any, baseline: VehicleDefinition, source: str, key: str) -> H
                          key=f"{key}.cause")
     params = parameters(cause)
     located = locations(baseline, cause) != [()]
+    names = {p.name for p in params}
     allowed = ["cause", *(["location"] if located else []), *(["directions"] if cause == "coupling" else []),
                *(p.name for p in params)]
     extra = [k for k in entry if k not in allowed]
     if extra:
         raise InputError(f"unknown key {extra[0]!r} for {cause}; expected {', '.join(allowed)}", source=source,
                          key=f"{key}.{extra[0]}")
-    missing = [k for k in allowed if k not in entry]
+    missing = [k for k in allowed if k not in entry and (k not in names or k in required(params))]
     if missing:
-        what = "parameter" if missing[0] in {p.name for p in params} else "key"
+        what = "parameter" if missing[0] in names else "key"
         raise InputError(f"missing {what} {missing[0]!r} for {cause}; expected {', '.join(allowed)}", source=source,
                          key=f"{key}.{missing[0]}")
     location = _location(entry, cause, baseline, source, key)
-    values = {p.name: truth_number(entry[p.name], source, f"{key}.{p.name}") for p in params}
+    values = truth_values(entry, params, source, key)
     hypothesis = Hypothesis(cause, location, values)
     try:
         extended_vehicle(baseline, [hypothesis])

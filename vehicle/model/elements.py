@@ -23,7 +23,7 @@ class BuildOptions:
     rigid_bushings: bool = False        #: translations rigid (kinematics); rotations unchanged
     #: [s]: the longest step of a run (a scenario's divides its output interval and resolves its
     #: inputs: vehicle.scenarios.schedule.timestep). At 2 ms the rig's camber loop moves by
-    #: < 0.005° and the road's yaw-rate response time by 0.2 ms when it halves (tools/benchmarks).
+    #: < 0.005° and the road's yaw-rate response time by < 0.1 ms when it halves (tools/benchmarks).
     timestep: float = 2e-3
 
 

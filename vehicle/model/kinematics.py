@@ -53,22 +53,25 @@ def newton(residual, x0: np.ndarray, what: str, iterations: int = 50) -> np.ndar
     x = np.array(x0, float)
     r = residual(x)
     for _ in range(iterations):
-        if np.abs(r).max() <= 1e-14:
+        if not np.all(np.isfinite(r)) or np.abs(r).max() <= 1e-14:
             break
         h = 1e-7 * np.maximum(1.0, np.abs(x))
         jac = np.column_stack([(residual(x + e) - residual(x - e)) / (2.0 * e[i])
                                for i, e in enumerate(np.diag(h))])
+        if not np.all(np.isfinite(jac)):
+            break
         step = np.linalg.lstsq(jac, -r, rcond=None)[0]
         for _ in range(30):
             trial = residual(x + step)
-            if np.abs(trial).max() < np.abs(r).max():
+            if np.all(np.isfinite(trial)) and np.abs(trial).max() < np.abs(r).max():
                 break
             step = step / 2.0
         else:
             break
         x, r = x + step, trial
     if not np.abs(r).max() <= SOLVED_M:
-        raise RuntimeError(f"{what} did not converge: residual {np.abs(r).max():.3g} m")
+        found = f"residual {np.abs(r).max():.3g} m" if np.all(np.isfinite(r)) else "a non-finite residual"
+        raise RuntimeError(f"{what} did not converge: {found}")
     return x
 
 

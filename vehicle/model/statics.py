@@ -92,7 +92,7 @@ def _solved(v: VehicleDefinition, axle: str, solve: Callable[[], tuple[CornerSta
     fail to close about the design position."""
     try:
         return solve()
-    except (RuntimeError, ValueError) as exc:  # fsolve finds no pose, brentq no bracket
+    except (RuntimeError, ValueError) as exc:  # the kinematics' Newton finds no pose
         raise InputError(f"the suspension does not move about its design position ({exc}); check the hardpoints",
                          source=str(v.path), key=f"{axle}.hardpoints") from None
 

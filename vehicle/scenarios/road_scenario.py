@@ -99,6 +99,10 @@ class RoadCase:
         """The case's scalar input (as a rig case's): the steering-wheel angle."""
         return self.steering
 
+    def longest_step_s(self) -> float:
+        """The longest time step [s] that resolves the steering and the target speed."""
+        return min(self.steering.longest_step_s(), self.speed.longest_step_s())
+
 
 @dataclass(frozen=True)
 class RoadScenario:

@@ -24,6 +24,9 @@ SHAPES = ("triangle", "sine")
 #: The longest time step [s] of a run; each run takes the longest at most this that divides its
 #: output interval and resolves its inputs (vehicle.scenarios.schedule.timestep).
 MAX_TIMESTEP_S = BuildOptions().timestep
+#: The shortest time step [s] a run takes: an input faster than it asks for (a 1 µs ramp) is a
+#: step to the car, not hours of run.
+MIN_TIMESTEP_S = 1e-4
 #: Time steps per sine period and per waypoint interval of an input, at least.
 STEPS_PER_PERIOD, STEPS_PER_WAYPOINT = 20, 5
 #: Largest sine frequency accepted [Hz] (its run steps at 1 ms, 20 steps a period).
@@ -91,6 +94,14 @@ class Case:
     def duration_s(self) -> float:
         """Length of the input phase [s] (settle phases not included)."""
         return float(self.table.times_s[-1]) if self.table is not None else self.waveform.duration_s
+
+    def longest_step_s(self) -> float:
+        """The longest time step [s] that resolves the input: its waveform's, or one step per sample
+        of a table."""
+        if self.table is None:
+            return self.waveform.longest_step_s()
+        gaps = np.diff(self.table.times_s)
+        return float(gaps[gaps > 0].min()) if np.any(gaps > 0) else math.inf
 
     def inputs(self, t_s: np.ndarray) -> np.ndarray:
         """Rig inputs (len(t_s), len(INPUT_CHANNELS)) at times since the input start [s], SI."""

@@ -8,7 +8,7 @@ import math
 from dataclasses import astuple, dataclass
 
 from vehicle.scenarios.road_scenario import RoadScenario
-from vehicle.scenarios.scenario import MAX_TIMESTEP_S, Scenario
+from vehicle.scenarios.scenario import MAX_TIMESTEP_S, MIN_TIMESTEP_S, Scenario
 from vsim_core.errors import InputError
 
 #: Largest factor on a scenario's durations (slower runs than that are typing errors).
@@ -68,12 +68,21 @@ def schedule(scenario: Scenario | RoadScenario, duration_scale: float, dt: float
 
 def timestep(scenario: Scenario | RoadScenario, longest_s: float = MAX_TIMESTEP_S) -> float:
     """The run's time step [s]: the longest at most ``longest_s`` that divides the output interval
-    and resolves every case's input as written (:meth:`Waveform.longest_step_s`; a duration scale
-    shortens a quick run, not its step). 50 Hz outputs step at 2 ms, 200 Hz at 5/3 ms."""
+    and resolves every case's input as written (:meth:`Case.longest_step_s`; a duration scale
+    shortens a quick run, not its step), but not below MIN_TIMESTEP_S. 50 Hz outputs step at 2 ms,
+    200 Hz at 5/3 ms."""
     interval = 1.0 / scenario.output_rate_hz
-    longest = min([longest_s] + [case.waveform.longest_step_s() for case in scenario.cases
-                                 if case.waveform is not None])
+    longest = max(MIN_TIMESTEP_S, min([longest_s] + [case.longest_step_s() for case in scenario.cases]))
     return interval / math.ceil(round(interval / longest, 9))
+
+
+def check_timestep(scenario: Scenario | RoadScenario, dt: float) -> None:
+    """ValueError unless ``dt`` [s] divides the scenario's output interval (else the samples would
+    come at another rate than the recording says)."""
+    steps = 1.0 / (scenario.output_rate_hz * dt)
+    if not (dt > 0.0 and abs(steps - round(steps)) <= 1e-9 * max(1.0, steps)):
+        raise ValueError(f"a time step of {dt:g} s does not divide the {1.0 / scenario.output_rate_hz:g} s "
+                         f"output interval of {scenario.name}")
 
 
 def output_interval(scenario: Scenario | RoadScenario, dt: float) -> int:

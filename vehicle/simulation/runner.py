@@ -30,7 +30,8 @@ from vehicle.model.statics import resolve_preloads
 from vehicle.scenarios.channels import INPUT_CHANNELS
 from vehicle.scenarios.road_scenario import RoadScenario
 from vehicle.scenarios.scenario import Case, Scenario
-from vehicle.scenarios.schedule import PHASES, CaseSchedule, Progress, output_interval, schedule, timestep
+from vehicle.scenarios.schedule import (PHASES, CaseSchedule, Progress, check_timestep, output_interval, schedule,
+                                        timestep)
 from vehicle.simulation.mounted import MountedCar
 from vehicle.simulation.outputs import MeasuredColumns, SampleBlock
 from vehicle.simulation.rig import KCRig
@@ -122,6 +123,8 @@ class PlayedScenario:
         # the preloads resolved once for every case's car (each build would solve the kinematics again)
         self.scenario, self.vehicle, self.duration_scale = scenario, resolve_preloads(vehicle), duration_scale
         self.progress, self._mount = progress, mount
+        if timestep_s is not None:
+            check_timestep(scenario, timestep_s)
         self.options = BuildOptions(bushing_model=scenario.bushing_model,
                                     timestep=timestep(scenario) if timestep_s is None else timestep_s)
         self.dt = self.options.timestep
