@@ -113,11 +113,11 @@ def test_a_run_compared_with_itself_differs_by_nothing(pumping: Run) -> None:
     assert camber.metrics["gradient"].unit == "deg/m" and camber.metrics["gradient"].sim < -5.0  # McPherson
     assert triangle.not_applicable == {"relaxation": "no final hold", "dynamic_stiffness": "not a sine input"}
     # the sine's |K*|: the pad's vertical force over its height, the wheel rate (29 N/mm at 0.2 Hz)
-    # and a part in quadrature that does not converge in the step at 2 Hz (|K*| 41, 34, 26 N/mm at
-    # h = 2, 1, 0.5 ms; with the closures' time constant at 1 ms, 82, 88, 73: the rig's damping)
+    # and the dampers in quadrature: 36.9, 36.8, 36.7 N/mm at h = 2, 1, 0.5 ms (it was 41, 34, 26
+    # while the pad force was read from a forward pass with the step's target held)
     pad = {ch.channel: ch for ch in sine.channels}["pad_fz_fl"]
     assert pad.metrics["dynamic_stiffness"].unit == "N/mm"
-    assert 20.0 < pad.metrics["dynamic_stiffness"].sim < 60.0
+    assert 15.0 < pad.metrics["dynamic_stiffness"].sim < 40.0
     assert "dynamic_stiffness" in sine.not_applicable and "only on pad_fz" in sine.not_applicable["dynamic_stiffness"]
 
 

@@ -125,12 +125,12 @@ def suspension(out, qpos, qvel, ten_length, ten_velocity, efc_pos, bush, spring,
 
 
 @nb.njit(cache=True)
-def rig_wheels(out, xmat, site_xpos, xfrc, qpos, efc_force, wheel, centre_site, carriage, pad_row, pad_qpos, sign,
-               design_z):
+def rig_wheels(out, xmat, site_xpos, xfrc, qpos, pad_force, wheel, centre_site, carriage, pad_qpos, sign, design_z):
     """What the rig reads at its four wheels into ``out`` (the columns of
     vehicle.simulation.outputs.RIG_WHEEL, in its order, for each wheel): wheel angles, half-track,
     travel (centre height from ``design_z``) and centre from the wheel's pose; the pad's commanded
-    Fx, Fy, its Fz (the drive equality's force, row ``pad_row``), its height and aligning torque."""
+    Fx, Fy, its Fz (``pad_force``: the drive equality's force in the last step, see
+    vehicle.simulation.stepping._run), its height and aligning torque."""
     for k in range(wheel.shape[0]):
         base = RIG_WHEEL_SIZE * k
         w, s, c = wheel[k], centre_site[k], carriage[k]
@@ -145,7 +145,7 @@ def rig_wheels(out, xmat, site_xpos, xfrc, qpos, efc_force, wheel, centre_site, 
         out[base + 7] = site_xpos[s, 2]
         out[base + 8] = xfrc[c, 0]
         out[base + 9] = xfrc[c, 1]
-        out[base + 10] = efc_force[pad_row[k]]
+        out[base + 10] = pad_force[k]
         out[base + 11] = qpos[pad_qpos[k]]
         out[base + 12] = xfrc[w, 5]
 

@@ -38,7 +38,6 @@ class KCRig(MountedCar):
         self.carriage_body = np.array([body(f"carriage_{c}") for c in CORNERS])
         self.centre_site = np.array([mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, self.car.corners[c]["centre_site"])
                                      for c in CORNERS])
-        self._run(0, _NO_INPUTS, _INACTIVE)
         #: Where each quantity sits in the rig's measured vector (:meth:`sampled`, :meth:`measure`).
         self.columns = self.measured_columns((), RIG_WHEEL)
         # The compiled measurement reads the constraint rows through views taken here: valid while
@@ -49,6 +48,10 @@ class KCRig(MountedCar):
         self._rows = self.equality_rows()
         self._efc_force, self._efc_pos = self.data.efc_force, self.data.efc_pos   # the views the probe reads
         self._efc = (self.data.nefc, self._efc_force.ctypes.data, self._efc_pos.ctypes.data)
+        self._pad_row = self._rows[self.pad_eq].astype(np.int64)
+        #: Each pad drive's force [N] in the last step (at rest, before any step: held target).
+        self.pad_force = self._efc_force[self._pad_row].copy()
+        self._run(0, _NO_INPUTS, _INACTIVE)   # compiles the stepping loop or loads it from numba's cache
         #: Wheel-centre heights at design [m] (order of CORNERS): the reference of the wheel travel.
         self.design_centre_z = self.data.site_xpos[self.centre_site, 2].copy()
         self._probe_bank: object = False   # the bank the probe's arguments were built for
@@ -85,6 +88,8 @@ class KCRig(MountedCar):
         self.coupling.reset()
         self.set_pads([0.0] * 4)
         self.set_rack(0.0)
+        mujoco.mj_forward(self.model, self.data)   # the pads' forces at rest (no step yet)
+        self.pad_force[:] = self._efc_force[self._pad_row]
 
     # -- running -----------------------------------------------------------------------------
     def step(self, n: int = 1) -> None:
@@ -103,7 +108,8 @@ class KCRig(MountedCar):
         """``n`` compiled steps (vehicle.simulation.stepping.run) with ``inputs`` and ``active`` as it documents."""
         m, d = self.model, self.data
         self._timed(stepping.run, n, inputs, active, m.eq_data, self.pad_eq, self.rack_eq, d.xfrc_applied,
-                    self.carriage_body, self.wheel_body, m._address, d._address, m.opt.timestep,
+                    self.carriage_body, self.wheel_body, self._efc_force, self._pad_row, self.pad_force, m._address,
+                    d._address, m.opt.timestep,
                     *self.coupling.kernel_arrays())
 
     def settle(self, duration: float = 1.0) -> None:
@@ -148,7 +154,8 @@ class KCRig(MountedCar):
         reset the state (:meth:`was_reset`): up to the first that follows the reset."""
         inputs, measured, pos, quat = self._sampling(samples, every, inputs, _NO_INPUTS.shape[1], bodies, "rig")
         m, d = self.model, self.data
-        rig = (m.eq_data, self.pad_eq, self.rack_eq, d.xfrc_applied, self.carriage_body, self.wheel_body)
+        rig = (m.eq_data, self.pad_eq, self.rack_eq, d.xfrc_applied, self.carriage_body, self.wheel_body,
+               self._efc_force, self._pad_row, self.pad_force)
         done = self._timed(stepping.run_sampled, every, inputs, _ALL_ACTIVE if inputs.shape[0] else _INACTIVE, rig,
                            m._address, d._address, m.opt.timestep, self.coupling.kernel_arrays(), self._probe_args(),
                            bodies.astype(np.int64), d.xpos, d.xquat, measured, pos, quat, d.warning.number,
@@ -184,9 +191,9 @@ class KCRig(MountedCar):
         if self._probe_bank is not bank:
             self._probe_bank = bank
             d = self.data
-            wheels = (d.xmat, d.site_xpos, d.xfrc_applied, d.qpos, self._efc_force, self.wheel_body.astype(np.int64),
+            wheels = (d.xmat, d.site_xpos, d.xfrc_applied, d.qpos, self.pad_force, self.wheel_body.astype(np.int64),
                       self.centre_site.astype(np.int64), self.carriage_body.astype(np.int64),
-                      self._rows[self.pad_eq].astype(np.int64), self.pad_qpos.astype(np.int64),
+                      self.pad_qpos.astype(np.int64),
                       np.array([SIDE_SIGN[c] for c in CORNERS], dtype=float), self.design_centre_z)
             data = (d.qpos, d.qvel, d.ten_length, d.ten_velocity, self._efc_pos)
             self._probe = (wheels, data, self.suspension_args(self._rows))

@@ -109,16 +109,20 @@ def coupling_step(h, qpos, qvel, qfrc, ten_length, ten_velocity, ten_J, ten_J_ro
 
 
 @nb.njit(cache=True)
-def _run(mj_step, n, inputs, active, eq_data, pad_eq, rack_eq, xfrc, carriage, wheel, m_addr, d_addr, h,
-        qpos, qvel, qfrc, ten_length, ten_velocity, ten_J, ten_J_rowadr, ten_J_rownnz, ten_J_colind, jnt_stiffness,
-        dof_damping, tendon_damping, bush, bank, cross, damp, spring):
+def _run(mj_step, n, inputs, active, eq_data, pad_eq, rack_eq, xfrc, carriage, wheel, efc_force, pad_row, pad_force,
+         m_addr, d_addr, h, qpos, qvel, qfrc, ten_length, ten_velocity, ten_J, ten_J_rowadr, ten_J_rownnz, ten_J_colind,
+         jnt_stiffness, dof_damping, tendon_damping, bush, bank, cross, damp, spring):
     """Advance ``n`` steps, row i of ``inputs`` set before step i (none if ``inputs`` has no rows).
 
     A row holds the rig inputs in the order of ``vehicle.scenarios.channels.INPUT_CHANNELS`` (17 values):
     pad heights [m], Fx, Fy [N] at the carriages, Mz [N·m] at the wheels, four corners each, then
     the rack [m]; ``active[g]`` says whether group g (pads, Fx, Fy, Mz, rack) is driven (else left
-    as is). ``mj_step`` is MuJoCo's, passed as a ctypes function so that the compiled code can be
-    cached.
+    as is). After each step ``pad_force`` holds the force of each pad's drive row (``pad_row``) in
+    that step, the force that moved the car to the new state: a later ``mj_forward`` recomputes the
+    rows with the step's target held, i.e. the force of a rig stopping now, which carries the
+    deceleration of the mass on the pad (a pad-force loop 2·m·k·V·h/(1 + h·b + h²·k) wide, m ≈ 34 kg:
+    84 N at 2 ms and 10 mm/s). ``mj_step`` is MuJoCo's, passed as a ctypes function so that the compiled code
+    can be cached.
     """
     for i in range(n):
         if inputs.shape[0]:
@@ -137,6 +141,8 @@ def _run(mj_step, n, inputs, active, eq_data, pad_eq, rack_eq, xfrc, carriage, w
         coupling_step(h, qpos, qvel, qfrc, ten_length, ten_velocity, ten_J, ten_J_rowadr, ten_J_rownnz, ten_J_colind,
                       jnt_stiffness, dof_damping, tendon_damping, bush, bank, cross, damp, spring)
         mj_step(m_addr, d_addr)
+        for c in range(pad_row.shape[0]):
+            pad_force[c] = efc_force[pad_row[c]]
 
 
 def run(*args) -> None:
@@ -162,7 +168,7 @@ def _run_sampled(mj_step, mj_forward, every, inputs, active, rig, m_addr, d_addr
                  xquat, measured, body_pos, body_quat, warnings, resets):
     """One sample every ``every`` steps for each row of ``measured``: :func:`_run` of ``every`` steps
     (their rows of ``inputs``, none if it has no rows; ``rig`` = its arguments from ``eq_data`` to
-    ``wheel``), ``mj_forward``, the rig's measured vector into the row
+    ``pad_force``), ``mj_forward``, the rig's measured vector into the row
     (:func:`vehicle.simulation.probes.rig_sample`, ``probe`` its arguments after ``out``) and the
     poses of ``bodies`` into ``body_pos``, ``body_quat``. Stops after the first sample at which one
     of MuJoCo's warning counters ``warnings[resets]`` rose (MuJoCo reset the state); returns the
