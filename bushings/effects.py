@@ -37,8 +37,8 @@ class Effects:
     asymmetry_step: float = 0.0   #: extra tangent fraction from zero deflection on one side [-] (a kink
     #: in the law), signs as ``asymmetry``: F_asym += |s|·K0·x on that side
     mullins: float = 0.0          #: softening μ below the largest |x| seen: η = 1 − μ(1 − (|x|/x_max)^p)
-    mullins_shape: float = 1.0    #: p, the shape of the recovery towards x_max (1: linear; > 1: the part
-    #: stays soft further up, < 1: it recovers early)
+    mullins_shape: float = 1.0    #: p >= 1, the shape of the recovery towards x_max (1: linear; > 1: the
+    #: part stays soft further up; < 1 would make the force's slope infinite at x = 0)
     heating: float = 0.0          #: softening per joule of heat held, κ = β/C_th [1/J]: η = 1/(1 + κQ)
     heating_tau_s: float = 300.0  #: thermal time constant of the heat held Q [s]
     backlash: float = 0.0         #: half-width of a dead band in series with the part [m or rad]
@@ -60,7 +60,7 @@ EFFECT_KEYS: dict[str, tuple[str, int, str, str, float]] = {
     "asymmetry": ("asymmetry", -1, "1/mm", "1/deg", -math.inf),
     "asymmetry_step": ("asymmetry_step", 0, "-", "-", -math.inf),
     "mullins": ("mullins", 0, "-", "-", 0.0),
-    "mullins_shape": ("mullins_shape", 0, "-", "-", 1e-3),
+    "mullins_shape": ("mullins_shape", 0, "-", "-", 1.0),
     "heating": ("heating", 0, "1/kJ", "1/kJ", 0.0),
     "heating_tau_s": ("heating_tau_s", 0, "s", "s", 1e-9),
     "backlash": ("backlash", 1, "mm", "deg", 0.0),

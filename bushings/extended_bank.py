@@ -57,14 +57,15 @@ def _effects_out(h, e, X, EP, ES, P, diss, F, K, Fout, Kout):
             k += abs(s) * k0
         mu = EP[c, E_MULLINS]
         if mu > 0.0:
-            if abs(x) > ES[c, S_XMAX]:
+            virgin = abs(x) >= ES[c, S_XMAX]   # on the virgin curve x_max moves with x: η stays 1
+            if virgin:
                 ES[c, S_XMAX] = abs(x)
             xmax = ES[c, S_XMAX]
             if xmax > 0.0:
-                p = EP[c, E_MULLINS_SHAPE]
+                p = EP[c, E_MULLINS_SHAPE]   # >= 1: the recovery's slope stays finite at x = 0
                 r = abs(x) / xmax
                 eta = 1.0 - mu * (1.0 - r ** p)
-                slope = mu * p * r ** (p - 1.0) / xmax if r > 0.0 else (mu / xmax if p == 1.0 else 0.0)
+                slope = 0.0 if virgin else mu * p * r ** (p - 1.0) / xmax
                 k = eta * k + f * slope * (1.0 if x >= 0.0 else -1.0)
                 f *= eta
         kappa = EP[c, E_HEAT]

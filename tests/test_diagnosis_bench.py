@@ -170,7 +170,7 @@ def test_asymmetry_family_adds_a_kink_and_a_progressive_part_on_one_side():
     np.testing.assert_allclose(tension, tension_law, rtol=1e-12)
 
 
-@pytest.mark.parametrize("shape", [0.5, 1.0, 2.5])
+@pytest.mark.parametrize("shape", [1.0, 2.5, 4.0])
 def test_mullins_recovery_is_the_power_of_its_shape(shape):
     """Reloaded from x_max/10 to x_max: η = 1 − μ(1 − (x/x_max)^p) of the virgin force, and the
     tangent the force's slope (what the implicit stepping needs)."""

@@ -259,3 +259,18 @@ def test_extension_keys_are_validated_in_the_vehicle_file(tmp_path):
         assert str(tmp_path) in str(err.value) and key in str(err.value) and words in str(err.value), str(err.value)
     with pytest.raises(InputError, match="with_extensions: effects.e9.z: unknown bushing"):
         with_extensions(load_vehicle(), effects={"e9.z": {"mullins": 0.1}})
+
+
+def test_a_mirrored_direction_is_the_left_law_turned_about_the_origin():
+    """The right side's law of a mirrored direction is F_right(e) = −F_left(−e), its preload and
+    both parts of its asymmetry (kink and progressive) included, along a loading history."""
+    from bushings.effects import Effects
+    from vehicle.model.geometry import mirrored_law
+
+    ch = load_parameter_set("fig5_9_progressive").channel("elastic")
+    left = Effects(preload=2e-4, asymmetry=0.1e3, asymmetry_step=0.3)
+    right_ch, right = mirrored_law(ch, left, -1.0)
+    e = 1.5e-3 * np.sin(np.linspace(0.0, 4.0 * np.pi, 400))
+    f_left = ExtendedBank([ch], [left]).run(e, 0.01)[:, 0]
+    f_right = ExtendedBank([right_ch], [right]).run(-e, 0.01)[:, 0]
+    np.testing.assert_allclose(f_right, -f_left, rtol=1e-9, atol=1e-6)

@@ -172,7 +172,7 @@ CAUSES: dict[str, Cause] = {c.id: c for c in (
           "towards it as a power of the deflection",
           "first cycle stiffer than the next; softening only below the previous maximum",
           (Parameter("mullins", "-", (0.0, 0.8), (0.08, 0.25), description="softening fraction at zero deflection"),
-           Parameter("mullins_shape", "-", (0.2, 5.0), (0.7, 1.4), log=True, default=1.0,
+           Parameter("mullins_shape", "-", (1.0, 5.0), (1.0, 2.0), log=True, default=1.0,
                      description="power p of the recovery: softening mu*(1 - (|x|/x_max)^p)")),
           lambda b: True, _mullins),
     Cause("self_heating",

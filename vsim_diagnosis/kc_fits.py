@@ -90,8 +90,11 @@ class Scorer:
 
 
 def nominal(cause: str) -> dict[str, float]:
-    """Mid-range values of a cause's parameters (geometric mean for log parameters)."""
-    return {p.name: (math.sqrt(p.draw[0] * p.draw[1]) if p.log else 0.5 * (p.draw[0] + p.draw[1]))
+    """Mid-range values of a cause's parameters (geometric mean for log parameters); a family's shape
+    parameter at its first form (its default), so that a screening run is the first parameter's
+    effect alone, scaled with it, and the second-parameter refit finds the shape."""
+    return {p.name: (p.default if p.default is not None else
+                     math.sqrt(p.draw[0] * p.draw[1]) if p.log else 0.5 * (p.draw[0] + p.draw[1]))
             for p in parameters(cause)}
 
 
@@ -117,7 +120,7 @@ def fit(h: Hypothesis, signature: np.ndarray, base: np.ndarray, scorer: Scorer,
     std = {}
     if len(columns) == 2:
         second = params[1]
-        moved = float(np.clip(at[second.name] + coef[1], *second.bounds))
+        moved = float(np.clip(at[second.name] + coef[1], *_side_bounds(second, at[first.name])))
         coef[1] = moved - at[second.name]
         coef[0] = float(np.dot(columns[0], mismatch - coef[1] * columns[1])) / gram[0, 0]
         at[second.name] = moved
@@ -180,6 +183,15 @@ def _variances(residual: np.ndarray, gram: np.ndarray) -> np.ndarray:
     return np.diag(np.linalg.inv(gram)) * s2 if gram[0, 0] > 0.0 else np.full(len(gram), math.inf)
 
 
+def _side_bounds(second: Parameter, first_value: float) -> tuple[float, float]:
+    """A second parameter's bounds; a sided one's on the side of the family's first (one side per
+    family, as the virtual rig draws it)."""
+    lo, hi = second.bounds
+    if second.sided:
+        return (max(lo, 0.0), hi) if first_value >= 0.0 else (lo, min(hi, 0.0))
+    return lo, hi
+
+
 def _magnitude(p: Parameter, at: float, coef: float, sd: float) -> tuple[float, float, float]:
     """A first parameter's value when its effect at ``at`` is scaled by ``coef`` (standard deviation
     ``sd``), kept within its bounds and on its side: the value, its uncertainty, and the scale of the
@@ -199,9 +211,10 @@ def _magnitude(p: Parameter, at: float, coef: float, sd: float) -> tuple[float, 
 def nudged(h: Hypothesis) -> tuple[Hypothesis, float]:
     """``h`` with its second parameter moved by a quarter of its realistic range (inwards from a
     bound), and the move: the run that gives the rows' slope along that parameter."""
-    second = parameters(h.cause)[1]
+    first, second = parameters(h.cause)[:2]
     value, step = h.values[second.name], 0.25 * (second.draw[1] - second.draw[0])
-    if value + step > second.bounds[1]:
+    lo, hi = _side_bounds(second, h.values[first.name])
+    if value + step > hi:
         step = -step
     return replace(h, values={**h.values, second.name: value + step}), step
 

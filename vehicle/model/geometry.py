@@ -53,12 +53,13 @@ def mirror_signs(axes, sign: float) -> np.ndarray:
 def mirrored_law(params: ChannelParams, effects: Effects, sign: float) -> tuple[ChannelParams, Effects]:
     """(law, effects) of a direction whose deflection is the left one's times ``sign`` (see
     :func:`mirror_signs`): F(e) becomes −F(−e), so the elastic law's sides, the preload and the
-    asymmetry swap; the rest of a law is odd already."""
+    asymmetry (both its parts) swap; the rest of a law is odd already."""
     if sign > 0:
         return params, effects
     p = params.replace(N_sup=-params.N_inf, N_inf=-params.N_sup, S_sup=-params.S_inf, S_inf=-params.S_sup,
                        P_sup=params.P_inf, P_inf=params.P_sup)
-    return p, dataclasses.replace(effects, preload=-effects.preload, asymmetry=-effects.asymmetry)
+    return p, dataclasses.replace(effects, preload=-effects.preload, asymmetry=-effects.asymmetry,
+                                  asymmetry_step=-effects.asymmetry_step)
 
 
 def wheel_axis(toe: float, camber: float, sign: float) -> np.ndarray:

@@ -72,8 +72,9 @@ def timestep(scenario: Scenario | RoadScenario, longest_s: float = MAX_TIMESTEP_
     shortens a quick run, not its step), but not below MIN_TIMESTEP_S. 50 Hz outputs step at 2 ms,
     200 Hz at 5/3 ms."""
     interval = 1.0 / scenario.output_rate_hz
-    longest = max(MIN_TIMESTEP_S, min([longest_s] + [case.longest_step_s() for case in scenario.cases]))
-    return interval / math.ceil(round(interval / longest, 9))
+    longest = min([longest_s] + [case.longest_step_s() for case in scenario.cases])
+    steps = min(math.ceil(round(interval / longest, 9)), max(1, math.floor(round(interval / MIN_TIMESTEP_S, 9))))
+    return interval / steps
 
 
 def check_timestep(scenario: Scenario | RoadScenario, dt: float) -> None:

@@ -165,7 +165,9 @@ class KCRig(MountedCar):
 
     # -- outputs -----------------------------------------------------------------------------
     def measure(self) -> RigOutputs:
-        """The rig's outputs at the current state (one sample without steps)."""
+        """The rig's outputs at the current state (one sample without steps): the pads' Fz are those
+        of the last step (:attr:`pad_force`), so inputs set since without a step show in Fx, Fy and
+        Mz (commands) but not yet in Fz."""
         return self.outputs(self.sampled(1, 0)[0][0])
 
     def outputs(self, v: np.ndarray) -> RigOutputs:
