@@ -47,7 +47,7 @@ def _stiff_side(x: np.ndarray, sign: float) -> np.ndarray:
 def _cubic(x, force, k0, v, state):
     c = v["asymmetry_cubic"] / MM ** 2
     side = _stiff_side(x, c)
-    return force - math.copysign(1.0, c) * abs(c) * k0 * np.where(side > 0.0, side, 0.0) ** 3 / 3.0
+    return force - c * k0 * np.where(side > 0.0, side, 0.0) ** 3 / 3.0   # c > 0: more compressive force
 
 
 def _smooth_kink(x, force, k0, v, state):
@@ -55,7 +55,7 @@ def _smooth_kink(x, force, k0, v, state):
     side = _stiff_side(x, s)
     # ∫ σ(u/w) du from 0 to side: w·(softplus(side/w) − ln 2), taken stably for large |side|/w
     grown = w * (np.logaddexp(0.0, side / w) - math.log(2.0))
-    return force - math.copysign(1.0, s) * abs(s) * k0 * grown
+    return force - s * k0 * grown
 
 
 def _ogden(x, force, k0, v, state):

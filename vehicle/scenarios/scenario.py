@@ -40,6 +40,12 @@ MAX_INPUT_S, MAX_SETTLE_S = 3600.0, 60.0
 NAME_PATTERN = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.\-]*")
 
 
+def shortest_gap_s(times_s) -> float:
+    """The shortest positive interval [s] between successive ``times_s`` (inf if none)."""
+    gaps = np.diff(np.asarray(times_s, dtype=float))
+    return float(gaps[gaps > 0].min()) if np.any(gaps > 0) else math.inf
+
+
 @dataclass(frozen=True)
 class Waveform:
     """A scalar input against time since the input start: piecewise-linear waypoints plus sines.
@@ -59,9 +65,8 @@ class Waveform:
     def longest_step_s(self) -> float:
         """The longest time step [s] that resolves the waveform: STEPS_PER_PERIOD steps per sine period
         and STEPS_PER_WAYPOINT per interval between waypoints (inf for a constant)."""
-        gaps = np.diff(self.times_s)
-        steps = [float(gaps[gaps > 0].min()) / STEPS_PER_WAYPOINT] if np.any(gaps > 0) else []
-        return min(steps + [1.0 / (STEPS_PER_PERIOD * f) for _, f in self.sines], default=math.inf)
+        return min([shortest_gap_s(self.times_s) / STEPS_PER_WAYPOINT]
+                   + [1.0 / (STEPS_PER_PERIOD * f) for _, f in self.sines])
 
     def __call__(self, t_s: np.ndarray) -> np.ndarray:
         t = np.minimum(np.asarray(t_s, dtype=float), self.duration_s)
@@ -98,10 +103,7 @@ class Case:
     def longest_step_s(self) -> float:
         """The longest time step [s] that resolves the input: its waveform's, or one step per sample
         of a table."""
-        if self.table is None:
-            return self.waveform.longest_step_s()
-        gaps = np.diff(self.table.times_s)
-        return float(gaps[gaps > 0].min()) if np.any(gaps > 0) else math.inf
+        return self.waveform.longest_step_s() if self.table is None else shortest_gap_s(self.table.times_s)
 
     def inputs(self, t_s: np.ndarray) -> np.ndarray:
         """Rig inputs (len(t_s), len(INPUT_CHANNELS)) at times since the input start [s], SI."""
