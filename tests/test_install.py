@@ -4,6 +4,7 @@ built-in scenario from an empty folder."""
 
 from __future__ import annotations
 
+import gc
 import os
 import shutil
 import subprocess
@@ -16,6 +17,8 @@ import pytest
 from bushings.bench.bench_file import load_bench
 from vehicle.model.vehicle_file import load_vehicle
 from vehicle.scenarios.scenario_file import load_scenario
+import vsim_cli.main
+from vsim_cli import executable
 from vsim_core.errors import InputError
 from vsim_core.shipped import BENCH_DIR, DEFAULT_VEHICLE, KC_SCENARIO_DIR, SCENARIO_DIR
 from vsim_recordings.run_reader import load_run
@@ -61,7 +64,7 @@ def test_a_scenario_names_an_unknown_vehicle_at_its_line(tmp_path: Path) -> None
 
 def test_the_wheel_runs_a_built_in_scenario_from_an_empty_folder(tmp_path: Path) -> None:
     """Build the wheel from the project's files, install it (without dependencies: they are this
-    environment's) into a folder of its own, and run ``vsim run pumping`` from an empty folder with
+    environment's) into a folder of its own, and run its ``vsim run pumping`` from an empty folder with
     only that folder on the path: the shipped data must come from the wheel, not the source tree."""
     wheels, target, empty, source = tmp_path / "wheels", tmp_path / "site", tmp_path / "empty", tmp_path / "source"
     empty.mkdir()
@@ -77,10 +80,36 @@ def test_the_wheel_runs_a_built_in_scenario_from_an_empty_folder(tmp_path: Path)
     where = subprocess.run([sys.executable, "-c", "import vsim_core.shipped as s; print(s.SCENARIO_DIR, s.DEFAULT_TYRE.is_file())"],
                            env=env, cwd=empty, capture_output=True, text=True, check=True).stdout.split()
     assert Path(where[0]) == target / "vsim_core" / "scenarios" and where[1] == "True"   # the .tir travels too
-    done = subprocess.run([sys.executable, "-m", "vsim_cli", "run", "pumping", "--duration-scale", "0.05"],
+    # the console script the README's first command runs (pip writes it into the target's bin/)
+    done = subprocess.run([str(target / "bin" / "vsim"), "run", "pumping", "--duration-scale", "0.05"],
                           env=env, cwd=empty, capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stderr
     run = load_run(empty / "out" / "pumping.mcap")
     assert run.complete and run.metadata.extra["scenario"] == "pumping"
     assert run.metadata.git_revision == "unknown"   # no source tree around an installed copy
     assert "c_segment" in run.metadata.vehicle_yaml and run.t_s[-1] > 5.0
+
+
+@pytest.mark.parametrize("preset", [None, "egl"])
+def test_the_executable_runs_the_command_with_the_collector_on(monkeypatch, preset) -> None:
+    """``vsim`` (``vsim_cli.executable``) passes the command's exit status through; the command runs
+    with the garbage collector on (only what the imports made is set aside) and MuJoCo's OpenGL back
+    end off unless the user chose one."""
+    seen = {}
+
+    def command() -> int:
+        seen.update(enabled=gc.isenabled(), frozen=gc.get_freeze_count(), gl=os.environ.get("MUJOCO_GL"))
+        return 3
+
+    monkeypatch.setattr(vsim_cli.main, "main", command)
+    if preset is None:
+        monkeypatch.delenv("MUJOCO_GL", raising=False)
+    else:
+        monkeypatch.setenv("MUJOCO_GL", preset)
+    try:
+        assert executable.main() == 3
+    finally:
+        gc.unfreeze()   # this test's process goes on: its objects back in the collector's care
+        gc.enable()
+    assert seen["enabled"] and seen["frozen"] > 0
+    assert seen["gl"] == (preset or "disable")

@@ -2,6 +2,6 @@
 
 import sys
 
-from vsim_cli.main import main
+from vsim_cli.executable import main
 
 sys.exit(main())

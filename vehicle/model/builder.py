@@ -29,8 +29,9 @@ left's (:func:`mirror_signs`).
 
 from __future__ import annotations
 
+import copy
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import mujoco
 import numpy as np
@@ -73,6 +74,12 @@ class CarModel:
     def xml(self) -> str:
         """The MJCF of the model."""
         return self.spec.to_xml()
+
+    def copy(self) -> CarModel:
+        """This car with a copy of its compiled model (what a mounting changes: drives' targets,
+        flags), the rest shared: a fresh car without compiling again (its channels, elements and
+        names are not changed after the build)."""
+        return replace(self, model=copy.copy(self.model))
 
     def body_point(self, data: mujoco.MjData, point) -> np.ndarray:
         """World position [m] at ``data``'s state (its kinematics recomputed) of a point given in the

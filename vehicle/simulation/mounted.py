@@ -31,9 +31,13 @@ RESET_WARNINGS = np.array([int(w) for w in (mujoco.mjtWarning.mjWARN_BADQPOS, mu
 class MountedCar:
     """A vehicle built for one mounting (``options``), with its bushing coupling."""
 
-    def __init__(self, vehicle: VehicleDefinition, options: BuildOptions):
+    def __init__(self, vehicle: VehicleDefinition, options: BuildOptions, built: CarModel | None = None):
+        """``built``: this vehicle already compiled with these options (a scenario's first case's car,
+        :meth:`CarModel.copy` of it before it ran), used instead of compiling again."""
         self.vehicle = resolve_preloads(vehicle)
-        self.car: CarModel = build(self.vehicle, options)
+        if built is not None and (built.definition is not self.vehicle or built.options != options):
+            raise ValueError("a car built for another vehicle or other build options")
+        self.car: CarModel = build(self.vehicle, options) if built is None else built.copy()
         m = self.model = self.car.model
         self.data = mujoco.MjData(m)
         self.coupling = ForceCoupling(self.car, self.data)

@@ -13,6 +13,7 @@ import dataclasses
 import mujoco
 import numpy as np
 
+from vehicle.model.builder import CarModel
 from vehicle.model.definition import CORNERS, SIDE_SIGN, VehicleDefinition
 from vehicle.model.elements import BuildOptions
 from vehicle.simulation import stepping
@@ -27,8 +28,10 @@ _ALL_ACTIVE = np.ones(5, dtype=bool)
 class KCRig(MountedCar):
     """A vehicle on the K&C rig, stepped with its bushing coupling."""
 
-    def __init__(self, vehicle: VehicleDefinition, options: BuildOptions = BuildOptions()):
-        super().__init__(vehicle, dataclasses.replace(options, rig=True))
+    def __init__(self, vehicle: VehicleDefinition, options: BuildOptions = BuildOptions(),
+                 built: CarModel | None = None):
+        """``built``: see :class:`~vehicle.simulation.mounted.MountedCar`."""
+        super().__init__(vehicle, dataclasses.replace(options, rig=True), built)
         m = self.model
         eq = lambda n: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_EQUALITY, n)
         body = lambda n: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, n)

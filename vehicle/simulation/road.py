@@ -25,6 +25,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from vehicle.model.builder import CarModel
 from vehicle.model.definition import CORNERS, SIDE_SIGN, VehicleDefinition
 from vehicle.model.elements import BuildOptions
 from vehicle.model.kinematics import steering_ratio
@@ -51,15 +52,16 @@ class RoadCar(MountedCar):
     """A vehicle on a flat road with a driver, stepped with its bushing coupling and its tyres."""
 
     def __init__(self, vehicle: VehicleDefinition, tyre_file: str | Path | None = None,
-                 options: BuildOptions = BuildOptions()):
+                 options: BuildOptions = BuildOptions(), built: CarModel | None = None):
         """``tyre_file``: the .tir of all four tyres (default: the vehicle file's ``tyre.property_file``).
-        InputError naming the vehicle file when neither names one."""
+        InputError naming the vehicle file when neither names one. ``built``: see
+        :class:`~vehicle.simulation.mounted.MountedCar`."""
         tyre_file = tyre_file or vehicle.tyre.property_file
         if tyre_file is None:
             raise InputError("the car on the road needs a tyre: give tyre.property_file (a .tir file)",
                              source=str(vehicle.path), key="tyre.property_file")
         tir = read_tir(tyre_file)
-        super().__init__(vehicle, dataclasses.replace(options, rig=False, clamped=False, road=True))
+        super().__init__(vehicle, dataclasses.replace(options, rig=False, clamped=False, road=True), built)
         m, d = self.model, self.data
         m.opt.enableflags |= mujoco.mjtEnableBit.mjENBL_ENERGY
         self.tyre_file = Path(tyre_file)

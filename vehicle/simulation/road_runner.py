@@ -61,7 +61,7 @@ class RoadRun(PlayedScenario):
     def __init__(self, scenario: RoadScenario, vehicle: VehicleDefinition, duration_scale: float = 1.0,
                  progress: Callable[[Progress], None] | None = None, timestep_s: float | None = None,
                  poses: bool = True):
-        super().__init__(scenario, vehicle, duration_scale, progress, lambda v, o: RoadCar(v, options=o), timestep_s,
+        super().__init__(scenario, vehicle, duration_scale, progress, lambda v, o, b: RoadCar(v, options=o, built=b), timestep_s,
                          poses)
 
     def _case(self, car: RoadCar, case: RoadCase, number: int, when: CaseSchedule) -> Iterator[SampleBlock]:

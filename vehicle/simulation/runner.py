@@ -24,6 +24,7 @@ from typing import Any, Callable, Iterator
 import mujoco
 import numpy as np
 
+from vehicle.model.builder import CarModel
 from vehicle.model.definition import VehicleDefinition, is_rotation
 from vehicle.model.elements import BuildOptions
 from vehicle.model.statics import resolve_preloads
@@ -108,7 +109,8 @@ def _deflection_limits(names: tuple[str, ...], rotation_rad: float, translation_
 
 class PlayedScenario:
     """What every play of a scenario shares, on the rig or on the road: the schedule of its cases,
-    the first case's car (``mount(vehicle, options)``), the simulated time and the time spent in
+    the first case's car (``mount(vehicle, options, built)``, ``built`` None or the model compiled
+    for the first case), the simulated time and the time spent in
     the compiled stepping loop. ``duration_scale`` multiplies every duration (settle phases,
     periods, holds) for quick runs; ``progress`` is called after every block with a :class:`Progress`;
     ``timestep_s`` is the car's time step (default the scenario's: :func:`~vehicle.scenarios.schedule.timestep`);
@@ -118,7 +120,8 @@ class PlayedScenario:
     phases: tuple[str, ...] = PHASES
 
     def __init__(self, scenario: Scenario | RoadScenario, vehicle: VehicleDefinition, duration_scale: float,
-                 progress: Callable[[Progress], None] | None, mount: Callable[[VehicleDefinition, BuildOptions], Any],
+                 progress: Callable[[Progress], None] | None,
+                 mount: Callable[[VehicleDefinition, BuildOptions, CarModel | None], Any],
                  timestep_s: float | None = None, poses: bool = True):
         # the preloads resolved once for every case's car (each build would solve the kinematics again)
         self.scenario, self.vehicle, self.duration_scale = scenario, resolve_preloads(vehicle), duration_scale
@@ -129,8 +132,9 @@ class PlayedScenario:
                                     timestep=timestep(scenario) if timestep_s is None else timestep_s)
         self.dt = self.options.timestep
         self.plan = schedule(scenario, duration_scale, self.dt)   # checks the scale before the build
-        #: The first case's car (each later case builds its own).
-        self.car = mount(self.vehicle, self.options)
+        #: The first case's car (each later case mounts its own on a copy of its model, as built).
+        self.car = mount(self.vehicle, self.options, None)
+        self._built = self.car.car.copy()
         self.total_s = self.plan[-1].end_s(self.dt)
         #: Ids of the bodies whose poses the blocks carry: every body but the world (``poses``), or none.
         self.recorded_bodies = np.arange(1 if poses else 0, self.car.model.nbody if poses else 0, dtype=np.int64)
@@ -148,7 +152,7 @@ class PlayedScenario:
         car = self.car
         for k, (case, when) in enumerate(zip(self.scenario.cases, self.plan), start=1):
             if k > 1:
-                car = self._mount(self.vehicle, self.options)
+                car = self._mount(self.vehicle, self.options, self._built)
             try:
                 yield from self._case(car, case, k, when)
             finally:
