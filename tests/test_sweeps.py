@@ -15,16 +15,18 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from distributed import KilledWorker
 
 from vehicle.model.file_overrides import PlaceError, file_value, vehicle_with
 from vehicle.model.vehicle_file import load_vehicle
 from vehicle.scenarios.scenario_file import load_scenario
 from vsim_analysis.run_metrics import run_metrics
 from vsim_cli.main import main
-from vsim_cluster.executor import ClusterLost, SerialExecutor, executor
+from vsim_cluster.executor import WORKERS_DIED, ClusterLost, Outcome, SerialExecutor, executor, reason
 from vsim_core.documents import Document
 from vsim_core.errors import InputError
 from vsim_core.shipped import DEFAULT_VEHICLE
@@ -182,6 +184,27 @@ def test_a_lost_scheduler_leaves_the_finished_rows_for_resume(serial_table, tmp_
     rows = _rows(tmp_path / "out")
     assert 1 <= len(rows) < 3 and all(r[-1] == "" for r in rows)    # finished runs only, none "failed"
     run_sweep(load_sweep(sweep_path), tmp_path / "out", SerialExecutor(), resume=True)
+    assert _table(tmp_path / "out") == _table(serial)
+
+
+class _WorkersDieUnderTheSecondRun(SerialExecutor):
+    """This process's runs, but the second ends as Dask ends a task whose workers kept dying."""
+
+    def each(self, fn, items):
+        for outcome in super().each(fn, items):
+            died = KilledWorker("run_point-2", SimpleNamespace(address="tcp://10.0.0.2:40000"), 3)
+            yield Outcome(outcome.index, error=reason(died)) if outcome.index == 1 else outcome
+
+
+def test_resume_makes_again_a_run_whose_workers_died(serial_table, tmp_path):
+    """A run lost with its workers is a failed row naming it, which --resume makes again; a run's
+    own failure (test_a_diverged_run_is_a_row_with_its_reason) is kept."""
+    sweep_path, serial = serial_table
+    report = run_sweep(load_sweep(sweep_path), tmp_path / "out", _WorkersDieUnderTheSecondRun())
+    rows = _rows(tmp_path / "out")
+    assert report.failed == 1 and rows[1][-1].startswith(WORKERS_DIED) and rows[1][-2] == "nan"
+    resumed = run_sweep(load_sweep(sweep_path), tmp_path / "out", SerialExecutor(), resume=True)
+    assert resumed.computed == 1 and resumed.failed == 0
     assert _table(tmp_path / "out") == _table(serial)
 
 

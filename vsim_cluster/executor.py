@@ -6,7 +6,8 @@ seed), so any worker computes the bits a serial run computes (on workers of the 
 numba compiles for the CPU it runs on). A task that raises is an outcome with its reason, not the
 end of the others; a worker that dies takes its tasks with it and the scheduler gives them to the
 others (a task that was on more dead workers than Dask's ``distributed.scheduler.allowed-failures``,
-3, fails with ``KilledWorker``). A cluster lost altogether (its scheduler gone) ends the session
+3, fails with ``KilledWorker``: its reason starts with :data:`WORKERS_DIED`, the run's own fate
+unknown). A cluster lost altogether (its scheduler gone) ends the session
 with :class:`ClusterLost`: the tasks not finished are not outcomes.
 
 The address comes from the command line (``--scheduler``), else :data:`SCHEDULER_ENV`, else a
@@ -22,7 +23,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any, Callable, Iterator, Sequence
 
-from distributed import Client, LocalCluster, as_completed
+from distributed import Client, KilledWorker, LocalCluster, as_completed
 
 from vsim_core.errors import InputError
 
@@ -32,6 +33,9 @@ SCHEDULER_ENV = "VSIM_SCHEDULER"
 SERIAL = "serial"
 #: The address that starts a cluster on this machine for the command (the default).
 LOCAL = "local"
+#: How the reason of a task begins when the workers running it kept dying (Dask's ``KilledWorker``):
+#: the cluster's failure, not the task's, so that a resumed sweep makes it again.
+WORKERS_DIED = "workers died"
 
 
 @dataclass(frozen=True)
@@ -73,8 +77,11 @@ class ClusterLost(RuntimeError):
     """The cluster stopped answering (its scheduler gone): the tasks not finished have no outcome."""
 
 
-def _reason(exc: BaseException) -> str:
+def reason(exc: BaseException) -> str:
+    """Why a task failed, in one line: the exception's type and text."""
     text = " ".join(str(exc).split())   # one line, whatever the exception printed
+    if isinstance(exc, KilledWorker):
+        return f"{WORKERS_DIED} ({text})"
     return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
 
 
@@ -89,7 +96,7 @@ class SerialExecutor(Executor):
             try:
                 result = fn(item)
             except Exception as exc:  # a task's failure is its outcome (the sweep records it)
-                yield Outcome(i, error=_reason(exc))
+                yield Outcome(i, error=reason(exc))
             else:
                 yield Outcome(i, result)
 
@@ -115,9 +122,9 @@ class DaskExecutor(Executor):
                         raise ClusterLost(f"{self.description} stopped answering (task {i + 1} of "
                                           f"{len(futures)}: {future.status})")
                     outcome = (Outcome(i, future.result()) if future.status == "finished"
-                               else Outcome(i, error=_reason(future.exception())))
+                               else Outcome(i, error=reason(future.exception())))
                 except OSError as exc:   # the connection to the scheduler or a worker went down
-                    raise ClusterLost(f"{self.description} stopped answering ({_reason(exc)})") from None
+                    raise ClusterLost(f"{self.description} stopped answering ({reason(exc)})") from None
                 yield outcome
                 future.release()
         finally:

@@ -17,6 +17,7 @@ import math
 from pathlib import Path
 from typing import Mapping, Sequence
 
+from vsim_cluster.executor import WORKERS_DIED
 from vsim_core.errors import InputError
 from vsim_core.files import atomic_output, read_text
 from vsim_core.provenance import software_version
@@ -58,7 +59,8 @@ def _line(cells: Sequence[str]) -> str:
 def read_table(path: Path, sweep: Sweep, points: Sequence[Sequence[float]]) -> dict[int, list[str]]:
     """The rows of an existing table by run number, checked against ``sweep`` and its design
     ``points``; InputError naming the file, line and column when they do not belong to this sweep.
-    A last line cut short (the process killed while writing it) is dropped: that run is redone."""
+    A last line cut short (the process killed while writing it) is dropped, and so is a run whose
+    workers died under it (:data:`~vsim_cluster.executor.WORKERS_DIED`): those runs are redone."""
     source = str(path)
     lines = read_text(path).splitlines()
     rows = list(csv.reader(lines))
@@ -81,7 +83,8 @@ def read_table(path: Path, sweep: Sweep, points: Sequence[Sequence[float]]) -> d
         if [repr(float(v)) for v in points[run - 1]] != row[1:1 + places]:
             raise InputError(f"run {run} was made with other parameter values than this sweep's design gives: "
                              f"the design changed since", source=source, key=f"line {number}")
-        out[run] = row
+        if not row[-1].startswith(WORKERS_DIED):
+            out[run] = row
     return out
 
 
