@@ -15,6 +15,7 @@ from typing import Callable
 import numpy as np
 
 from bushings.parameter_sets import load_parameter_set
+from vsim_cluster.executor import SCHEDULER_ENV, SERIAL, executor
 from vsim_diagnosis.catalogue import CAUSES, applicable, draw, draw_parameters
 from vsim_diagnosis.truth_forms import FORMS
 from vsim_diagnosis.virtual_bench import OUTSIDE, measure_bench, parse_truth
@@ -36,6 +37,11 @@ def _slow_seeds(spec: str) -> range:
 #: Seeds of the slow suites' success-rate tests, 20 per cause (VSIM_SLOW_SEEDS, see _slow_seeds, runs
 #: a part of them; the issue's figure is the full 20).
 SLOW_SEEDS = _slow_seeds(os.environ.get("VSIM_SLOW_SEEDS", "20"))
+#: Where the slow suites' draws run (VSIM_SLOW_SCHEDULER): ``serial`` (the default: one after the
+#: other in the test's process, ``pytest -n`` spreading the causes), ``local`` (a Dask cluster on this
+#: machine) or a scheduler's address (a cluster whose workers share this machine's files: the draws'
+#: folders are the test's). Each draw's own diagnosis then runs in its worker's process.
+SLOW_SCHEDULER = os.environ.get("VSIM_SLOW_SCHEDULER", SERIAL)
 #: The success rate over all draws that the slow suites require (of a single cause).
 MIN_SUCCESS_RATE = 0.9
 #: The rate at which both causes of a pair must be named (issue 29).
@@ -99,23 +105,42 @@ def diagnose_fresh(directory: Path, baseline: str, report: Path | None = None) -
     return json.loads(done.stdout)
 
 
-def assert_success_rate(cause: str, seeds: range, tmp: Path, attempt: Callable[[Path, int], None],
-                        record: Callable[[str, object], None], min_rate: float = MIN_SUCCESS_RATE) -> None:
-    """``attempt(directory, seed)`` for every seed, in a fresh directory each: an AssertionError is a
-    wrong diagnosis (printed with its seed as it comes); the rate must reach ``min_rate``.
-    ``record`` is pytest's ``record_property``: the tally goes to the run's summary (tests/conftest.py),
-    which ``pytest -n`` does not swallow as it does what tests print."""
-    right, wrong = 0, []
-    for seed in seeds:
-        case = tmp / str(seed)
+class _Draw:
+    """One draw of a success-rate test as a task: ``attempt`` in a fresh folder of ``tmp``; the
+    verdict as text ("" right, else why wrong); any error but an AssertionError is raised."""
+
+    def __init__(self, attempt: Callable[[Path, int], None], tmp: Path, spread: bool):
+        self.attempt, self.tmp, self.spread = attempt, tmp, spread
+
+    def __call__(self, seed: int) -> str:
+        if self.spread:   # the draws fill the cluster's workers: each diagnosis in its worker's process
+            os.environ[SCHEDULER_ENV] = SERIAL
+        case = self.tmp / str(seed)
         case.mkdir()
         try:
-            attempt(case, seed)
+            self.attempt(case, seed)
+        except AssertionError as exc:
+            return str(exc) or "wrong"
+        return ""
+
+
+def assert_success_rate(cause: str, seeds: range, tmp: Path, attempt: Callable[[Path, int], None],
+                        record: Callable[[str, object], None], min_rate: float = MIN_SUCCESS_RATE,
+                        scheduler: str = SLOW_SCHEDULER) -> None:
+    """``attempt(directory, seed)`` for every seed, in a fresh directory each, on ``scheduler``'s
+    executor (:data:`SLOW_SCHEDULER`): an AssertionError is a wrong diagnosis (printed with its seed);
+    the rate must reach ``min_rate``. ``record`` is pytest's ``record_property``: the tally goes to the
+    run's summary (tests/conftest.py), which ``pytest -n`` does not swallow as it does what tests print."""
+    with executor(scheduler) as ex:
+        verdicts = ex.map(_Draw(attempt, tmp, scheduler != SERIAL), list(seeds))
+    right, wrong = 0, []
+    for seed, why in zip(seeds, verdicts):
+        if why:
+            wrong.append(seed)
+            print(f"\n{cause} seed {seed}: wrong: {why}")
+        else:
             right += 1
             print(f"\n{cause} seed {seed}: right")
-        except AssertionError as exc:
-            wrong.append(seed)
-            print(f"\n{cause} seed {seed}: wrong: {exc}")
     record(TALLY, {"cause": cause, "right": right, "draws": len(seeds), "wrong": wrong})
     rate = right / len(seeds)
     print(f"\n{cause}: {right}/{len(seeds)} diagnosed right ({rate:.0%})")

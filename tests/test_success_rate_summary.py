@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 pytest_plugins = ["pytester"]
@@ -30,3 +31,24 @@ def test_tallies_are_summed_up_per_file_under_xdist(pytester, monkeypatch):
                                   r"test_rates.py  mullins +10/10$",
                                   r"test_rates.py  none +8/10 +wrong: seeds 100, 101$",
                                   r"test_rates.py  all single draws +27/30 +\(90%; required at least 90%\)$"])
+
+
+def test_draws_spread_on_a_cluster_give_the_tally_of_draws_in_turn(tmp_path):
+    """VSIM_SLOW_SCHEDULER: the draws as tasks of a local Dask cluster, each in a folder of its own
+    with its diagnosis kept in its worker's process, tally as the draws made one after the other."""
+    from tests.diagnosis_helpers import assert_success_rate
+    from vsim_cluster.executor import LOCAL, SCHEDULER_ENV, SERIAL
+
+    here = os.getpid()
+
+    def attempt(case: Path, seed: int) -> None:
+        assert case.is_dir() and not any(case.iterdir())
+        assert os.getpid() == here or os.environ[SCHEDULER_ENV] == SERIAL, "a nested cluster"
+        assert seed % 3, "named another cause"
+
+    tallies = {}
+    for scheduler in (SERIAL, LOCAL):
+        (tmp_path / scheduler).mkdir()
+        assert_success_rate("mullins", range(100, 109), tmp_path / scheduler, attempt,
+                            lambda name, tally: tallies.setdefault(scheduler, tally), 0.5, scheduler)
+    assert tallies[LOCAL] == tallies[SERIAL] == {"cause": "mullins", "right": 6, "draws": 9, "wrong": [102, 105, 108]}
