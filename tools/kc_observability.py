@@ -8,7 +8,7 @@ error), in units of the channel's noise (the virtual rig's defaults). A baseline
 ``vsim_diagnosis.kc_catalogue.OBSERVABLE`` lists the places whose excess is at least
 ``kc_catalogue.MIN_EXCESS`` at the test campaign's speed (``--duration-scale 0.25``).
 
-    python tools/kc_observability.py [--vehicle V.yaml] [--duration-scale S] [--json]
+    python tools/kc_observability.py [--vehicle V.yaml] [--duration-scale S] [--cause C ...] [--json]
 
 About 2 min on 2 cores at ``--duration-scale 0.25`` (its runs on a local Dask cluster, or where ``VSIM_SCHEDULER`` says).
 """
@@ -78,12 +78,14 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--vehicle", type=Path, default=DEFAULT_VEHICLE)
     parser.add_argument("--duration-scale", type=float, default=1.0, help="the campaign's speed-up (0.25: the tests')")
+    parser.add_argument("--cause", action="append", choices=[*BUSHING_CAUSES, *VEHICLE_CAUSES, "backlash"],
+                        help="only this cause (repeat for more; default: every cause)")
     parser.add_argument("--json", action="store_true")
     args = parser.parse_args()
     vehicle = load_vehicle(args.vehicle)
     base = campaign(vehicle, args.duration_scale)
-    places = [Hypothesis(c, where, values) for c in (*BUSHING_CAUSES, *VEHICLE_CAUSES, "backlash")
-              for where in locations(vehicle, c) for values in weak(c)]
+    causes = args.cause or (*BUSHING_CAUSES, *VEHICLE_CAUSES, "backlash")
+    places = [Hypothesis(c, where, values) for c in causes for where in locations(vehicle, c) for values in weak(c)]
     out: dict[str, dict[str, float]] = {}
     with executor() as ex, closing(ex.each(_campaign, [(extended_vehicle(vehicle, [h]), args.duration_scale)
                                                        for h in places])) as outcomes:

@@ -5,8 +5,9 @@ one's, mirrored on the right as the vehicle mirrors every law) and extends that 
 The vehicle adds causes of its own: ``coupling`` (a cross stiffness between two directions of one
 bushing), ``strut_friction`` (Coulomb friction of the strut rods), ``beam_torsion`` (a factor on
 the twist beam's torsional stiffness), and an axle's ``spring_rate``, ``damper_force`` and (front)
-``anti_roll_bar`` off their design values by a factor: the errors engineers find first when they
-correlate a model with a K&C rig, beside hardpoints (not screened yet). Outside the catalogue, the virtual rig can hide
+``anti_roll_bar`` off their design values by a factor, and a ``hardpoint`` a few millimetres off
+along one coordinate (both sides, as the vehicle file mirrors them): the errors engineers find
+first when they correlate a model with a K&C rig. Outside the catalogue, the virtual rig can hide
 ``backlash`` (a dead band in one bushing direction, as a worn ball joint would give).
 
 ``self_heating`` is not a K&C cause: the rig's triangles at 0.1 Hz dissipate a few joules per cycle
@@ -24,7 +25,8 @@ import numpy as np
 
 from bushings.parameter_sets import ParameterSet, load_parameter_set
 from vehicle.model.definition import BushingDef, Curve, Damper, DirectionDef, VehicleDefinition
-from vehicle.model.vehicle_file import with_extensions
+from vehicle.model.file_overrides import vehicle_with
+from vehicle.model.vehicle_file import parse_vehicle, with_extensions
 from vsim_core.documents import Document, dump_yaml
 from vsim_core.errors import InputError
 from vsim_core.units import DEG_PER_RAD, MM_PER_M
@@ -75,7 +77,16 @@ VEHICLE_CAUSES: dict[str, VehicleCause] = {c.id: c for c in (
     VehicleCause("damper_force", "an axle's dampers give more or less force than their curve (valving, oil)",
                  "loops that widen with the input's speed on one axle",
                  (_scale("damper_scale", "damper curve's forces"),), located=True, axles=("front", "rear")),
+    VehicleCause("hardpoint", "a suspension hardpoint of the model off where the car has it (drawing, tolerances "
+                 "of the build, the measurement of the car), along one coordinate, both sides alike",
+                 "kinematic gradients (bump and roll steer, camber gain) and compliance steer off on one axle, "
+                 "loop widths unchanged",
+                 (Parameter("offset", "mm", (-25.0, 25.0), (1.0, 4.0), signed=True,
+                            description="the hardpoint's displacement along its coordinate (the right side mirrored)"),),
+                 located=True, axles=("front", "rear")),
 )}
+#: Coordinates of a hardpoint, in the order of the vehicle file's [x, y, z] (ISO 8855, metres).
+COORDINATES = ("x", "y", "z")
 #: The vehicle file's section of each axle factor cause (its `rate` or its `curve`'s forces are multiplied).
 AXLE_SCALES = {"spring_rate": "spring", "anti_roll_bar": "anti_roll_bar", "damper_force": "damper"}
 #: The model error in excess of the noise (RMS over the K&C campaign of the change of every compared
@@ -103,6 +114,15 @@ OBSERVABLE: dict[str, dict[tuple[str, ...], float]] = {
     "beam_torsion": {(): 1.106},
     "spring_rate": {("front",): 1.048, ("rear",): 1.060},
     "anti_roll_bar": {("front",): 1.096},
+    # the heights that set bump steer and camber gain, the tie rod's lever, the strut's inclination;
+    # the rest (the pivots' x and y, spring and damper mounts: floors of 7 to over 100 mm) hardly
+    # shows in quasi-static K&C tests
+    "hardpoint": {("front", "tie_rod_inner", "z"): 0.416, ("front", "wishbone_front_pivot", "z"): 0.467,
+                  ("front", "tie_rod_outer", "z"): 0.470, ("front", "lower_ball_joint", "z"): 0.510,
+                  ("front", "tie_rod_outer", "x"): 1.261, ("front", "lower_ball_joint", "x"): 1.277,
+                  ("front", "strut_lower", "y"): 1.905, ("front", "strut_top", "y"): 1.944,
+                  ("front", "wishbone_rear_pivot", "z"): 2.174, ("rear", "arm_pivot", "z"): 1.763,
+                  ("rear", "wheel_centre", "z"): 2.17, ("rear", "beam_centre", "z"): 2.495},
     "backlash": {("e1_front", "y"): 0.049, ("e1_rear", "x"): 0.103, ("e1_rear", "y"): 0.057},
 }
 #: Outside the catalogue: a dead band in one bushing direction.
@@ -120,12 +140,16 @@ class Hypothesis:
 
     @property
     def label(self) -> str:
-        """``cause@bushing.direction`` (or the axle cause alone), for people."""
-        where = {1: "{0}", 2: "{0}.{1}", 3: "{0}.{1}/{2}"}.get(len(self.location), "").format(*self.location)
+        """``cause@bushing.direction`` (``coupling@bushing.a/b``, ``hardpoint@axle.point.coordinate``, or
+        the axle cause alone), for people."""
+        where = ".".join(self.location) if self.cause == "hardpoint" else \
+            {1: "{0}", 2: "{0}.{1}", 3: "{0}.{1}/{2}"}.get(len(self.location), "").format(*self.location)
         return f"{self.cause}@{where}" if where else self.cause
 
     def location_json(self) -> dict[str, Any] | None:
         """The location as the diagnosis reports it."""
+        if self.cause == "hardpoint":
+            return dict(zip(("axle", "hardpoint", "coordinate"), self.location))
         if len(self.location) == 2:
             return {"bushing": self.location[0], "direction": self.location[1]}
         if len(self.location) == 3:
@@ -195,6 +219,10 @@ def locations(vehicle: VehicleDefinition, cause: str) -> list[tuple[str, ...]]:
     of translations of one bushing (coupling), an axle (``("front",)``) or a fixed place (``()``)."""
     if cause == "coupling":
         return [(b.name, a, c) for b in vehicle.bushings for i, a in enumerate(DIRECTIONS) for c in DIRECTIONS[i + 1:]]
+    if cause == "hardpoint":   # a point on the centre plane (the beam's centre) stays on it
+        return [(axle, name, c) for axle in VEHICLE_CAUSES[cause].axles
+                for name, point in getattr(vehicle, axle).hardpoints.items()
+                for c in COORDINATES if not (c == "y" and point[1] == 0.0)]
     if cause in VEHICLE_CAUSES:
         return [(a,) for a in VEHICLE_CAUSES[cause].axles] or [()]
     applies = CAUSES[cause].applies if cause in CAUSES else (lambda law: True)
@@ -208,6 +236,7 @@ def _si_per_file_unit(direction: str) -> float:
 
 def extended_vehicle(vehicle: VehicleDefinition, hypotheses: list[Hypothesis]) -> VehicleDefinition:
     """``vehicle`` with every hypothesis switched on (the truth of the virtual rig, or a fitted model)."""
+    vehicle = _moved_hardpoints(vehicle, [h for h in hypotheses if h.cause == "hardpoint"])
     laws: dict[str, ParameterSet] = {}
     coupling: dict[str, list[dict[str, Any]]] = {}
     strut = beam = None
@@ -217,7 +246,7 @@ def extended_vehicle(vehicle: VehicleDefinition, hypotheses: list[Hypothesis]) -
             strut = v["strut_friction"]
         elif h.cause == "beam_torsion":
             beam = v["beam_torsion_scale"]
-        elif h.cause in AXLE_SCALES:
+        elif h.cause in AXLE_SCALES or h.cause == "hardpoint":
             continue   # set on the extended vehicle below
         elif h.cause == "coupling":
             name, a, b = h.location
@@ -239,6 +268,23 @@ def extended_vehicle(vehicle: VehicleDefinition, hypotheses: list[Hypothesis]) -
         if h.cause in AXLE_SCALES:
             out = _scaled_axle(out, h.cause, h.location[0], float(h.values[parameters(h.cause)[0].name]))
     return out
+
+
+def _moved_hardpoints(vehicle: VehicleDefinition, moves: list[Hypothesis]) -> VehicleDefinition:
+    """``vehicle`` with the hardpoints of ``moves`` (``hardpoint`` hypotheses) moved, as its file edited
+    by hand: the bushings that sit on a hardpoint, and their axes through hardpoints, follow it.
+    ValueError for a vehicle changed in code since its file was read (its text no longer says it)."""
+    if not moves:
+        return vehicle
+    if not vehicle.text or parse_vehicle(vehicle.text, vehicle.path) != vehicle:
+        raise ValueError(f"{vehicle.name}: hardpoints are moved in the vehicle's file, which no longer describes it")
+    places: dict[str, float] = {}
+    for h in moves:
+        axle, name, coordinate = h.location
+        at = places.get(f"{axle}.hardpoints.{name}.{coordinate}",
+                        getattr(vehicle, axle).hardpoints[name][COORDINATES.index(coordinate)])
+        places[f"{axle}.hardpoints.{name}.{coordinate}"] = at + float(h.values["offset"]) / MM_PER_M
+    return vehicle_with(vehicle.text, vehicle.path, places, "the diagnosis's hardpoint offsets")
 
 
 def _scaled_axle(vehicle: VehicleDefinition, cause: str, axle: str, factor: float) -> VehicleDefinition:
@@ -271,6 +317,9 @@ def extended_vehicle_yaml(baseline: VehicleDefinition, hypotheses: list[Hypothes
         elif h.cause == "coupling":
             name, a, b = h.location
             entries[name].setdefault("coupling", []).append({"directions": [a, b], "stiffness": v["stiffness"]})
+        elif h.cause == "hardpoint":
+            axle, name, coordinate = h.location
+            data[axle]["hardpoints"][name] = [float(x) for x in getattr(extended, axle).hardpoints[name]]
         elif h.cause in AXLE_SCALES:
             section, factor = data[h.location[0]][AXLE_SCALES[h.cause]], float(v[parameters(h.cause)[0].name])
             if "rate" in section:

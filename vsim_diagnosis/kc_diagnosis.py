@@ -15,7 +15,9 @@
    effect of one more run with that parameter moved: both are fitted), run again, and scored on the
    held-out tests: the verdict rests on full vehicle simulations, never on the screening's
    linearisation.
-4. When the best leaves a mismatch beyond the noise, or a test it does not fit: every other
+4. A rival that the campaign cannot tell from the best (:mod:`vsim_diagnosis.kc_alike`) is reported
+   with the shipped test that would separate them.
+5. When the best leaves a mismatch beyond the noise, or a test it does not fit: every other
    hypothesis beside it, its magnitude fitted on what the best's run leaves from its own screening
    run; the best few run beside it on every test, both magnitudes refitted together, run again and
    scored (:func:`vsim_diagnosis.verdict.pair_named` decides whether two causes are named).
@@ -45,6 +47,7 @@ import numpy as np
 from vehicle.model.definition import VehicleDefinition
 from vsim_cluster.executor import Executor, TaskFailed, executor as open_executor
 from vsim_diagnosis.catalogue import PAIR_SEPARATOR
+from vsim_diagnosis.kc_alike import Separation, alike, extra_scenarios, separations
 from vsim_diagnosis.kc_catalogue import (BUSHING_CAUSES, VEHICLE_CAUSES, Hypothesis, extended_vehicle, locations,
                                          parameters)
 from vsim_diagnosis.kc_fits import Candidate, Scorer, fit, fit_pair, kept, nominal, nudged, verify
@@ -94,6 +97,10 @@ class KCDiagnosis(Outcome):
     second: Candidate | None = None       #: the second cause named (one of ``pairs``), if any
     #: held-out error of the second cause alone, at its own single fit as ``best`` is (for its share)
     second_alone_error: float = math.nan
+    #: verified rivals of a single named cause that the campaign cannot tell from it (kc_alike), best first
+    alike: list[Candidate] = field(default_factory=list)
+    #: per rival, the shipped test the dataset lacks that separates it from the named cause best
+    separations: list[Separation | None] = field(default_factory=list)
 
     @property
     def final(self) -> Candidate:
@@ -215,6 +222,17 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, executor: Execut
                     single = replace(single)
                     verify([single], rows([extended_vehicle(vehicle, [single.hypothesis])], every), scorer)
                 alone = single.heldout_error
+        rivals: list[Candidate] = []
+        apart: list[Separation | None] = []
+        if second is None and decide(before, best.heldout_error, 1.0) == "named":
+            rivals = alike(best, top, before)
+        if rivals:
+            say(f"{best.hypothesis.label} cannot be told apart on these tests from "
+                f"{', '.join(c.hypothesis.label for c in rivals)}: both run on the shipped tests the dataset lacks")
+            apart = separations([extended_vehicle(vehicle, [c.hypothesis]) for c in (best, *rivals)],
+                                extra_scenarios({t.job.scenario.name for t in layout.tests}), layout.channels,
+                                scorer.noise, float(np.median([t.job.duration_scale for t in layout.tests])),
+                                lambda jobs: pool.map(run_job, jobs))
     errors = scorer.test_errors(base)
     for m in found:
         say(f"the baseline does not fit {m.test}{' (held out)' if m.heldout else ''}: {m.error:.2f} × the noise, "
@@ -232,7 +250,7 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, executor: Execut
         say(f"  with it, {m.test} is still not fitted: {m.error:.2f} × the noise")
     out = KCDiagnosis(verdict, best, top + screened[VERIFIED:], heldout, [t.name for t in layout.tests], errors,
                       before, layout, scorer.noise, base, None, found, left, time.perf_counter() - started, pairs,
-                      second, alone)
+                      second, alone, rivals, apart)
     if verdict == "named":
         named = [c.hypothesis for c in out.causes]
         out.verdict = PAIR_SEPARATOR.join(h.cause for h in named)

@@ -111,6 +111,13 @@ def decide(before: float, after: float, floor: float, misfit_seen: bool = False)
     return "none" if before <= NOISE_FACTOR * floor and not misfit_seen else "unexplained"
 
 
+def told_apart(rival: float, best: float, floor: float) -> bool:
+    """Whether the data tell the best cause (held-out error ``best``) from a ``rival`` (its own): the
+    best beats the rival as a cause must beat the baseline (:func:`decide`), not by a share of the
+    noise that another draw of it could reverse."""
+    return decide(rival, best, floor) == "named"
+
+
 def second_cause_wanted(before: float, after: float, floor: float, misfit_left: bool = False) -> bool:
     """Whether to look for two causes at once: what the best single cause leaves (its held-out error
     ``after``, or the baseline's ``before`` if it makes things worse) is beyond NOISE_FACTOR times

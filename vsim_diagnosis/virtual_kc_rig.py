@@ -98,9 +98,9 @@ def _path(value: Any, base_dir: Path | None) -> Path:
     return path if path.is_absolute() or base_dir is None else base_dir / path
 
 
-def _label(location: tuple[str, ...]) -> str:
-    return location[0] if len(location) == 1 else ".".join(location) if len(location) == 2 else \
-        f"{location[0]} [{location[1]}, {location[2]}]"
+def _label(location: tuple[str, ...], cause: str) -> str:
+    return location[0] if len(location) == 1 else ".".join(location) if len(location) == 2 or cause == "hardpoint" \
+        else f"{location[0]} [{location[1]}, {location[2]}]"
 
 
 def _location(entry: Mapping[str, Any], cause: str, baseline: VehicleDefinition, source: str,
@@ -122,15 +122,16 @@ def _location(entry: Mapping[str, Any], cause: str, baseline: VehicleDefinition,
                              source=source, key=f"{key}.directions")
         location = (where, *sorted(dirs, key=DIRECTIONS.index))
         if location not in valid:
-            raise InputError(f"coupling cannot sit in {_label(location)}; valid bushings: {bushings}", source=source,
+            raise InputError(f"coupling cannot sit in {_label(location, cause)}; valid bushings: {bushings}", source=source,
                              key=f"{key}.location")
         return location
     where = entry.get("location")
     location = tuple(where.split(".")) if isinstance(where, str) else ()
     if location not in valid:
-        choices = ", ".join(_label(loc) for loc in valid) if valid else \
+        choices = ", ".join(_label(loc, cause) for loc in valid) if valid else \
             f"none: {cause} applies to no bushing direction of {baseline.name}"
-        form = "an axle" if all(len(loc) == 1 for loc in valid) else "bushing.direction"
+        form = "an axle" if all(len(loc) == 1 for loc in valid) else \
+            "axle.hardpoint.coordinate" if cause == "hardpoint" else "bushing.direction"
         raise InputError(f"{cause} cannot sit in {where!r}; expected {form}, one of: {choices}",
                          source=source, key=f"{key}.location")
     return location

@@ -15,6 +15,7 @@ from vehicle.model.definition import VehicleDefinition
 from vsim_core.files import atomic_output
 from vsim_diagnosis.catalogue import PAIR_SEPARATOR
 from vsim_diagnosis.kc_catalogue import Hypothesis, extended_vehicle_yaml, parameters
+from vsim_diagnosis.kc_alike import Separation
 from vsim_diagnosis.kc_diagnosis import KCDiagnosis, Misfit
 from vsim_diagnosis.kc_fits import Candidate
 from vsim_diagnosis.verdict import MISFIT_CHANCE, NOISE_FACTOR
@@ -76,11 +77,37 @@ def summary(d: KCDiagnosis) -> dict[str, Any]:
         "share_explained": d.explained[1],
         "causes": [{"cause": c.hypothesis.cause, "location": c.hypothesis.location_json(),
                     "parameters": _parameters(d, c), "share_explained": share} for c, share in zip(d.causes, d.shares)],
+        "alike": [_alike(c, sep) for c, sep in zip(d.alike, d.separations)],
         "misfits": [_misfit(m) for m in d.misfits],
         "misfits_after": [_misfit(m) for m in d.misfits_after],
         "noise": {c: float(s) for c, s in zip(d.layout.channels, d.noise)},
         "wall_s": d.wall_s,
     }
+
+
+def _alike(c: Candidate, sep: Separation | None) -> dict[str, Any]:
+    """A rival the campaign cannot tell from the named cause, and the shipped test that separates them."""
+    return {"cause": c.hypothesis.cause, "location": c.hypothesis.location_json(),
+            "parameters": dict(c.hypothesis.values), "heldout_error": c.heldout_error,
+            "separated_by": None if sep is None else {"scenario": sep.scenario, "file": str(sep.path),
+                                                      "difference": sep.difference, "separates": sep.separates}}
+
+
+def _alike_sentence(d: KCDiagnosis) -> str:
+    """What the campaign cannot tell apart, and the test that would."""
+    out = ""
+    for c, sep in zip(d.alike, d.separations):
+        values = ", ".join(f"{k} = {v:.4g} {p.unit}" for (k, v), p in zip(c.hypothesis.values.items(),
+                                                                           parameters(c.hypothesis.cause)))
+        out += (f" These tests cannot tell it from **{c.hypothesis.cause}** at {_where(c)} ({values}; held-out error "
+                f"{c.heldout_error:.2f}): ")
+        if sep is None or not sep.separates:
+            out += ("no shipped test separates them" + ("." if sep is None else
+                    f" (the most, `{sep.scenario}`, by {sep.difference:.2g} × the noise, RMS)."))
+        else:
+            out += (f"the shipped test `{sep.scenario}` would separate them (their predictions differ there by "
+                    f"{sep.difference:.2g} × the noise, RMS).")
+    return out
 
 
 def _misfit(m: Misfit) -> dict[str, Any]:
@@ -125,7 +152,7 @@ def verdict_sentence(d: KCDiagnosis) -> str:
     how, share = d.explained
     if how == "partial":
         sentence += partly_explained(share, ", ".join(m.test for m in d.misfits_after))
-    return sentence
+    return sentence + _alike_sentence(d)
 
 
 def _test_features(d: KCDiagnosis, measured: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -1,0 +1,95 @@
+"""Causes a K&C campaign cannot tell apart, and the test that would (:mod:`vsim_diagnosis.kc_diagnosis`).
+
+Two hypotheses can act alike on the tests measured: a hardpoint and a bushing stiffness, the two
+ends of the strut's axis moved sideways, the tie rod's inner end raised or its outer end lowered.
+A rival of the best cause is *alike* when it would be named on its own (it explains the mismatch
+as a cause must) and the best does not beat it as a cause must beat what it is compared with
+(:func:`vsim_diagnosis.verdict.told_apart`): the campaign then names the best, but it cannot say
+which of the two is the car's. Each alike rival and the best are run on every shipped rig scenario
+the dataset lacks; the one where their predictions differ most, in units of the measured noise
+(each channel's mean removed, as a zero error would be), is the extra test that separates them.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable, Sequence
+
+import numpy as np
+
+from vehicle.model.definition import VehicleDefinition
+from vehicle.scenarios.scenario import Scenario
+from vehicle.scenarios.scenario_file import load_scenario
+from vsim_core.shipped import SCENARIO_DIR, built_in
+from vsim_diagnosis.kc_fits import Candidate
+from vsim_diagnosis.kc_layout import Job
+from vsim_diagnosis.verdict import decide, told_apart
+
+
+@dataclass(frozen=True)
+class Separation:
+    """A shipped test and how far apart two models' predictions of it lie."""
+
+    scenario: str          #: the scenario's name
+    path: Path             #: its file
+    difference: float      #: RMS of the predictions' difference [× the noise], each channel's mean removed
+
+    @property
+    def separates(self) -> bool:
+        """Whether the test, measured, would tell the two apart as the diagnosis tells causes apart:
+        the wrong one's error there, √(1 + difference²) × the noise, told from the right one's, the
+        noise (:func:`~vsim_diagnosis.verdict.told_apart`: a difference of at least 0.48)."""
+        return told_apart(math.hypot(1.0, self.difference), 1.0, 1.0)
+
+
+def alike(best: Candidate, verified: Sequence[Candidate], before: float, floor: float = 1.0) -> list[Candidate]:
+    """The verified candidates other than ``best`` (another cause, or another place) that would be
+    named on their own against the baseline's held-out error ``before`` and that ``best`` does not
+    tell apart from itself (:func:`~vsim_diagnosis.verdict.told_apart`), best first."""
+    same = lambda c: (c.hypothesis.cause, c.hypothesis.location) == (best.hypothesis.cause, best.hypothesis.location)
+    return [c for c in verified if c.verified and not same(c)
+            and decide(before, c.heldout_error, floor) == "named"
+            and not told_apart(c.heldout_error, best.heldout_error, floor)]
+
+
+def extra_scenarios(measured: Sequence[str]) -> list[tuple[Path, Scenario]]:
+    """The shipped rig scenarios (the K&C campaign's and the others; not the road's) whose names are
+    not among ``measured``."""
+    out = []
+    for name in built_in(SCENARIO_DIR):
+        path = SCENARIO_DIR / f"{name}.yaml"
+        scenario = load_scenario(path)
+        if isinstance(scenario, Scenario) and scenario.name not in measured:
+            out.append((path, scenario))
+    return out
+
+
+def separations(vehicles: Sequence[VehicleDefinition], scenarios: Sequence[tuple[Path, Scenario]],
+                channels: Sequence[str], noise: np.ndarray, duration_scale: float,
+                run: Callable[[list[Job]], list[dict[str, np.ndarray]]]) -> list[Separation | None]:
+    """For every vehicle after the first (the rivals of ``vehicles[0]``, the best cause's), the
+    scenario whose predictions differ most from the first's in units of ``noise`` (per channel of
+    ``channels``), or None without scenarios; ``run`` gives the compared channels of jobs (their
+    input phases), on whatever executor."""
+    if not scenarios:
+        return [None] * (len(vehicles) - 1)
+    jobs = [Job(s, v, duration_scale, tuple(channels)) for v in vehicles for _, s in scenarios]
+    results = run(jobs)
+    n = len(scenarios)
+    predicted = [[np.column_stack([r[c] for c in channels]) for r in results[k * n:(k + 1) * n]]
+                 for k in range(len(vehicles))]
+    out: list[Separation | None] = []
+    for rival in predicted[1:]:
+        differences = [_difference(a, b, noise) for a, b in zip(predicted[0], rival)]
+        k = int(np.argmax(differences))
+        out.append(Separation(scenarios[k][1].name, scenarios[k][0], differences[k]))
+    return out
+
+
+def _difference(a: np.ndarray, b: np.ndarray, noise: np.ndarray) -> float:
+    """RMS of (a − b) / noise over samples and channels, each channel's mean removed."""
+    d = (a - b) / noise
+    d -= d.mean(axis=0)
+    return math.sqrt(float(np.mean(d ** 2))) if d.size else 0.0
