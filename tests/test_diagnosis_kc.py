@@ -30,7 +30,7 @@ from vsim_diagnosis.kc_catalogue import (OBSERVABLE, Hypothesis, draw, extended_
 from vsim_cluster.executor import SerialExecutor
 from vsim_core.shipped import DEFAULT_VEHICLE
 from vsim_diagnosis.catalogue import PAIR_SEPARATOR
-from vsim_diagnosis.kc_alike import Separation, alike
+from vsim_diagnosis.kc_alike import Separation, alike, separations
 from vsim_diagnosis.kc_diagnosis import _second_stage, diagnose_kc
 from vsim_diagnosis.kc_fits import Candidate, Scorer, fit, nominal, verify
 from vsim_diagnosis.kc_layout import Layout, Test
@@ -180,6 +180,20 @@ def test_alike_rivals_are_those_the_tests_cannot_tell_from_the_best():
     assert Separation("s", Path("s.yaml"), threshold * 1.001).separates
     assert not Separation("s", Path("s.yaml"), threshold * 0.999).separates
     assert told_apart(1.5, 1.0, 1.0) and not told_apart(1.05, 1.0, 1.0)
+    # the separating test: the largest difference in noise units, each channel's mean removed; a
+    # scenario a vehicle did not finish is left out
+    tests = [(Path(f"{n}.yaml"), SimpleNamespace(name=n)) for n in ("slow", "shifted", "apart", "failed")]
+    t = np.linspace(0.0, 1.0, 200)
+    rival = {"slow": 0.2 * t, "shifted": 5.0 + 0 * t, "apart": 0.8 * np.sin(6 * t), "failed": None}
+
+    def run(jobs):
+        return [{"toe": 0 * t, "camber": 0 * t} if j.vehicle == "best" else
+                (None if rival[j.scenario.name] is None else {"toe": 2.0 * rival[j.scenario.name], "camber": 0 * t})
+                for j in jobs]
+
+    (sep,) = separations(["best", "rival"], tests, ["toe", "camber"], np.array([2.0, 1.0]), 1.0, run)
+    d = 0.8 * np.sin(6 * t)
+    assert sep.scenario == "apart" and sep.difference == pytest.approx(np.sqrt(np.mean((d - d.mean()) ** 2) / 2))
 
 
 def test_the_screening_fit_scales_the_effect_and_clips_a_hopeless_one_at_its_bound():

@@ -68,24 +68,26 @@ def extra_scenarios(measured: Sequence[str]) -> list[tuple[Path, Scenario]]:
 
 def separations(vehicles: Sequence[VehicleDefinition], scenarios: Sequence[tuple[Path, Scenario]],
                 channels: Sequence[str], noise: np.ndarray, duration_scale: float,
-                run: Callable[[list[Job]], list[dict[str, np.ndarray]]]) -> list[Separation | None]:
+                run: Callable[[list[Job]], list[dict[str, np.ndarray] | None]]) -> list[Separation | None]:
     """For every vehicle after the first (the rivals of ``vehicles[0]``, the best cause's), the
     scenario whose predictions differ most from the first's in units of ``noise`` (per channel of
-    ``channels``), or None without scenarios; ``run`` gives the compared channels of jobs (their
-    input phases), on whatever executor."""
-    if not scenarios:
-        return [None] * (len(vehicles) - 1)
+    ``channels``), or None when no scenario ran for both; ``run`` gives the compared channels of
+    jobs (their input phases) in their order, on whatever executor, None for a run that failed (a
+    rival far off may leave the car's valid range in a harsher test)."""
     jobs = [Job(s, v, duration_scale, tuple(channels)) for v in vehicles for _, s in scenarios]
     results = run(jobs)
     n = len(scenarios)
-    predicted = [[np.column_stack([r[c] for c in channels]) for r in results[k * n:(k + 1) * n]]
+    predicted = [[None if r is None else np.column_stack([r[c] for c in channels]) for r in results[k * n:(k + 1) * n]]
                  for k in range(len(vehicles))]
     out: list[Separation | None] = []
     for rival in predicted[1:]:
-        differences = [_difference(a, b, noise) for a, b in zip(predicted[0], rival)]
-        k = int(np.argmax(differences))
-        out.append(Separation(scenarios[k][1].name, scenarios[k][0], differences[k]))
+        differences = [-math.inf if a is None or b is None else _difference(a, b, noise)
+                       for a, b in zip(predicted[0], rival)]
+        k = int(np.argmax(differences)) if differences else 0
+        out.append(Separation(scenarios[k][1].name, scenarios[k][0], differences[k])
+                   if differences and differences[k] > -math.inf else None)
     return out
+
 
 
 def _difference(a: np.ndarray, b: np.ndarray, noise: np.ndarray) -> float:

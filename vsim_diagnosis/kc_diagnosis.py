@@ -232,7 +232,7 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, executor: Execut
             apart = separations([extended_vehicle(vehicle, [c.hypothesis]) for c in (best, *rivals)],
                                 extra_scenarios({t.job.scenario.name for t in layout.tests}), layout.channels,
                                 scorer.noise, float(np.median([t.job.duration_scale for t in layout.tests])),
-                                lambda jobs: pool.map(run_job, jobs))
+                                lambda jobs: pool.results(run_job, jobs))
     errors = scorer.test_errors(base)
     for m in found:
         say(f"the baseline does not fit {m.test}{' (held out)' if m.heldout else ''}: {m.error:.2f} × the noise, "
