@@ -131,16 +131,19 @@ def assert_success_rate(cause: str, seeds: range, tmp: Path, attempt: Callable[[
     executor (:data:`SLOW_SCHEDULER`): an AssertionError is a wrong diagnosis (printed with its seed);
     the rate must reach ``min_rate``. ``record`` is pytest's ``record_property``: the tally goes to the
     run's summary (tests/conftest.py), which ``pytest -n`` does not swallow as it does what tests print."""
-    with executor(scheduler) as ex:
-        verdicts = ex.map(_Draw(attempt, tmp, scheduler != SERIAL), list(seeds))
     right, wrong = 0, []
-    for seed, why in zip(seeds, verdicts):
-        if why:
-            wrong.append(seed)
-            print(f"\n{cause} seed {seed}: wrong: {why}")
-        else:
-            right += 1
-            print(f"\n{cause} seed {seed}: right")
+    with executor(scheduler) as ex:
+        for o in ex.each(_Draw(attempt, tmp, scheduler != SERIAL), list(seeds)):   # printed as they come
+            seed = seeds[o.index]
+            if o.error:
+                raise RuntimeError(f"{cause} seed {seed}: {o.error}")
+            if o.result:
+                wrong.append(seed)
+                print(f"\n{cause} seed {seed}: wrong: {o.result}", flush=True)
+            else:
+                right += 1
+                print(f"\n{cause} seed {seed}: right", flush=True)
+    wrong.sort()
     record(TALLY, {"cause": cause, "right": right, "draws": len(seeds), "wrong": wrong})
     rate = right / len(seeds)
     print(f"\n{cause}: {right}/{len(seeds)} diagnosed right ({rate:.0%})")
