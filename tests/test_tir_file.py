@@ -62,7 +62,8 @@ def test_sections_numbers_texts_tables_and_lines_are_read(tmp_path: Path) -> Non
 
 
 @pytest.mark.parametrize("edit, expected", [
-    (("FITTYP                   = 61", "FITTYP = 7"), r"t\.tir:13: \[MODEL\] FITTYP: unknown Magic Formula 7\.0; expected one of 61"),
+    (("FITTYP                   = 61", "FITTYP = 5"), r"t\.tir:13: \[MODEL\] FITTYP: unknown Magic Formula 5\.0; expected one "
+                                                      r"of 6 \(MF 5\.2\), 21 \(MF 5\.2\), 52 \(MF 5\.2\), 61 \(MF 6\.1\), 62"),
     (("FITTYP                   = 61", "FITTYP = 61.5"), r"\[MODEL\] FITTYP: unknown Magic Formula 61\.5"),
     (("LENGTH                   = 'meter'", "LENGTH = 'mm'"), r"t\.tir:7: \[UNITS\] LENGTH: 'mm' is not SI; expected 'meter'"),
     (("ANGLE                    = 'radians'", ""), r"t\.tir: \[UNITS\] ANGLE: missing; expected a quoted text"),

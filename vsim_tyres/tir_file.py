@@ -23,8 +23,10 @@ import numpy as np
 from vsim_core.errors import InputError
 from vsim_core.files import is_file, read_text
 
-#: FITTYP values read, with the Magic Formula version each names.
-FITTYPS = {61: "MF 6.1", 62: "MF 6.2"}
+#: FITTYP values read, with the Magic Formula version each names: MF 5.2 files say 6 (MF-Tyre 5.2,
+#: Adams' PAC2002), 21 (MF-Tyre) or 52 (files written by hand), as MFeval reads them; MF-Tyre 5.0
+#: and 5.1 files (FITTYP 5) differ in equations not checked here and stay refused.
+FITTYPS = {6: "MF 5.2", 21: "MF 5.2", 52: "MF 5.2", 61: "MF 6.1", 62: "MF 6.2"}
 #: [UNITS] keys and the SI names accepted for each (lower case).
 SI_UNITS = {"LENGTH": ("meter", "metre", "m"), "FORCE": ("newton", "n"), "ANGLE": ("radian", "radians", "rad"),
             "MASS": ("kg", "kilogram"), "TIME": ("second", "sec", "s")}

@@ -1,6 +1,7 @@
 """First-order transient slip of the Magic Formula tyre: the slips the formula sees lag the
 kinematic ones over a relaxation length (Pacejka, *Tire and Vehicle Dynamics*, 3rd ed., §7.2.2;
-the relaxation lengths of MF 6.1 are the slip stiffnesses over the carcass stiffnesses).
+the relaxation lengths of MF 6.1 are the slip stiffnesses over the carcass stiffnesses, MF 5.2's
+its own laws of PTX and PTY).
 
 Written in the contact-deflection form, which holds down to standstill: with ``q`` the lagged slip
 (κ', or tan α') and ``v`` the contact point's slip velocity that drives it (``Ω·Re − Vx`` for κ,
@@ -23,7 +24,7 @@ import numba as nb
 
 from vsim_core.compiled_cache import follow
 from vsim_tyres import magic_formula
-from vsim_tyres.magic_formula import carcass_stiffnesses, low_speed_ramp, slip_stiffnesses
+from vsim_tyres.magic_formula import carcass_stiffnesses, low_speed_ramp, mf52_relaxation_lengths, slip_stiffnesses
 
 follow(__file__, magic_formula.__file__)
 
@@ -35,7 +36,11 @@ SIGMA_MIN = 1e-4
 @nb.njit(cache=True)
 def relaxation_lengths(p, fz: float, gamma: float) -> tuple[float, float]:
     """``(σκ, σα)`` [m] at load ``fz`` [N] and inclination ``gamma`` [rad]: slip stiffness over
-    carcass stiffness, each at least :data:`SIGMA_MIN`."""
+    carcass stiffness (MF 5.2: :func:`~vsim_tyres.magic_formula.mf52_relaxation_lengths`), each at
+    least :data:`SIGMA_MIN`."""
+    if p.MF52 > 0.0:
+        sigma_k, sigma_a = mf52_relaxation_lengths(p, max(fz, 0.0), gamma)
+        return max(sigma_k, SIGMA_MIN), max(sigma_a, SIGMA_MIN)
     kxk, kya = slip_stiffnesses(p, max(fz, 0.0), gamma)
     cx, cy = carcass_stiffnesses(p, max(fz, 0.0))
     return (max(abs(kxk) / cx, SIGMA_MIN) if cx > 0.0 else SIGMA_MIN,
