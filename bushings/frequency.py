@@ -82,6 +82,28 @@ def first_harmonic(channel: ChannelParams, amplitudes_m: np.ndarray, frequencies
     return DynamicStiffness(a, f, harmonic_ratio(e, force, n).reshape(a.shape))
 
 
+def lossier(channel: ChannelParams, amplitude_m: float, frequency_hz: float, factor: float = 2.0) -> ChannelParams:
+    """``channel`` with its ladder's stiffness Kpa × ``factor`` and its linear spring K0 set so that
+    its dynamic stiffness |K*| at (``amplitude_m``, ``frequency_hz``) stays its own: more loss (a
+    factor above 1) at the same stiffness there, as a lossier compound in a part of the same rate.
+
+    With the deflection imposed K0 only adds K0 to K*: with c the rest's K* (the ladder stiffened),
+    K0 = −Re c + √(|K*|² − (Im c)²). ValueError for a law whose elastic part is not linear (K0 is then
+    no parallel spring) or when no K0 ≥ 0 gives |K*| (the stiffened ladder alone is already stiffer).
+    """
+    if (any(math.isfinite(x) for x in (channel.N_sup, channel.N_inf, channel.S_sup, channel.S_inf))
+            or channel.P_sup or channel.P_inf):
+        raise ValueError(f"a {channel.model} law with a nonlinear elastic part: its K0 is not a parallel spring")
+    at = (np.array([amplitude_m]), np.array([frequency_hz]))
+    target = abs(first_harmonic(channel, *at).k_complex_n_per_m[0])
+    stiffened = channel.replace(Kpa=channel.Kpa * factor)
+    rest = first_harmonic(stiffened, *at).k_complex_n_per_m[0] - channel.K0
+    k0 = -rest.real + math.sqrt(target ** 2 - rest.imag ** 2) if target >= abs(rest.imag) else -1.0
+    if k0 < 0.0:
+        raise ValueError(f"Kpa × {factor:g} alone makes |K*| above the law's {target:.4g} N/m: no K0 keeps it")
+    return stiffened.replace(K0=k0)
+
+
 def equivalent_damping(channel: ChannelParams, amplitudes_m: np.ndarray, frequencies_hz: np.ndarray, *,
                        eps_m: float = 1e-10, tol: float = 1e-6, max_iter: int = 2000) -> DynamicStiffness:
     """Dynamic stiffness by the equivalent-damping approximation (spec eqs 5.16/5.17).

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from bushings import BushingBank, load_parameter_set, to_si
-from bushings.frequency import equivalent_damping, first_harmonic, harmonic_ratio, rate_scaled
+from bushings.frequency import equivalent_damping, first_harmonic, harmonic_ratio, lossier, rate_scaled
 from vsim_core.errors import InputError
 
 MM = 1e-3
@@ -101,3 +101,31 @@ def test_equivalent_damping_stiffness_close_to_time_domain(channel):
 def test_equivalent_damping_refuses_the_continuous_sts():
     with pytest.raises(InputError, match="ladder"):
         equivalent_damping(load_parameter_set("fig5_9").channel("sts_continuous"), 1 * MM, 1.0)
+
+
+@pytest.mark.parametrize("name", ["fig5_9", "fig5_7_lowloss", "fig5_8"])
+def test_a_lossier_law_keeps_its_dynamic_stiffness_and_dissipates_more(name):
+    """frequency.lossier: the ladder stiffened, K0 lowered so that |K*| at the given amplitude and
+    frequency is the law's own (K0 adds to K* exactly with the deflection imposed); tan δ grows
+    with the factor, and a factor of 1 gives the law back."""
+    law = load_parameter_set(name).channel()
+    at = (np.array([0.2e-3]), np.array([0.1]))
+    before = first_harmonic(law, *at)
+    twice = lossier(law, 0.2e-3, 0.1, 2.0)
+    after = first_harmonic(twice, *at)
+    assert after.k_dyn_n_per_m[0] == pytest.approx(before.k_dyn_n_per_m[0], rel=1e-9)
+    assert twice.Kpa == 2.0 * law.Kpa and twice.K0 < law.K0
+    assert 1.6 * before.tan_delta[0] < after.tan_delta[0] < 2.5 * before.tan_delta[0]
+    more = first_harmonic(lossier(law, 0.2e-3, 0.1, 3.0), *at)
+    assert more.tan_delta[0] > after.tan_delta[0]
+    assert lossier(law, 0.2e-3, 0.1, 1.0).K0 == pytest.approx(law.K0, rel=1e-9)
+    # elsewhere the stiffness is not kept: at ten times the amplitude the sliders slip more
+    assert first_harmonic(twice, at[0] * 10, at[1]).k_dyn_n_per_m[0] != pytest.approx(
+        first_harmonic(law, at[0] * 10, at[1]).k_dyn_n_per_m[0], rel=1e-3)
+
+
+def test_a_lossier_law_is_refused_where_k0_is_no_parallel_spring():
+    with pytest.raises(ValueError, match="nonlinear elastic part"):
+        lossier(load_parameter_set("fig5_9_progressive").channel(), 0.2e-3, 0.1)
+    with pytest.raises(ValueError, match="no K0 keeps it"):
+        lossier(load_parameter_set("fig5_9").channel(), 1e-6, 0.1, 50.0)   # sliders stuck: K* ≈ K0 + Kpa

@@ -15,6 +15,7 @@ import copy
 from pathlib import Path
 from typing import Any, Mapping
 
+from bushings.frequency import lossier
 from bushings.parameter_sets import load_parameter_set
 from bushings.parameters import MODELS
 from vehicle.model.definition import DIRECTIONS, VehicleDefinition
@@ -124,3 +125,21 @@ def vehicle_with(text: str, path: Path, values: Mapping[str, float], source: str
         return parse_vehicle(text, path)
     data = with_values(Document(text, str(path)).data, values)
     return parse_vehicle(dump_yaml(data, sort_keys=False), path, source)
+
+
+def lossier_places(vehicle: VehicleDefinition, direction: str, amplitude_m: float, frequency_hz: float,
+                   factor: float = 2.0) -> dict[str, float]:
+    """The places and values (the file's units, for :func:`vehicle_with`) that give the bushing
+    direction ``direction`` (``"e1_front.y"``) of ``vehicle`` its law with the ladder ``factor``
+    times as stiff and the same |K*| at (``amplitude_m``, ``frequency_hz``): a lossier part of the
+    same stiffness there (:func:`bushings.frequency.lossier`)."""
+    bushing, _, axis = direction.partition(".")
+    found = [b for b in vehicle.bushings if b.name == bushing and axis in b.directions]
+    if not found:
+        raise PlaceError(f"no bushing direction {direction!r} in {vehicle.name}")
+    d = found[0].directions[axis]
+    own = load_parameter_set(d.set_name).values if d.set_name is not None else d.params
+    old = d.channel()
+    new = lossier(old, amplitude_m, frequency_hz, factor)
+    return {f"bushings.{direction}.Kpa": float(own["Kpa"] * new.Kpa / old.Kpa),
+            f"bushings.{direction}.K0": float(own["K0"] * new.K0 / old.K0)}
