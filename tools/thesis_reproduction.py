@@ -144,6 +144,11 @@ JOBS = [
 ]
 
 
+def _relaxed(case: dict) -> float:
+    """How much of its step a rack step's E2 front force gives back after the transient [%]."""
+    return -100.0 * case["e2_front_left_y_force_settled_relax"] / case["e2_front_left_y_force_step"]
+
+
 def _fmt(v: float | None, digits: int = 4) -> str:
     return "—" if v is None else f"{v:.{digits}f}"
 
@@ -344,10 +349,14 @@ def report(r: dict, files: dict[str, str]) -> str:
         f"steered corner ({rs['e2_front_left_y_force_ringing']:.0f} N peak to peak in the E2 front bushing), "
         f"and once it has died out, {SETTLED_S} s later, the force and the toe hardly move "
         f"({rs['e2_front_left_y_force_settled_relax']:+.4f} N, {rs['toe_fl_settled_relax']:+.1e} deg over "
-        "4.5 s), with either law and with a slower ramp. The law itself relaxes: on the bench, held at 0.3 mm "
+        "4.5 s), with either law. The law itself relaxes: on the bench, held at 0.3 mm "
         f"after a 50 ms ramp, fig5_9 loses {-100 * bench['fig5_9']:.1f} % of its force and fig5_8 (RT) "
         f"{-100 * bench['fig5_8']:.1f} % between {SETTLED_S} s and 6 s (RT more, as the thesis says). "
-        "**The cause is the ringing**, found by two experiments. On the bench, the same step followed by a "
+        "**The cause is the ringing**, found by three experiments. On the car, the same step ramped in "
+        f"{SLOW_RISE_S} s rings {slow['e2_front_left_y_force_ringing']:.0f} N peak to peak, and its force does "
+        f"relax after the transient: {slow['e2_front_left_y_force_settled_relax']:+.2f} N over 4.5 s, "
+        f"{_relaxed(slow):.1f} % of its {slow['e2_front_left_y_force_step']:.1f} N step towards zero, against "
+        f"{_relaxed(rs):.1g} % after the 50 ms ramp. On the bench, the same step followed by a "
         "20 Hz ringing that decays in 0.1 s, as the corner's does, leaves "
         f"{-100 * ringing[0.05]:.1f} % of relaxation after it with ±0.05 mm of ringing and "
         f"{abs(100 * ringing[0.15]):.1f} % with ±0.15 mm (the car's: "
