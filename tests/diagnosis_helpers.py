@@ -15,7 +15,7 @@ from typing import Callable
 import numpy as np
 
 from bushings.parameter_sets import load_parameter_set
-from vsim_cluster.executor import SCHEDULER_ENV, SERIAL, executor
+from vsim_cluster.executor import SCHEDULER_ENV, SERIAL, Outcome, executor
 from vsim_diagnosis.catalogue import CAUSES, applicable, draw, draw_parameters
 from vsim_diagnosis.truth_forms import FORMS
 from vsim_diagnosis.virtual_bench import OUTSIDE, measure_bench, parse_truth
@@ -51,6 +51,13 @@ TALLY = "diagnosis_tally"
 #: The bench baseline each cause is hidden in: the viscoelastic causes need an STS or RT baseline.
 BASELINES = {"viscoelasticity_missing": "fig5_6_progressive", "viscoelasticity_excess": "fig5_8_progressive"}
 DEFAULT_BASELINE = "fig5_9_progressive"
+
+
+def _result(outcome: Outcome, cause: str, seeds: range) -> tuple[str, str]:
+    """A draw's verdict from the cluster; RuntimeError for a draw that failed otherwise than wrong."""
+    if outcome.error:
+        raise RuntimeError(f"{cause} seed {seeds[outcome.index]}: {outcome.error}")
+    return outcome.result
 
 
 def hidden_truth(cause: str, seed: int) -> tuple[str, list[dict]]:
@@ -107,42 +114,45 @@ def diagnose_fresh(directory: Path, baseline: str, report: Path | None = None) -
 
 class _Draw:
     """One draw of a success-rate test as a task: ``attempt`` in a fresh folder of ``tmp``; the
-    verdict as text ("" right, else why wrong); any error but an AssertionError is raised."""
+    verdict as (why wrong, "" when right; what ``attempt`` said of a right one); any error but an
+    AssertionError is raised."""
 
-    def __init__(self, attempt: Callable[[Path, int], None], tmp: Path, spread: bool):
+    def __init__(self, attempt: Callable[[Path, int], str | None], tmp: Path, spread: bool):
         self.attempt, self.tmp, self.spread = attempt, tmp, spread
 
-    def __call__(self, seed: int) -> str:
+    def __call__(self, seed: int) -> tuple[str, str]:
         if self.spread:   # the draws fill the cluster's workers: each diagnosis in its worker's process
             os.environ[SCHEDULER_ENV] = SERIAL
         case = self.tmp / str(seed)
         case.mkdir()
         try:
-            self.attempt(case, seed)
+            note = self.attempt(case, seed)
         except AssertionError as exc:
-            return str(exc) or "wrong"
-        return ""
+            return str(exc) or "wrong", ""
+        return "", note or ""
 
 
-def assert_success_rate(cause: str, seeds: range, tmp: Path, attempt: Callable[[Path, int], None],
+def assert_success_rate(cause: str, seeds: range, tmp: Path, attempt: Callable[[Path, int], str | None],
                         record: Callable[[str, object], None], min_rate: float = MIN_SUCCESS_RATE,
                         scheduler: str = SLOW_SCHEDULER) -> None:
     """``attempt(directory, seed)`` for every seed, in a fresh directory each, on ``scheduler``'s
-    executor (:data:`SLOW_SCHEDULER`): an AssertionError is a wrong diagnosis (printed with its seed);
-    the rate must reach ``min_rate``. ``record`` is pytest's ``record_property``: the tally goes to the
-    run's summary (tests/conftest.py), which ``pytest -n`` does not swallow as it does what tests print."""
+    executor (:data:`SLOW_SCHEDULER`): an AssertionError is a wrong diagnosis (printed with its seed,
+    as what a right one returns); the rate must reach ``min_rate``. ``record`` is pytest's
+    ``record_property``: the tally goes to the run's summary (tests/conftest.py), which ``pytest -n``
+    does not swallow as it does what tests print."""
+    draw = _Draw(attempt, tmp, scheduler != SERIAL)
     right, wrong = 0, []
     with executor(scheduler) as ex:
-        for o in ex.each(_Draw(attempt, tmp, scheduler != SERIAL), list(seeds)):   # printed as they come
-            seed = seeds[o.index]
-            if o.error:
-                raise RuntimeError(f"{cause} seed {seed}: {o.error}")
-            if o.result:
-                wrong.append(seed)
-                print(f"\n{cause} seed {seed}: wrong: {o.result}", flush=True)
+        # in this process the draws run here, an error keeping its traceback
+        verdicts = (((i, draw(seed)) for i, seed in enumerate(seeds)) if scheduler == SERIAL else
+                    ((o.index, _result(o, cause, seeds)) for o in ex.each(draw, list(seeds))))
+        for i, (why, note) in verdicts:   # printed as they come
+            if why:
+                wrong.append(seeds[i])
+                print(f"\n{cause} seed {seeds[i]}: wrong: {why}", flush=True)
             else:
                 right += 1
-                print(f"\n{cause} seed {seed}: right", flush=True)
+                print(f"\n{cause} seed {seeds[i]}: right{f' ({note})' if note else ''}", flush=True)
     wrong.sort()
     record(TALLY, {"cause": cause, "right": right, "draws": len(seeds), "wrong": wrong})
     rate = right / len(seeds)

@@ -38,11 +38,15 @@ NO_DAMPERS = {f"{axle}.damper.curve.{i}.1": value for axle in ("front", "rear") 
 #: The front bushings' directions with ladder laws in the vehicle file, made lossier one at a time
 #: and all together in the fig. 4.31 experiment.
 FRONT_LADDERS = ("e1_front.y", "e1_front.z", "e2_front.x", "e2_front.y", "e2_front.z")
+#: The control of the fig. 4.31 experiment: E1 front's lateral law with its stiffnesses and slider
+#: thresholds scaled by this (its force scaled at every deflection).
+SOFTER = 0.9
 #: Time after a rack step's ramp beyond which its transient has died out [s].
 SETTLED_S = 0.5
 #: The slower ramp of the rack-step experiment [s].
 SLOW_RISE_S = 0.5
-#: Where the lateral-force test deflects the E2 front bushing: amplitude [m] and frequency [Hz].
+#: Where a lossier law keeps its |K*| (bushings.frequency.lossier): amplitude [m] and frequency [Hz]
+#: (E2 front's lateral direction works about there in the lateral-force test; E1 front's, at 0.3–2 mm).
 LOSS_AT = (0.2e-3, 0.1)
 
 
@@ -76,8 +80,10 @@ def _run(job: tuple[str, str, str | None, tuple]) -> tuple[str, dict]:
     label, name, model, values = job
     scenario = load_scenario(name)
     if label.endswith("_slow"):
-        scenario = parse_scenario(scenario.text.replace("rise_time_s: 0.05", f"rise_time_s: {SLOW_RISE_S}"),
-                                  scenario.path)
+        slow = scenario.text.replace("rise_time_s: 0.05", f"rise_time_s: {SLOW_RISE_S}")
+        if slow == scenario.text:
+            raise RuntimeError(f"{name}: no 'rise_time_s: 0.05' to slow down in the scenario file")
+        scenario = parse_scenario(slow, scenario.path)
     if model is not None:   # "file": the vehicle file's own laws, whatever the scenario says
         scenario = replace(scenario, bushing_model=None if model == "file" else model)
     vehicle = vehicle_with(DEFAULT_VEHICLE.read_text(), DEFAULT_VEHICLE, dict(values), label)
@@ -95,6 +101,9 @@ def _run(job: tuple[str, str, str | None, tuple]) -> tuple[str, dict]:
                 r[f"{y}_loop_deg"] = None if loop is None else loop.width
             z = run.signals["e1_rear_right_z_deflection"][on]
             r["e1_rear_z_pp_mm"] = float(np.ptp(z))
+            # how far the test works each front ladder direction: half its peak to peak [mm]
+            r["amplitude_mm"] = {d: float(np.ptp(run.signals[d.replace(".", "_left_") + "_deflection"][on]) / 2)
+                                 for d in FRONT_LADDERS}
             last = case_mask(run, c, last_cycle=True)
             r["trace"] = {s: run.signals[s][last][::5].tolist() for s in (x, "camber_fl", "toe_fl")}
         else:
@@ -119,8 +128,13 @@ def jobs() -> list[tuple[str, str, str | None, tuple]]:
     vehicle = load_vehicle(DEFAULT_VEHICLE)
     lossy = {d: lossier_places(vehicle, d, *LOSS_AT) for d in FRONT_LADDERS}
     every = {k: v for values in lossy.values() for k, v in values.items()}
+    # the control: E1 front's lateral law (an STS) with its stiffnesses and thresholds scaled, so that
+    # its force is SOFTER times its own at every deflection: the same loss factor, a softer part
+    law = load_parameter_set(next(b for b in vehicle.bushings if b.name == "e1_front").directions["y"].set_name)
+    softer = tuple((f"bushings.e1_front.y.{k}", SOFTER * law.values[k]) for k in ("K0", "Kpa", "Kr", "Ff"))
     return JOBS + [(f"lateral_lossier_{d}", "lateral_force", None, tuple(lossy[d].items())) for d in FRONT_LADDERS] \
-        + [("lateral_lossier_front", "lateral_force", None, tuple(every.items()))]
+        + [("lateral_lossier_front", "lateral_force", None, tuple(every.items())),
+           ("lateral_softer_e1_front.y", "lateral_force", None, softer)]
 
 
 JOBS = [
@@ -145,6 +159,15 @@ JOBS = [
     *[(f"double_{way}_{law}_slow", f"double_rack_step_{way}", law, ())
       for way in ("same", "opposite") for law in ("stvs", "rt")],
 ]
+
+
+def _stiffness_change(direction: str, amplitudes_mm: list[float]) -> list[float]:
+    """The change of |K*| at 0.1 Hz [%] of ``direction``'s law made lossier, at each amplitude [mm]."""
+    bushing, axis = direction.split(".")
+    law = next(b for b in load_vehicle(DEFAULT_VEHICLE).bushings if b.name == bushing).directions[axis].channel()
+    a, f = np.array(amplitudes_mm) * 1e-3, np.full(len(amplitudes_mm), LOSS_AT[1])
+    before, after = (first_harmonic(x, a, f).k_dyn_n_per_m for x in (law, lossier(law, *LOSS_AT)))
+    return [float(100.0 * (y / x - 1.0)) for x, y in zip(before, after)]
 
 
 def _relaxed(case: dict) -> float:
@@ -218,6 +241,9 @@ def report(r: dict, files: dict[str, str]) -> str:
     carrier = max(FRONT_LADDERS, key=lambda d: min(change[d]))
     others = max(max(change[d]) for d in FRONT_LADDERS if d != carrier)
     loss = {d: (_loss(d, False), _loss(d, True)) for d in FRONT_LADDERS}
+    worked = {d: [r["lateral_file"][c]["amplitude_mm"][d] for c in sorted(r["lateral_file"])] for d in FRONT_LADDERS}
+    kept = {d: _stiffness_change(d, worked[d]) for d in FRONT_LADDERS}
+    softer = [100.0 * (w / f - 1.0) for w, f in zip(toe["lateral_softer_e1_front.y"], toe["lateral_file"])]
     roll_rear = [r["roll_stvs"][c]["camber_rr_loop_deg"] for c in sorted(r["roll_stvs"])]
     speeds_rear = [r["speeds_stvs"][c]["camber_rr_loop_deg"] for c in (1, 2, 3)]
     lines = [
@@ -303,13 +329,16 @@ def report(r: dict, files: dict[str, str]) -> str:
         "force (50 to 300 daN) changes a lot: the lossier bushing dissipates more.",
         "",
         "Scenario `lateral_force`, the vehicle file's laws, and the same with the law of one front "
-        "bushing direction (or of all five front directions with ladder laws) made lossier at the same "
-        "stiffness where the test works it: its ladder twice as stiff and its linear spring lowered to keep "
-        "|K*| at 0.2 mm and 0.1 Hz (`bushings.frequency.lossier`; tan δ "
-        + ", ".join(f"{d} {a[0]:.3f} → {b[0]:.3f}" for d, (a, b) in loss.items() if d.endswith(".y"))
-        + ", |K*| kept to "
-        + f"{max(abs(b[1] / a[1] - 1.0) for a, b in loss.values()):.0e}). Front left toe loop width [deg], "
-        "and its change with the lossier law:",
+        "bushing direction (or of all five front directions with ladder laws) made lossier: its ladder twice "
+        "as stiff and its linear spring lowered to keep |K*| at 0.2 mm and 0.1 Hz (`bushings.frequency.lossier`; "
+        "tan δ there " + ", ".join(f"{d} {a[0]:.3f} → {b[0]:.3f}" for d, (a, b) in loss.items() if d.endswith(".y"))
+        + "). Where the test works them the stiffness moves too: E1 front y, worked at "
+        f"{min(worked['e1_front.y']):.2f}–{max(worked['e1_front.y']):.2f} mm, is "
+        f"{-max(kept['e1_front.y']):.1f}–{-min(kept['e1_front.y']):.1f} % softer; E2 front's directions, "
+        f"worked at {min(min(worked[d]) for d in FRONT_LADDERS if d.startswith('e2')):.3f}–"
+        f"{max(max(worked[d]) for d in FRONT_LADDERS if d.startswith('e2')):.2f} mm, up to "
+        f"{max(max(kept[d]) for d in FRONT_LADDERS if d.startswith('e2')):.0f} % stiffer. Front left toe loop "
+        "width [deg], and its change with the lossier law:",
         "",
         "| lossier law in | " + " | ".join(r["lateral_file"][c]["label"] for c in sorted(r["lateral_file"])) + " |",
         "|---|" + "---|" * len(toe["lateral_file"]),
@@ -321,7 +350,9 @@ def report(r: dict, files: dict[str, str]) -> str:
         (f"**Agrees, once the bushing that carries the loop is the lossier one.** The toe loop under lateral "
          f"force is carried by {carrier}: its law made lossier widens the loop by {min(change[carrier]):.0f} to "
          f"{max(change[carrier]):.0f} %; any other front direction alone by {others:.1f} % at most (E2 front's "
-         f"lateral direction by {max(change['e2_front.y']):.1f} %). Every front ladder "
+         f"lateral direction by {max(change['e2_front.y']):.1f} %). It is the loss, not the softening that "
+         f"comes with it: the control, E1 front y's force {100 * (1 - SOFTER):.0f} % lower at every deflection (its "
+         f"loss factor unchanged), widens the loop by {min(softer):.0f} to {max(softer):.0f} % only. Every front ladder "
          f"lossier, as the thesis swapped the identified laws of whole bushings: {min(change['front']):.0f} to "
          f"{max(change['front']):.0f} %, the large change the thesis shows (it gives no numbers)."
          if min(change["front"]) > 20.0 else

@@ -18,7 +18,8 @@ def main() -> int:
     """Run ``vsim`` on the command line's arguments; its exit status."""
     # Nothing of vsim renders through MuJoCo (replays are Rerun's): MuJoCo's OpenGL back end is not
     # imported (40 ms). A user's own setting stands.
-    os.environ.setdefault("MUJOCO_GL", "disable")
+    if not os.environ.get("MUJOCO_GL"):
+        os.environ["MUJOCO_GL"] = "disable"
     gc.disable()
     from vsim_cli.main import main as vsim
 
@@ -27,4 +28,6 @@ def main() -> int:
     try:
         return vsim()
     finally:
-        gc.freeze()   # what is left is freed by the process's exit, not walked by the teardown's collections
+        # what is left is freed by the process's exit, not walked by the teardown's collections (so a
+        # __del__ in a reference cycle does not run then: every file and cluster is closed by now)
+        gc.freeze()

@@ -68,13 +68,6 @@ class Executor:
             raise TaskFailed(f"task {failed[0].index + 1} of {len(items)} failed: {failed[0].error}")
         return [o.result for o in out if o is not None]
 
-    def results(self, fn: Callable[[Any], Any], items: Sequence[Any]) -> list[Any]:
-        """``fn`` of every item in the items' order, None where the task failed."""
-        out: list[Any] = [None] * len(items)
-        for o in self.each(fn, items):
-            out[o.index] = None if o.error else o.result
-        return out
-
 
 class TaskFailed(RuntimeError):
     """A task of :meth:`Executor.map` failed; the message carries its reason."""
@@ -85,7 +78,8 @@ class ClusterLost(RuntimeError):
 
 
 def reason(exc: BaseException) -> str:
-    """Why a task failed, in one line: the exception's type and text."""
+    """Why a task failed, in one line: the exception's type and text (for Dask's ``KilledWorker``,
+    :data:`WORKERS_DIED` and its text)."""
     text = " ".join(str(exc).split())   # one line, whatever the exception printed
     if isinstance(exc, KilledWorker):
         return f"{WORKERS_DIED} ({text})"

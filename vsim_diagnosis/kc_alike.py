@@ -22,9 +22,10 @@ import numpy as np
 from vehicle.model.definition import VehicleDefinition
 from vehicle.scenarios.scenario import Scenario
 from vehicle.scenarios.scenario_file import load_scenario
+from vehicle.simulation.runner import DivergenceError
 from vsim_core.shipped import SCENARIO_DIR, built_in
 from vsim_diagnosis.kc_fits import Candidate
-from vsim_diagnosis.kc_layout import Job
+from vsim_diagnosis.kc_layout import Job, run_job
 from vsim_diagnosis.verdict import decide, told_apart
 
 
@@ -66,14 +67,23 @@ def extra_scenarios(measured: Sequence[str]) -> list[tuple[Path, Scenario]]:
     return out
 
 
+def run_unless_diverged(job: Job) -> dict[str, np.ndarray] | None:
+    """:func:`~vsim_diagnosis.kc_layout.run_job`'s channels, None when the car leaves its valid range
+    (a rival far off may, in a harsher test than the dataset's): a task of the executor."""
+    try:
+        return run_job(job)
+    except DivergenceError:
+        return None
+
+
 def separations(vehicles: Sequence[VehicleDefinition], scenarios: Sequence[tuple[Path, Scenario]],
                 channels: Sequence[str], noise: np.ndarray, duration_scale: float,
                 run: Callable[[list[Job]], list[dict[str, np.ndarray] | None]]) -> list[Separation | None]:
     """For every vehicle after the first (the rivals of ``vehicles[0]``, the best cause's), the
     scenario whose predictions differ most from the first's in units of ``noise`` (per channel of
     ``channels``), or None when no scenario ran for both; ``run`` gives the compared channels of
-    jobs (their input phases) in their order, on whatever executor, None for a run that failed (a
-    rival far off may leave the car's valid range in a harsher test)."""
+    jobs (their input phases) in their order, on whatever executor, None for a run that left the
+    car's valid range (:func:`run_unless_diverged`)."""
     jobs = [Job(s, v, duration_scale, tuple(channels)) for v in vehicles for _, s in scenarios]
     results = run(jobs)
     n = len(scenarios)

@@ -114,7 +114,8 @@ OBSERVABLE: dict[str, dict[tuple[str, ...], float]] = {
     "beam_torsion": {(): 1.106},
     "spring_rate": {("front",): 1.048, ("rear",): 1.060},
     "anti_roll_bar": {("front",): 1.096},
-    # the heights that set bump steer and camber gain, the tie rod's lever, the strut's inclination;
+    # the heights that set bump steer and camber gain, the tie rod's lever, the strut's inclination
+    # (the rear wheel centre's height too, floor 2.17 mm, but that is no hardpoint's: see locations);
     # the rest (the pivots' x and y, spring and damper mounts: floors of 7 to over 100 mm) hardly
     # shows in quasi-static K&C tests
     "hardpoint": {("front", "tie_rod_inner", "z"): 0.416, ("front", "wishbone_front_pivot", "z"): 0.467,
@@ -122,7 +123,7 @@ OBSERVABLE: dict[str, dict[tuple[str, ...], float]] = {
                   ("front", "tie_rod_outer", "x"): 1.261, ("front", "lower_ball_joint", "x"): 1.277,
                   ("front", "strut_lower", "y"): 1.905, ("front", "strut_top", "y"): 1.944,
                   ("front", "wishbone_rear_pivot", "z"): 2.174, ("rear", "arm_pivot", "z"): 1.763,
-                  ("rear", "wheel_centre", "z"): 2.17, ("rear", "beam_centre", "z"): 2.495},
+                  ("rear", "beam_centre", "z"): 2.495},
     "backlash": {("e1_front", "y"): 0.049, ("e1_rear", "x"): 0.103, ("e1_rear", "y"): 0.057},
 }
 #: Outside the catalogue: a dead band in one bushing direction.
@@ -219,10 +220,15 @@ def locations(vehicle: VehicleDefinition, cause: str) -> list[tuple[str, ...]]:
     of translations of one bushing (coupling), an axle (``("front",)``) or a fixed place (``()``)."""
     if cause == "coupling":
         return [(b.name, a, c) for b in vehicle.bushings for i, a in enumerate(DIRECTIONS) for c in DIRECTIONS[i + 1:]]
-    if cause == "hardpoint":   # a point on the centre plane (the beam's centre) stays on it
+    if cause == "hardpoint":
+        # moved in the vehicle's file: none for a vehicle its text no longer describes (changed in
+        # code); a point on the centre plane (the beam's centre) stays on it; the wheel centre's
+        # height is the tyre's loaded radius's (the file holds them within 5 mm of each other): an
+        # error there is one of ride height or radius, not of a hardpoint
         return [(axle, name, c) for axle in VEHICLE_CAUSES[cause].axles
                 for name, point in getattr(vehicle, axle).hardpoints.items()
-                for c in COORDINATES if not (c == "y" and point[1] == 0.0)]
+                for c in COORDINATES if not (c == "y" and point[1] == 0.0) and (name, c) != ("wheel_centre", "z")
+                ] if _described(vehicle) else []
     if cause in VEHICLE_CAUSES:
         return [(a,) for a in VEHICLE_CAUSES[cause].axles] or [()]
     applies = CAUSES[cause].applies if cause in CAUSES else (lambda law: True)
@@ -276,7 +282,7 @@ def _moved_hardpoints(vehicle: VehicleDefinition, moves: list[Hypothesis]) -> Ve
     ValueError for a vehicle changed in code since its file was read (its text no longer says it)."""
     if not moves:
         return vehicle
-    if not vehicle.text or parse_vehicle(vehicle.text, vehicle.path) != vehicle:
+    if not _described(vehicle):
         raise ValueError(f"{vehicle.name}: hardpoints are moved in the vehicle's file, which no longer describes it")
     places: dict[str, float] = {}
     for h in moves:
@@ -285,6 +291,12 @@ def _moved_hardpoints(vehicle: VehicleDefinition, moves: list[Hypothesis]) -> Ve
                         getattr(vehicle, axle).hardpoints[name][COORDINATES.index(coordinate)])
         places[f"{axle}.hardpoints.{name}.{coordinate}"] = at + float(h.values["offset"]) / MM_PER_M
     return vehicle_with(vehicle.text, vehicle.path, places, "the diagnosis's hardpoint offsets")
+
+
+def _described(vehicle: VehicleDefinition) -> bool:
+    """Whether the vehicle's file text reads as ``vehicle`` (not so once changed in code, its
+    preloads resolved included)."""
+    return bool(vehicle.text) and parse_vehicle(vehicle.text, vehicle.path) == vehicle
 
 
 def _scaled_axle(vehicle: VehicleDefinition, cause: str, axle: str, factor: float) -> VehicleDefinition:

@@ -47,7 +47,7 @@ import numpy as np
 from vehicle.model.definition import VehicleDefinition
 from vsim_cluster.executor import Executor, TaskFailed, executor as open_executor
 from vsim_diagnosis.catalogue import PAIR_SEPARATOR
-from vsim_diagnosis.kc_alike import Separation, alike, extra_scenarios, separations
+from vsim_diagnosis.kc_alike import Separation, alike, extra_scenarios, run_unless_diverged, separations
 from vsim_diagnosis.kc_catalogue import (BUSHING_CAUSES, VEHICLE_CAUSES, Hypothesis, extended_vehicle, locations,
                                          parameters)
 from vsim_diagnosis.kc_fits import Candidate, Scorer, fit, fit_pair, kept, nominal, nudged, verify
@@ -100,7 +100,9 @@ class KCDiagnosis(Outcome):
     #: verified rivals of a single named cause that the campaign cannot tell from it (kc_alike), best first
     alike: list[Candidate] = field(default_factory=list)
     #: per rival, the shipped test the dataset lacks that separates it from the named cause best
+    #: (None: none ran for both)
     separations: list[Separation | None] = field(default_factory=list)
+    extra_tests: int = 0                  #: shipped rig tests the dataset lacks (tried to separate rivals)
 
     @property
     def final(self) -> Candidate:
@@ -224,15 +226,17 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, executor: Execut
                 alone = single.heldout_error
         rivals: list[Candidate] = []
         apart: list[Separation | None] = []
+        extra = extra_scenarios({t.job.scenario.name for t in layout.tests})
         if second is None and decide(before, best.heldout_error, 1.0) == "named":
             rivals = alike(best, top, before)
         if rivals:
             say(f"{best.hypothesis.label} cannot be told apart on these tests from "
-                f"{', '.join(c.hypothesis.label for c in rivals)}: both run on the shipped tests the dataset lacks")
-            apart = separations([extended_vehicle(vehicle, [c.hypothesis]) for c in (best, *rivals)],
-                                extra_scenarios({t.job.scenario.name for t in layout.tests}), layout.channels,
-                                scorer.noise, float(np.median([t.job.duration_scale for t in layout.tests])),
-                                lambda jobs: pool.results(run_job, jobs))
+                f"{', '.join(c.hypothesis.label for c in rivals)}: both run on the {len(extra)} shipped tests the "
+                f"dataset lacks")
+            apart = separations([extended_vehicle(vehicle, [c.hypothesis]) for c in (best, *rivals)], extra,
+                                layout.channels, scorer.noise,
+                                float(np.median([t.job.duration_scale for t in layout.tests])),
+                                lambda jobs: pool.map(run_unless_diverged, jobs))
     errors = scorer.test_errors(base)
     for m in found:
         say(f"the baseline does not fit {m.test}{' (held out)' if m.heldout else ''}: {m.error:.2f} × the noise, "
@@ -250,7 +254,7 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, executor: Execut
         say(f"  with it, {m.test} is still not fitted: {m.error:.2f} × the noise")
     out = KCDiagnosis(verdict, best, top + screened[VERIFIED:], heldout, [t.name for t in layout.tests], errors,
                       before, layout, scorer.noise, base, None, found, left, time.perf_counter() - started, pairs,
-                      second, alone, rivals, apart)
+                      second, alone, rivals, apart, len(extra))
     if verdict == "named":
         named = [c.hypothesis for c in out.causes]
         out.verdict = PAIR_SEPARATOR.join(h.cause for h in named)

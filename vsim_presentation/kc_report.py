@@ -101,9 +101,13 @@ def _alike_sentence(d: KCDiagnosis) -> str:
                                                                            parameters(c.hypothesis.cause)))
         out += (f" These tests cannot tell it from **{c.hypothesis.cause}** at {_where(c)} ({values}; held-out error "
                 f"{c.heldout_error:.2f}): ")
-        if sep is None or not sep.separates:
-            out += ("no shipped test separates them" + ("." if sep is None else
-                    f" (the most, `{sep.scenario}`, by {sep.difference:.2g} × the noise, RMS)."))
+        if sep is None:
+            out += ("the dataset holds every shipped rig test." if not d.extra_tests else
+                    f"none of the {d.extra_tests} shipped rig tests the dataset lacks ran on both (the car left "
+                    f"its valid range).")
+        elif not sep.separates:
+            out += (f"no shipped test separates them (the most, `{sep.scenario}`, by {sep.difference:.2g} × the "
+                    f"noise, RMS).")
         else:
             out += (f"the shipped test `{sep.scenario}` would separate them (their predictions differ there by "
                     f"{sep.difference:.2g} × the noise, RMS).")

@@ -123,7 +123,7 @@ class DirectionDef:
     set_name: str | None                #: named parameter set in models/bushings/, or None
     model: str | None                   #: model to read the set as, or the inline model
     params: Mapping[str, Any] | None    #: inline parameters (thesis units), or None
-    source: str                         #: file and key, for error messages
+    source: str = field(compare=False)  #: file and key, for error messages (not what the law is)
     families: Families = NO_FAMILIES    #: laws for run-time models this one cannot be read as
     #: state extensions of the law (:mod:`bushings.effects`, parameter-set units), over the set's own
     effects: Mapping[str, Any] = field(default_factory=dict)

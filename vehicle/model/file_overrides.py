@@ -132,7 +132,8 @@ def lossier_places(vehicle: VehicleDefinition, direction: str, amplitude_m: floa
     """The places and values (the file's units, for :func:`vehicle_with`) that give the bushing
     direction ``direction`` (``"e1_front.y"``) of ``vehicle`` its law with the ladder ``factor``
     times as stiff and the same |K*| at (``amplitude_m``, ``frequency_hz``): a lossier part of the
-    same stiffness there (:func:`bushings.frequency.lossier`)."""
+    same stiffness there (:func:`bushings.frequency.lossier`; for a rotation, in rad for m).
+    :class:`PlaceError` for a direction without a ladder."""
     bushing, _, axis = direction.partition(".")
     found = [b for b in vehicle.bushings if b.name == bushing and axis in b.directions]
     if not found:
@@ -140,6 +141,8 @@ def lossier_places(vehicle: VehicleDefinition, direction: str, amplitude_m: floa
     d = found[0].directions[axis]
     own = load_parameter_set(d.set_name).values if d.set_name is not None else d.params
     old = d.channel()
+    if not old.Kpa or not own.get("K0"):
+        raise PlaceError(f"{direction} has no ladder law (K0 and Kpa) to make lossier: {old.model}")
     new = lossier(old, amplitude_m, frequency_hz, factor)
     return {f"bushings.{direction}.Kpa": float(own["Kpa"] * new.Kpa / old.Kpa),
             f"bushings.{direction}.K0": float(own["K0"] * new.K0 / old.K0)}
