@@ -99,7 +99,6 @@ def separations(vehicles: Sequence[VehicleDefinition], scenarios: Sequence[tuple
     return out
 
 
-
 def _difference(a: np.ndarray, b: np.ndarray, noise: np.ndarray) -> float:
     """RMS of (a − b) / noise over samples and channels, each channel's mean removed."""
     d = (a - b) / noise

@@ -14,8 +14,8 @@ from matplotlib.figure import Figure
 from vehicle.model.definition import VehicleDefinition
 from vsim_core.files import atomic_output
 from vsim_diagnosis.catalogue import PAIR_SEPARATOR
-from vsim_diagnosis.kc_catalogue import Hypothesis, extended_vehicle_yaml, parameters
 from vsim_diagnosis.kc_alike import Separation
+from vsim_diagnosis.kc_catalogue import Hypothesis, extended_vehicle_yaml, parameters
 from vsim_diagnosis.kc_diagnosis import KCDiagnosis, Misfit
 from vsim_diagnosis.kc_fits import Candidate
 from vsim_diagnosis.verdict import MISFIT_CHANCE, NOISE_FACTOR
