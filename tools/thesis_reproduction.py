@@ -25,6 +25,7 @@ from bushings.bank import BushingBank  # noqa: E402
 from bushings.frequency import first_harmonic, lossier  # noqa: E402
 from bushings.parameter_sets import load_parameter_set  # noqa: E402
 from vehicle.model.file_overrides import lossier_places, vehicle_with  # noqa: E402
+from vehicle.model.definition import DirectionDef  # noqa: E402
 from vehicle.model.vehicle_file import load_vehicle  # noqa: E402
 from vehicle.scenarios.scenario_file import load_scenario, parse_scenario  # noqa: E402
 from vsim_analysis.run_metrics import case_loop, case_mask, case_relaxation, cases  # noqa: E402
@@ -64,10 +65,15 @@ def _bench_relaxation(set_name: str, ringing_m: float = 0.0, deflection_m: float
     return float(force[-1, 0] / force[settled, 0] - 1.0)
 
 
+def _direction(direction: str) -> DirectionDef:
+    """``bushing.direction`` of the default car's vehicle file."""
+    bushing, axis = direction.split(".")
+    return next(b for b in load_vehicle(DEFAULT_VEHICLE).bushings if b.name == bushing).directions[axis]
+
+
 def _loss(direction: str, lossier_law: bool) -> tuple[float, float]:
     """(tan δ, |K*| [N/mm]) at :data:`LOSS_AT` of ``direction``'s law in the vehicle file, or made lossier."""
-    bushing, axis = direction.split(".")
-    law = next(b for b in load_vehicle(DEFAULT_VEHICLE).bushings if b.name == bushing).directions[axis].channel()
+    law = _direction(direction).channel()
     at = (np.array([LOSS_AT[0]]), np.array([LOSS_AT[1]]))
     k = first_harmonic(lossier(law, *LOSS_AT) if lossier_law else law, *at).k_complex_n_per_m[0]
     return float(k.imag / k.real), float(abs(k) / 1e3)
@@ -130,7 +136,7 @@ def jobs() -> list[tuple[str, str, str | None, tuple]]:
     every = {k: v for values in lossy.values() for k, v in values.items()}
     # the control: E1 front's lateral law (an STS) with its stiffnesses and thresholds scaled, so that
     # its force is SOFTER times its own at every deflection: the same loss factor, a softer part
-    law = load_parameter_set(next(b for b in vehicle.bushings if b.name == "e1_front").directions["y"].set_name)
+    law = load_parameter_set(_direction("e1_front.y").set_name)
     softer = tuple((f"bushings.e1_front.y.{k}", SOFTER * law.values[k]) for k in ("K0", "Kpa", "Kr", "Ff"))
     return JOBS + [(f"lateral_lossier_{d}", "lateral_force", None, tuple(lossy[d].items())) for d in FRONT_LADDERS] \
         + [("lateral_lossier_front", "lateral_force", None, tuple(every.items())),
@@ -163,8 +169,7 @@ JOBS = [
 
 def _stiffness_change(direction: str, amplitudes_mm: list[float]) -> list[float]:
     """The change of |K*| at 0.1 Hz [%] of ``direction``'s law made lossier, at each amplitude [mm]."""
-    bushing, axis = direction.split(".")
-    law = next(b for b in load_vehicle(DEFAULT_VEHICLE).bushings if b.name == bushing).directions[axis].channel()
+    law = _direction(direction).channel()
     a, f = np.array(amplitudes_mm) * 1e-3, np.full(len(amplitudes_mm), LOSS_AT[1])
     before, after = (first_harmonic(x, a, f).k_dyn_n_per_m for x in (law, lossier(law, *LOSS_AT)))
     return [float(100.0 * (y / x - 1.0)) for x, y in zip(before, after)]

@@ -102,7 +102,7 @@ class KCDiagnosis(Outcome):
     #: per rival, the shipped test the dataset lacks that separates it from the named cause best
     #: (None: none ran for both)
     separations: list[Separation | None] = field(default_factory=list)
-    extra_tests: int = 0                  #: shipped rig tests the dataset lacks (tried to separate rivals)
+    extra_tests: int = 0                  #: shipped rig tests the dataset lacks (read when there are rivals)
 
     @property
     def final(self) -> Candidate:
@@ -226,10 +226,11 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, executor: Execut
                 alone = single.heldout_error
         rivals: list[Candidate] = []
         apart: list[Separation | None] = []
-        extra = extra_scenarios({t.job.scenario.name for t in layout.tests})
+        extra: list = []
         if second is None and decide(before, best.heldout_error, 1.0) == "named":
             rivals = alike(best, top, before)
-        if rivals:
+        if rivals:   # the shipped scenarios read only then
+            extra = extra_scenarios({t.job.scenario.name for t in layout.tests})
             say(f"{best.hypothesis.label} cannot be told apart on these tests from "
                 f"{', '.join(c.hypothesis.label for c in rivals)}: both run on the {len(extra)} shipped tests the "
                 f"dataset lacks")
