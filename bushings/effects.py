@@ -32,8 +32,12 @@ class Effects:
     """
 
     preload: float = 0.0          #: operating point of the mounted part on its law [m or rad]
-    asymmetry: float = 0.0        #: extra tangent fraction per unit deflection on one side [1/m or 1/rad];
-    #: > 0 stiffens compression (x < 0), < 0 tension: F_asym = |a|·K0·x·|x|/2 on that side
+    asymmetry: float = 0.0        #: extra tangent fraction per unit deflection on one side, at the
+    #: parameter sets' unit of deflection r (1 mm or 1 deg) [1/m or 1/rad]; > 0 stiffens compression
+    #: (x < 0), < 0 tension: on that side the tangent grows by |a|·K0·r·(|x|/r)^n,
+    #: F_asym = |a|·K0·r·(|x|/r)^n·x/(n + 1)
+    asymmetry_power: float = 1.0  #: n >= 1, how the progressive part grows (1: the tangent in proportion
+    #: to the deflection; 2: as its square, a stop met gradually)
     asymmetry_step: float = 0.0   #: extra tangent fraction from zero deflection on one side [-] (a kink
     #: in the law), signs as ``asymmetry``: F_asym += |s|·K0·x on that side
     mullins: float = 0.0          #: softening μ below the largest |x| seen: η = 1 − μ(1 − (|x|/x_max)^p)
@@ -50,7 +54,10 @@ class Effects:
 
 
 #: Fields that shape an effect but switch none on.
-_SETTINGS = ("heating_tau_s", "mullins_shape")
+_SETTINGS = ("heating_tau_s", "mullins_shape", "asymmetry_power")
+#: Largest power of an asymmetry's progressive part: a stop's force grows at most as the fourth power
+#: of its deflection; beyond, a typing error (and overflow far from the reference deflection).
+MAX_ASYMMETRY_POWER = 5.0
 NO_EFFECTS = Effects()
 
 #: Parameter-set ``effects`` keys -> (Effects field, power of the length unit, unit for translations,
@@ -59,6 +66,7 @@ EFFECT_KEYS: dict[str, tuple[str, int, str, str, float]] = {
     "preload": ("preload", 1, "mm", "deg", -math.inf),
     "asymmetry": ("asymmetry", -1, "1/mm", "1/deg", -math.inf),
     "asymmetry_step": ("asymmetry_step", 0, "-", "-", -math.inf),
+    "asymmetry_power": ("asymmetry_power", 0, "-", "-", 1.0),
     "mullins": ("mullins", 0, "-", "-", 0.0),
     "mullins_shape": ("mullins_shape", 0, "-", "-", 1.0),
     "heating": ("heating", 0, "1/kJ", "1/kJ", 0.0),
@@ -81,6 +89,9 @@ def effects_to_si(values: Mapping[str, Any], quantity: str = "translation", sour
         si[name] = float(raw) * length ** power * (1e-3 if key == "heating" else 1.0)
     if si.get("mullins", 0.0) >= 1.0:
         raise InputError(f"expected mullins < 1, got {values['mullins']!r}", source=source, key="effects.mullins")
+    if si.get("asymmetry_power", 1.0) > MAX_ASYMMETRY_POWER:
+        raise InputError(f"expected asymmetry_power <= {MAX_ASYMMETRY_POWER:g}, got {values['asymmetry_power']!r}",
+                         source=source, key="effects.asymmetry_power")
     return Effects(**si)
 
 

@@ -12,12 +12,13 @@ import numpy as np
 from bushings import kernel as kn
 from bushings.bank import DEFAULT_TOLERANCE, BushingBank
 from bushings.effects import NO_EFFECTS, Effects
-from bushings.parameters import ChannelParams
+from bushings.parameters import LENGTH_UNIT_SI, ChannelParams
 from vsim_core.compiled_cache import follow
 
 # Columns of the effect parameter matrix (one row per channel) and of the effect state.
-E_PRELOAD, E_ASYM, E_ASYM_STEP, E_MULLINS, E_MULLINS_SHAPE, E_HEAT, E_HEAT_TAU, E_BACKLASH, E_TARE = range(9)
-N_ECOLS = 9
+(E_PRELOAD, E_ASYM, E_ASYM_POWER, E_ASYM_STEP, E_MULLINS, E_MULLINS_SHAPE, E_HEAT, E_HEAT_TAU, E_BACKLASH,
+ E_TARE) = range(10)
+N_ECOLS = 10
 S_XMAX, S_HEAT, S_DISS = range(3)
 N_SCOLS = 3
 #: Duration and steps of the quasi-static mounting ramp to the preload deflection.
@@ -45,11 +46,12 @@ def _effects_out(h, e, X, EP, ES, P, diss, F, K, Fout, Kout):
     """Force and tangent of each channel with its effects, from the base law's (F, K) at X."""
     for c in range(X.shape[0]):
         x, f, k = X[c], F[c], K[c]
-        a = EP[c, E_ASYM]
+        a = EP[c, E_ASYM]   # per unit deflection to the power n (see ExtendedBank)
         if a != 0.0 and (x < 0.0) == (a > 0.0):
-            k0 = P[c, kn.P_K0]
-            f += abs(a) * k0 * x * abs(x) * 0.5
-            k += abs(a) * k0 * abs(x)
+            n = EP[c, E_ASYM_POWER]
+            extra = abs(a) * P[c, kn.P_K0] * abs(x) ** n
+            f += extra * x / (n + 1.0)
+            k += extra
         s = EP[c, E_ASYM_STEP]
         if s != 0.0 and (x < 0.0) == (s > 0.0):
             k0 = P[c, kn.P_K0]
@@ -113,6 +115,7 @@ class ExtendedBank:
 
     def __init__(self, channels: Sequence[ChannelParams], effects: Sequence[Effects] | None = None,
                  tolerance: float = DEFAULT_TOLERANCE):
+        channels = list(channels)
         self.bank = BushingBank(channels, tolerance)
         effects = list(effects) if effects is not None else [NO_EFFECTS] * self.bank.size
         if len(effects) != self.bank.size:
@@ -120,9 +123,11 @@ class ExtendedBank:
         self.effects = tuple(effects)
         M = self.bank.size
         self.EP = np.zeros((M, N_ECOLS))
-        for c, fx in enumerate(self.effects):
-            self.EP[c, :E_TARE] = (fx.preload, fx.asymmetry, fx.asymmetry_step, fx.mullins, fx.mullins_shape,
-                                   fx.heating, fx.heating_tau_s, fx.backlash)
+        for c, (ch, fx) in enumerate(zip(channels, self.effects)):
+            # the asymmetry's rate is given at the parameter sets' unit of deflection r: a·r^(1−n) per (m or rad)^n
+            rate = fx.asymmetry * LENGTH_UNIT_SI[ch.quantity] ** (1.0 - fx.asymmetry_power)
+            self.EP[c, :E_TARE] = (fx.preload, rate, fx.asymmetry_power, fx.asymmetry_step, fx.mullins,
+                                   fx.mullins_shape, fx.heating, fx.heating_tau_s, fx.backlash)
         self.ES = np.zeros((M, N_SCOLS))
         self._X = np.zeros(M)
         self.force = np.zeros(M)

@@ -31,11 +31,11 @@ from vsim_diagnosis.kc_catalogue import (OBSERVABLE, Hypothesis, draw, extended_
 from vsim_cluster.executor import SerialExecutor
 from vsim_core.shipped import DEFAULT_VEHICLE
 from vsim_diagnosis.catalogue import PAIR_SEPARATOR
-from vsim_diagnosis.kc_alike import Separation, alike, separations
+from vsim_diagnosis.kc_alike import alike, separations
 from vsim_diagnosis.kc_diagnosis import _second_stage, diagnose_kc
 from vsim_diagnosis.kc_fits import Candidate, Scorer, fit, nominal, verify
 from vsim_diagnosis.kc_layout import Layout, Test
-from vsim_diagnosis.verdict import pair_named, split, told_apart
+from vsim_diagnosis.verdict import Separation, pair_named, split, told_apart
 from vsim_diagnosis.virtual_kc_rig import DEFAULT_SCENARIOS, measure_kc, parse_kc_truth
 from vsim_presentation.kc_report import _parameters, summary
 from vsim_recordings.recorder import run_scenario, simulate
@@ -200,7 +200,7 @@ def test_alike_rivals_are_those_the_tests_cannot_tell_from_the_best():
 
     (sep,) = separations(["best", "rival"], tests, ["toe", "camber"], np.array([2.0, 1.0]), 1.0, run)
     d = 0.8 * np.sin(6 * t)
-    assert sep.scenario == "apart" and sep.difference == pytest.approx(np.sqrt(np.mean((d - d.mean()) ** 2) / 2))
+    assert sep.test == "apart" and sep.difference == pytest.approx(np.sqrt(np.mean((d - d.mean()) ** 2) / 2))
 
 
 def test_the_screening_fit_scales_the_effect_and_clips_a_hopeless_one_at_its_bound():

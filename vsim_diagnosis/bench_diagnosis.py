@@ -3,7 +3,8 @@ through the baseline law, quantify the mismatch, fit every applicable cause of t
 half of the tests, score it on the other half, and name the cause that explains the mismatch, or
 say that nothing significant is missing, or that the mismatch is real but unexplained. When the
 best cause leaves a mismatch beyond the noise, every pair of causes is fitted the same way, and
-two are named when the pair removes most of what the best one left.
+two are named when the pair removes most of what the best one left. A rival the tests cannot tell
+from a named cause is reported with the shipped programme that would (:mod:`vsim_diagnosis.bench_alike`).
 
 The measured deflection drives the simulation (as a bench drives the part), record after record
 with the rests between them, so that the part's state carries over as on the rig. A constant
@@ -27,8 +28,9 @@ from scipy.optimize import least_squares
 from bushings.extended_bank import ExtendedBank
 from bushings.parameter_sets import ParameterSet
 from vsim_diagnosis.catalogue import PAIR_SEPARATOR, Cause, applicable, combined, parts
-from vsim_diagnosis.verdict import (Outcome, decide, explained, pair_named, pair_shares, second_cause_wanted,
-                                    split)
+from vsim_diagnosis.bench_alike import extra_programmes, load_cell_noise_n, separations
+from vsim_diagnosis.verdict import (Outcome, Separation, alike, decide, explained, pair_named, pair_shares,
+                                    second_cause_wanted, split)
 from vsim_recordings.bench_dataset import BenchDataset
 
 #: Penalty per fitted parameter on the held-out error used for ranking.
@@ -74,6 +76,17 @@ class Replay:
         scale = np.array([max(np.ptp(r.record.F) / 2.0, 1e-9) for r in data.records])
         return cls(np.concatenate(e), np.concatenate(dts), np.concatenate(rec), np.concatenate(meas),
                    [r.name for r in data.records], scale)
+
+    def followed_by(self, t_s: np.ndarray, e_m: np.ndarray, rest_s: float) -> "Replay":
+        """The history to be played with, after it, a rest of ``rest_s`` at zero deflection and the
+        deflections ``e_m`` [m] at times ``t_s`` [s] (a uniform grid): for :meth:`simulate` only (no
+        record, no measured force)."""
+        n = max(1, math.ceil(rest_s / REST_STEP_S - 1e-9))
+        steps = np.diff(t_s, prepend=t_s[0] - (t_s[1] - t_s[0]))
+        return Replay(np.concatenate([self.e, np.zeros(n), e_m]),
+                      np.concatenate([self.dts, np.full(n, rest_s / n), steps]),
+                      np.concatenate([self.record, np.full(n + len(t_s), -1)]),
+                      np.concatenate([self.measured, np.zeros(n + len(t_s))]), self.names, self.scale)
 
     def simulate(self, models: Sequence[ParameterSet]) -> np.ndarray:
         """Forces (K, T) of K candidate models along the history, each from a virgin part."""
@@ -135,6 +148,9 @@ class Candidate:
     std: dict[str, float] = field(default_factory=dict)
     model: ParameterSet | None = None                       #: the extended baseline with ``final``
     fit_s: float = 0.0                 #: wall time of its fit and score [s] (to schedule the longest first)
+    #: relative RMS error over every test, each scored by a fit on the other half (computed only when
+    #: the held-out half cannot tell it from the best: :func:`_crossed`)
+    two_fold_error: float = math.nan
 
 
 @dataclass
@@ -154,6 +170,10 @@ class BenchDiagnosis(Outcome):
     #: the second stage (:func:`vsim_diagnosis.verdict.second_cause_wanted`): every pair of causes,
     #: best first; empty when the best single cause left nothing beyond the noise
     pairs: list[Candidate] = field(default_factory=list)
+    #: rivals of a single named cause that the tests cannot tell from it (bench_alike), best first
+    alike: list[Candidate] = field(default_factory=list)
+    #: per rival, the shipped bench programme that separates it from the named cause best
+    separations: list[Separation | None] = field(default_factory=list)
 
     @property
     def heldout_error_before(self) -> float:
@@ -290,6 +310,15 @@ def fit_cause(replay: Replay, base: ParameterSet, cause: Cause, train: np.ndarra
     return values, std
 
 
+def _crossed(c: Candidate, replay: Replay, baseline: ParameterSet, heldout: np.ndarray) -> Candidate:
+    """``c`` with its two-fold error: refitted on the held-out tests (from its values, and either side
+    of a sided parameter) and scored on the training tests, whose errors join its held-out ones."""
+    values, _ = fit_cause(replay, baseline, c.cause, heldout, c.values, PAIR_NFEV, corners=True)
+    errors = replay.record_errors(replay.residuals(replay.simulate([c.cause.apply(baseline, values)]), heldout)[0])
+    c.two_fold_error = aggregate(np.where(heldout, c.record_errors, errors), np.ones(len(heldout), dtype=bool))
+    return c
+
+
 def diagnose_bench(data: BenchDataset, baseline: ParameterSet,
                    progress: Callable[[str], None] | None = None) -> BenchDiagnosis:
     """Diagnose a bench dataset against a baseline parameter set (see the module docstring)."""
@@ -335,6 +364,23 @@ def diagnose_bench(data: BenchDataset, baseline: ParameterSet,
                            key=lambda c: (c.score, c.cause.id))
             if pairs and pair_named(before, best.heldout_error, pairs[0].heldout_error, floor):
                 best, verdict = pairs[0], "named"
+        rivals = ([c for c in ranking[1:] if alike(before, c.heldout_error, best.heldout_error, floor)]
+                  if verdict == "named" and best is ranking[0] else [])
+        if rivals:
+            # the held-out half cannot tell them apart: the other half is asked too (two-fold cross-validation)
+            say(f"{', '.join(c.cause.id for c in rivals)}: not told from {best.cause.id} by the held-out tests; "
+                f"fitting each on them and scoring it on the training tests")
+            contenders = sorted(pool.map(lambda c: _crossed(c, replay, baseline, heldout), [best, *rivals]),
+                                key=lambda c: c.two_fold_error * (1.0 + PARAMETER_PENALTY * len(c.cause.parameters)))
+            both, floor_both = aggregate(base_errors, everything), aggregate(noise, everything)
+            best = contenders[0]
+            rivals = [c for c in contenders[1:] if alike(both, c.two_fold_error, best.two_fold_error, floor_both)]
+    apart = []
+    if rivals:
+        say(f"{', '.join(c.cause.id for c in rivals)}: not told from {best.cause.id} by these tests; playing the "
+            f"shipped bench programmes after them")
+        apart = separations(replay, [c.cause.apply(baseline, c.values) for c in (best, *rivals)],
+                            load_cell_noise_n(noise, replay.scale), extra_programmes())
     if verdict == "named":
         say(f"refitting {best.cause.id} on every test")
         best.final, linearised = fit_cause(replay, baseline, best.cause, everything, start=best.values, max_nfev=6)
@@ -344,4 +390,5 @@ def diagnose_bench(data: BenchDataset, baseline: ParameterSet,
                                       source=f"{baseline.name} extended by {best.cause.id}, fitted by vsim diagnose "
                                              f"on {data.path.name} ({len(replay.names)} bench tests)")
     return BenchDiagnosis(best.cause.id if verdict == "named" else verdict, baseline, replay, heldout,
-                          base_errors, noise, ranking, best, data.part, time.perf_counter() - started, pairs)
+                          base_errors, noise, ranking, best, data.part, time.perf_counter() - started, pairs,
+                          rivals, apart)

@@ -117,7 +117,9 @@ def _effect(key: str, parameter: str) -> Callable[[dict, dict, Mapping[str, floa
 # A family's shape parameter left out (a hypothesis written before the family had it) is its first form.
 def _asymmetry(params: dict, effects: dict, v: Mapping[str, float]) -> tuple[dict, dict]:
     step = v.get("asymmetry_step", NO_EFFECTS.asymmetry_step)
-    return params, _add(_add(dict(effects), "asymmetry", v["asymmetry"]), "asymmetry_step", step)
+    power = v.get("asymmetry_power", NO_EFFECTS.asymmetry_power)
+    return params, {**_add(_add(dict(effects), "asymmetry", v["asymmetry"]), "asymmetry_step", step),
+                    "asymmetry_power": power}
 
 
 def _mullins(params: dict, effects: dict, v: Mapping[str, float]) -> tuple[dict, dict]:
@@ -153,17 +155,20 @@ CAUSES: dict[str, Cause] = {c.id: c for c in (
           (Parameter("preload", "mm", (-5.0, 5.0), (1.5, 3.0), signed=True, sided=True,
                      description="deflection of the mounted part at the rig's zero (2-4 kN of static load)"),),
           _elastic_law, _effect("preload", "preload")),
-    # a family of two forms (issue 29): an elastomer stiffens progressively as it is compressed, and
-    # a part with a stop, a void or a rate-limiting sleeve takes its extra stiffness at once from
-    # zero deflection (a kink in its law; e.g. voided bushings, Kadlowec et al. 2003)
+    # a family (issue 29): an elastomer stiffens progressively as it is compressed, a part with a stop
+    # met gradually as a power of its deflection (bump stops' force laws grow as its square to its
+    # fourth power), and a part with a void or a rate-limiting sleeve takes its extra stiffness at
+    # once from zero deflection (a kink in its law; e.g. voided bushings, Kadlowec et al. 2003)
     Cause("asymmetry",
           "tension/compression asymmetry beyond the elastic law: one side stiffer, at once from zero deflection "
-          "(a kink) and progressively",
+          "(a kink) and progressively, as a power of the deflection",
           "loops not point-symmetric about their centre",
           (Parameter("asymmetry", "1/mm", (-1.0, 1.0), (0.05, 0.15), signed=True, sided=True,
-                     description="extra tangent fraction of K0 per mm; > 0 stiffens compression"),
+                     description="extra tangent fraction of K0 per mm at 1 mm; > 0 stiffens compression"),
            Parameter("asymmetry_step", "-", (-1.0, 1.0), (0.03, 0.10), signed=True, sided=True, default=0.0,
-                     description="extra tangent fraction of K0 from zero deflection; > 0 stiffens compression")),
+                     description="extra tangent fraction of K0 from zero deflection; > 0 stiffens compression"),
+           Parameter("asymmetry_power", "-", (1.0, 3.0), (1.0, 2.0), default=1.0,
+                     description="power n of the progressive part: the extra tangent grows as |x|^n")),
           lambda b: b.values.get("K0", 0.0) > 0.0, _asymmetry),
     # the recovery's shape (issue 29): a power of |x|/x_max, 1 the linear recovery, as the families of
     # Ogden & Roxburgh (1999) and Dorfmann & Ogden (2004) bend it with the past maximum's energy

@@ -13,7 +13,6 @@ the dataset lacks; the one where their predictions differ most, in units of the 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Sequence
 
@@ -26,33 +25,17 @@ from vehicle.simulation.runner import DivergenceError
 from vsim_core.shipped import SCENARIO_DIR, built_in
 from vsim_diagnosis.kc_fits import Candidate
 from vsim_diagnosis.kc_layout import Job, run_job
-from vsim_diagnosis.verdict import decide, told_apart
-
-
-@dataclass(frozen=True)
-class Separation:
-    """A shipped test and how far apart two models' predictions of it lie."""
-
-    scenario: str          #: the scenario's name
-    path: Path             #: its file
-    difference: float      #: RMS of the predictions' difference [× the noise], each channel's mean removed
-
-    @property
-    def separates(self) -> bool:
-        """Whether the test, measured, would tell the two apart as the diagnosis tells causes apart:
-        the wrong one's error there, √(1 + difference²) × the noise, told from the right one's, the
-        noise (:func:`~vsim_diagnosis.verdict.told_apart`: a difference of at least 0.48)."""
-        return told_apart(math.hypot(1.0, self.difference), 1.0, 1.0)
+from vsim_diagnosis.verdict import Separation, difference
+from vsim_diagnosis.verdict import alike as is_alike
 
 
 def alike(best: Candidate, verified: Sequence[Candidate], before: float, floor: float = 1.0) -> list[Candidate]:
-    """The verified candidates other than ``best`` (another cause, or another place) that would be
-    named on their own against the baseline's held-out error ``before`` and that ``best`` does not
-    tell apart from itself (:func:`~vsim_diagnosis.verdict.told_apart`), best first."""
+    """The verified candidates other than ``best`` (another cause, or another place) that the tests
+    cannot tell from it (:func:`vsim_diagnosis.verdict.alike`, against the baseline's held-out error
+    ``before``), best first."""
     same = lambda c: (c.hypothesis.cause, c.hypothesis.location) == (best.hypothesis.cause, best.hypothesis.location)
     return [c for c in verified if c.verified and not same(c)
-            and decide(before, c.heldout_error, floor) == "named"
-            and not told_apart(c.heldout_error, best.heldout_error, floor)]
+            and is_alike(before, c.heldout_error, best.heldout_error, floor)]
 
 
 def extra_scenarios(measured: Sequence[str]) -> list[tuple[Path, Scenario]]:
@@ -91,16 +74,10 @@ def separations(vehicles: Sequence[VehicleDefinition], scenarios: Sequence[tuple
                  for k in range(len(vehicles))]
     out: list[Separation | None] = []
     for rival in predicted[1:]:
-        differences = [-math.inf if a is None or b is None else _difference(a, b, noise)
+        differences = [-math.inf if a is None or b is None else difference(a, b, noise)
                        for a, b in zip(predicted[0], rival)]
         k = int(np.argmax(differences)) if differences else 0
         out.append(Separation(scenarios[k][1].name, scenarios[k][0], differences[k])
                    if differences and differences[k] > -math.inf else None)
     return out
 
-
-def _difference(a: np.ndarray, b: np.ndarray, noise: np.ndarray) -> float:
-    """RMS of (a − b) / noise over samples and channels, each channel's mean removed."""
-    d = (a - b) / noise
-    d -= d.mean(axis=0)
-    return math.sqrt(float(np.mean(d ** 2))) if d.size else 0.0

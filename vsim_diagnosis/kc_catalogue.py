@@ -161,6 +161,10 @@ class Hypothesis:
             {"axle": "rear"} if self.cause == "beam_torsion" else None)
 
 
+#: The most parameters of a cause the K&C diagnosis fits (:func:`parameters`).
+KC_FITTED_PARAMETERS = 2
+
+
 def draw(cause: str, rng: np.random.Generator) -> Hypothesis:
     """A random hypothesis of ``cause``: a place where the K&C campaign sees it (:data:`OBSERVABLE`)
     and values in the realistic range, the first parameter's magnitude mapped into the part of it
@@ -181,11 +185,13 @@ def draw(cause: str, rng: np.random.Generator) -> Hypothesis:
 
 
 def parameters(cause: str) -> tuple[Parameter, ...]:
-    """The fitted parameters of a K&C cause (``backlash`` included, for the virtual rig)."""
+    """The fitted parameters of a K&C cause (``backlash`` included, for the virtual rig): of a bushing
+    cause, its first two (:mod:`vsim_diagnosis.kc_fits` fits a magnitude and one shape); a family's
+    further shape (the asymmetry's power) stays at its first form, in the hypotheses and the draws."""
     if cause in VEHICLE_CAUSES:
         return VEHICLE_CAUSES[cause].parameters
     if cause in CAUSES:
-        return CAUSES[cause].parameters
+        return CAUSES[cause].parameters[:KC_FITTED_PARAMETERS]
     if cause == "backlash":
         return (BACKLASH,)
     raise InputError(f"unknown cause {cause!r}; expected one of {', '.join([*BUSHING_CAUSES, *VEHICLE_CAUSES])} "

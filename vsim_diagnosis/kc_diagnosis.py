@@ -47,13 +47,13 @@ import numpy as np
 from vehicle.model.definition import VehicleDefinition
 from vsim_cluster.executor import Executor, TaskFailed, executor as open_executor
 from vsim_diagnosis.catalogue import PAIR_SEPARATOR
-from vsim_diagnosis.kc_alike import Separation, alike, extra_scenarios, run_unless_diverged, separations
+from vsim_diagnosis.kc_alike import alike, extra_scenarios, run_unless_diverged, separations
 from vsim_diagnosis.kc_catalogue import (BUSHING_CAUSES, VEHICLE_CAUSES, Hypothesis, extended_vehicle, locations,
                                          parameters)
 from vsim_diagnosis.kc_fits import Candidate, Scorer, fit, fit_pair, kept, nominal, nudged, verify
 from vsim_diagnosis.kc_layout import Layout, run_job
-from vsim_diagnosis.verdict import (Outcome, decide, explained, misfit, misfit_stretch, pair_named, pair_shares,
-                                    second_cause_wanted, split)
+from vsim_diagnosis.verdict import (Outcome, Separation, decide, explained, misfit, misfit_stretch, pair_named,
+                                    pair_shares, second_cause_wanted, split)
 from vsim_recordings.kc_dataset import KCDataset
 
 #: Hypotheses re-run on the full vehicle after the screening.

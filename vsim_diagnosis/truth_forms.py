@@ -1,10 +1,13 @@
-"""Other forms of catalogued effects, that the virtual bench can hide and the diagnosis does not fit
-(issue 29): each written here apart from the catalogue's families (``bushings.extended_bank``), as a
-change of the measured part's force along its deflection history, so that a test of "another form"
-cannot pass by fitting the very formula that made the data.
+"""Other forms of catalogued effects, that the virtual bench can hide (issue 29): each written here
+apart from the catalogue's families (``bushings.extended_bank``), as a change of the measured part's
+force along its deflection history, so that a test of "another form" cannot pass by fitting the
+very formula that made the data. The diagnosis fits none of them but the first, which is the
+asymmetry family's power 2 (written apart all the same).
 
 * ``asymmetry_cubic``: one side stiffens as the square of the deflection (a bushing whose rubber
   reaches a stop gradually), F += |c|·K0·x³/3 on that side;
+* ``asymmetry_exponential``: one side stiffens exponentially (a hyperelastic law of Fung's kind),
+  tangent += |s|·K0·(exp(|x|/w) − 1) on that side;
 * ``asymmetry_smooth_kink``: one side stiffer from about zero deflection, the step in tangent
   smoothed over a width w (a voided bushing closing its voids), tangent += |s|·K0·σ(∓x/w);
 * ``mullins_ogden``: Ogden–Roxburgh (1999) softening, η = 1 − erf((W_max − W)/(β·W_max))/r with
@@ -50,6 +53,12 @@ def _cubic(x, force, k0, v, state):
     return force - c * k0 * np.where(side > 0.0, side, 0.0) ** 3 / 3.0   # c > 0: more compressive force
 
 
+def _exponential(x, force, k0, v, state):
+    s, w = v["asymmetry_exp"], v["exp_length_mm"] * MM
+    u = np.maximum(_stiff_side(x, s), 0.0)
+    return force - s * k0 * w * (np.expm1(u / w) - u / w)
+
+
 def _smooth_kink(x, force, k0, v, state):
     s, w = v["asymmetry_kink"], v["kink_width_mm"] * MM
     side = _stiff_side(x, s)
@@ -72,6 +81,11 @@ FORMS: dict[str, Form] = {f.id: f for f in (
          (Parameter("asymmetry_cubic", "1/mm^2", (-1.0, 1.0), (0.02, 0.06), signed=True, sided=True,
                     description="extra tangent fraction of K0 per mm²; > 0 stiffens compression"),),
          _cubic),
+    Form("asymmetry_exponential", "asymmetry", "one side stiffens exponentially with the deflection",
+         (Parameter("asymmetry_exp", "-", (-1.0, 1.0), (0.01, 0.04), signed=True, sided=True,
+                    description="scale of the extra tangent, a fraction of K0; > 0 stiffens compression"),
+          Parameter("exp_length_mm", "mm", (0.2, 10.0), (1.0, 2.0), description="deflection of an e-fold growth")),
+         _exponential),
     Form("asymmetry_smooth_kink", "asymmetry", "one side stiffer from about zero deflection, smoothed over a width",
          (Parameter("asymmetry_kink", "-", (-1.0, 1.0), (0.08, 0.2), signed=True, sided=True,
                     description="extra tangent fraction of K0 well inside the stiff side"),

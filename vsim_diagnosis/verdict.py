@@ -6,6 +6,8 @@ is missing, or the mismatch is real but unexplained."""
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
+from pathlib import Path
 from typing import Sequence
 
 import numpy as np
@@ -116,6 +118,37 @@ def told_apart(rival: float, best: float, floor: float) -> bool:
     best beats the rival as a cause must beat the baseline (:func:`decide`), not by a share of the
     noise that another draw of it could reverse."""
     return decide(rival, best, floor) == "named"
+
+
+def alike(before: float, rival: float, best: float, floor: float) -> bool:
+    """Whether a rival cause (held-out error ``rival``) is one the tests cannot tell from the best
+    (``best``): it would be named on its own against the baseline's ``before``, and the best does not
+    beat it as a cause must (:func:`told_apart`)."""
+    return decide(before, rival, floor) == "named" and not told_apart(rival, best, floor)
+
+
+@dataclass(frozen=True)
+class Separation:
+    """An extra test, the dataset's lacking, and how far apart two causes' predictions of it lie."""
+
+    test: str              #: its name (a scenario, a bench programme)
+    path: Path             #: its file
+    difference: float      #: RMS of the predictions' difference [× the noise], each channel's mean removed
+
+    @property
+    def separates(self) -> bool:
+        """Whether the test, measured, would tell the two apart as the diagnosis tells causes apart:
+        the wrong one's error there, √(1 + difference²) × the noise, told from the right one's, the
+        noise (:func:`told_apart`: a difference of at least 0.48)."""
+        return told_apart(math.hypot(1.0, self.difference), 1.0, 1.0)
+
+
+def difference(a: np.ndarray, b: np.ndarray, noise: np.ndarray | float) -> float:
+    """RMS of (a − b) / noise over samples (rows) and channels (columns), each channel's mean removed
+    (as a zero error would be)."""
+    d = (a - b) / noise
+    d = d - d.mean(axis=0)
+    return math.sqrt(float(np.mean(d ** 2))) if d.size else 0.0
 
 
 def second_cause_wanted(before: float, after: float, floor: float, misfit_left: bool = False) -> bool:

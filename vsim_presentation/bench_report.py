@@ -16,7 +16,7 @@ from vsim_diagnosis.bench_diagnosis import BenchDiagnosis, Candidate, aggregate
 from vsim_diagnosis.catalogue import PAIR_SEPARATOR, Cause, parts
 from vsim_diagnosis.verdict import MIN_GAIN
 from vsim_core.units import MM_PER_M
-from vsim_presentation.diagnosis_report import Report, partly_explained, ranking_chart
+from vsim_presentation.diagnosis_report import Report, partly_explained, ranking_chart, separation_clause
 from vsim_presentation.figures import save_figure
 
 #: Held-out records overlaid in the report (the largest baseline errors first).
@@ -47,7 +47,8 @@ def _parameters(d: BenchDiagnosis, cause: Cause | None = None) -> dict[str, Any]
 
 def _candidates(candidates: list[Candidate]) -> list[dict[str, Any]]:
     return [{"cause": c.cause.id, "heldout_error": c.heldout_error, "score": c.score,
-             "n_parameters": len(c.cause.parameters), "parameters": c.values} for c in candidates]
+             "n_parameters": len(c.cause.parameters), "parameters": c.values,
+             "two_fold_error": None if math.isnan(c.two_fold_error) else c.two_fold_error} for c in candidates]
 
 
 def summary(d: BenchDiagnosis) -> dict[str, Any]:
@@ -68,6 +69,10 @@ def summary(d: BenchDiagnosis) -> dict[str, Any]:
         "tests": [{"name": n, "heldout": bool(h), "error_before": float(b),
                    "error_after": float(d.best.record_errors[k]) if d.named else float(b)}
                   for k, (n, h, b) in enumerate(zip(d.replay.names, d.heldout, d.baseline_errors))],
+        "alike": [{"cause": c.cause.id, "parameters": c.values, "heldout_error": c.heldout_error,
+                   "separated_by": None if sep is None else {"programme": sep.test, "file": str(sep.path),
+                                                             "difference": sep.difference, "separates": sep.separates}}
+                  for c, sep in zip(d.alike, d.separations)],
         "baseline": {"name": d.baseline.name, "model": d.baseline.model},
         "wall_s": d.wall_s,
     }
@@ -91,6 +96,16 @@ def verdict_sentence(d: BenchDiagnosis) -> str:
     how, share = d.explained
     if how == "partial":
         sentence += partly_explained(share)
+    first = d.ranking[0]
+    if d.best is not first and PAIR_SEPARATOR not in d.verdict:
+        sentence += (f" The held-out tests alone could not tell it from **{first.cause.id}**; each fitted on one half "
+                     f"and scored on the other, it is the better ({d.best.two_fold_error:.2%} against "
+                     f"{first.two_fold_error:.2%}).")
+    for c, sep in zip(d.alike, d.separations):
+        values = ", ".join(f"{p.name} = {c.values[p.name]:.4g} {p.unit}" for p in c.cause.parameters)
+        sentence += (f" These tests cannot tell it from **{c.cause.id}** ({values}; held-out error "
+                     f"{c.heldout_error:.2%}): " + ("no shipped bench programme can follow them." if sep is None else
+                                                   separation_clause(sep, "bench programme")))
     return sentence
 
 

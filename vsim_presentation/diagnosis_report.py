@@ -11,6 +11,7 @@ from typing import Any, Iterable, Sequence
 from matplotlib.figure import Figure
 
 from vsim_core.files import atomic_output
+from vsim_diagnosis.verdict import Separation
 from vsim_presentation.figures import save_figure
 
 
@@ -77,3 +78,12 @@ def partly_explained(share: float, left: str = "") -> str:
     still = f"; still not fitted: {left}" if left else ""
     return (f" Partly explained: it removes {share:.0%} of the mismatch beyond the noise, and what it leaves is "
             f"still significant{still}.")
+
+
+def separation_clause(sep: Separation, what: str) -> str:
+    """Whether the extra ``what`` (e.g. "rig test") ``sep`` names would separate two causes the
+    dataset cannot tell apart, with how far apart their predictions lie there."""
+    if not sep.separates:
+        return f"no shipped {what} separates them (the most, `{sep.test}`, by {sep.difference:.2g} × the noise, RMS)."
+    return (f"the shipped {what} `{sep.test}` would separate them (their predictions differ there by "
+            f"{sep.difference:.2g} × the noise, RMS).")

@@ -14,12 +14,11 @@ from matplotlib.figure import Figure
 from vehicle.model.definition import VehicleDefinition
 from vsim_core.files import atomic_output
 from vsim_diagnosis.catalogue import PAIR_SEPARATOR
-from vsim_diagnosis.kc_alike import Separation
 from vsim_diagnosis.kc_catalogue import Hypothesis, extended_vehicle_yaml, parameters
 from vsim_diagnosis.kc_diagnosis import KCDiagnosis, Misfit
 from vsim_diagnosis.kc_fits import Candidate
-from vsim_diagnosis.verdict import MISFIT_CHANCE, NOISE_FACTOR
-from vsim_presentation.diagnosis_report import Report, partly_explained, ranking_chart
+from vsim_diagnosis.verdict import MISFIT_CHANCE, NOISE_FACTOR, Separation
+from vsim_presentation.diagnosis_report import Report, partly_explained, ranking_chart, separation_clause
 from vsim_presentation.figures import save_figure
 
 #: Channels overlaid in the report (the largest baseline mismatch on held-out tests first).
@@ -89,7 +88,7 @@ def _alike(c: Candidate, sep: Separation | None) -> dict[str, Any]:
     """A rival the campaign cannot tell from the named cause, and the shipped test that separates them."""
     return {"cause": c.hypothesis.cause, "location": c.hypothesis.location_json(),
             "parameters": dict(c.hypothesis.values), "heldout_error": c.heldout_error,
-            "separated_by": None if sep is None else {"scenario": sep.scenario, "file": str(sep.path),
+            "separated_by": None if sep is None else {"scenario": sep.test, "file": str(sep.path),
                                                       "difference": sep.difference, "separates": sep.separates}}
 
 
@@ -105,12 +104,8 @@ def _alike_sentence(d: KCDiagnosis) -> str:
             out += ("the dataset holds every shipped rig test." if not d.extra_tests else
                     f"none of the {d.extra_tests} shipped rig tests the dataset lacks ran on both (the car left "
                     f"its valid range).")
-        elif not sep.separates:
-            out += (f"no shipped test separates them (the most, `{sep.scenario}`, by {sep.difference:.2g} × the "
-                    f"noise, RMS).")
         else:
-            out += (f"the shipped test `{sep.scenario}` would separate them (their predictions differ there by "
-                    f"{sep.difference:.2g} × the noise, RMS).")
+            out += separation_clause(sep, "rig test")
     return out
 
 
