@@ -25,6 +25,7 @@ from typing import Callable, Sequence
 import numpy as np
 from scipy.optimize import least_squares
 
+from bushings.bench.records import sample_steps
 from bushings.extended_bank import ExtendedBank
 from bushings.parameter_sets import ParameterSet
 from vsim_diagnosis.catalogue import PAIR_SEPARATOR, Cause, applicable, combined, parts
@@ -68,9 +69,8 @@ class Replay:
                 dts.append(np.full(n, r.rest_before_s / n))
                 rec.append(np.full(n, -1))
                 meas.append(np.zeros(n))
-            steps = np.diff(x.t, prepend=x.t[0] - (x.t[1] - x.t[0]))
             e.append(x.e)
-            dts.append(steps)
+            dts.append(sample_steps(x.t))
             rec.append(np.full(len(x.t), k))
             meas.append(x.F)
         scale = np.array([max(np.ptp(r.record.F) / 2.0, 1e-9) for r in data.records])
@@ -82,9 +82,8 @@ class Replay:
         deflections ``e_m`` [m] at times ``t_s`` [s] (a uniform grid): for :meth:`simulate` only (no
         record, no measured force)."""
         n = max(1, math.ceil(rest_s / REST_STEP_S - 1e-9))
-        steps = np.diff(t_s, prepend=t_s[0] - (t_s[1] - t_s[0]))
         return Replay(np.concatenate([self.e, np.zeros(n), e_m]),
-                      np.concatenate([self.dts, np.full(n, rest_s / n), steps]),
+                      np.concatenate([self.dts, np.full(n, rest_s / n), sample_steps(t_s)]),
                       np.concatenate([self.record, np.full(n + len(t_s), -1)]),
                       np.concatenate([self.measured, np.zeros(n + len(t_s))]), self.names, self.scale)
 

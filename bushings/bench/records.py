@@ -52,6 +52,12 @@ def read_bench_csv(path: str | Path) -> BenchRecord:
     return BenchRecord(source=Path(path).name, t=cols["t_s"], e=cols["e_mm"] * MM, F=cols["F_N"])
 
 
+def sample_steps(t: np.ndarray) -> np.ndarray:
+    """The step [s] before each sample of times ``t`` [s]: the first sample reached in one step of
+    the record's first interval."""
+    return np.diff(t, prepend=t[0] - (t[1] - t[0]))
+
+
 def simulate_record(channels: Sequence[ChannelParams], t: np.ndarray, e: np.ndarray) -> np.ndarray:
     """Forces (T, M) of M channels driven through the deflections e (T,) [m] at times t (T,) [s].
 
@@ -59,7 +65,7 @@ def simulate_record(channels: Sequence[ChannelParams], t: np.ndarray, e: np.ndar
     the record's first interval. The time base may be non-uniform (e.g. a subsampled record).
     """
     bank = BushingBank(channels)
-    dts = np.diff(t, prepend=t[0] - (t[1] - t[0]))
+    dts = sample_steps(t)
     out = np.empty((len(t), bank.size))
     row = np.empty(bank.size)
     for i in range(len(t)):
