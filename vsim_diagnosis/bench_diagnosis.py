@@ -229,9 +229,12 @@ class _Objective:
             self.cache = {key: self.residuals(z[None])[0]}
         return self.cache[key]
 
-    def jac(self, z: np.ndarray) -> np.ndarray:
+    def jac(self, z: np.ndarray, hi: np.ndarray) -> np.ndarray:
+        """Forward differences, backward where a step forward would pass the upper bound ``hi`` (a
+        sided parameter's bound at zero: its effect switches sides beyond)."""
         r0 = self.fun(z)
         h = 1e-3 * np.maximum(1.0, np.abs(z))
+        h = np.where(z + h > hi, -h, h)
         r = self.residuals(z + np.diag(h))
         return ((r - r0) / h[:, None]).T
 
@@ -276,22 +279,44 @@ def _sides(cause: Cause, values: dict[str, float]) -> np.ndarray:
     return _points(axes)
 
 
+def _sides_apart(cause: Cause, grid: np.ndarray) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """(which points of ``grid``, lower and upper fit bounds) for each side of the sided parameters
+    the points take, zero the bound between the sides. A sided parameter's effect switches sides at
+    zero, a cusp in the cost that a least-squares fit cannot cross, or crosses into the wrong basin
+    (an asymmetry's kink fitted on one side and its progressive part on the other): each side is
+    fitted within its own bounds."""
+    lo, hi = _coordinates(cause)
+    sided = np.array([p.sided for p in cause.parameters])
+    keys = np.where(sided, grid >= 0.0, True)
+    return [((keys == key).all(axis=1), np.where(sided & key, 0.0, lo), np.where(sided & ~key, 0.0, hi))
+            for key in np.unique(keys, axis=0)]
+
+
 def fit_cause(replay: Replay, base: ParameterSet, cause: Cause, train: np.ndarray,
               start: dict[str, float] | None = None, max_nfev: int = 15, corners: bool = False
               ) -> tuple[dict[str, float], dict[str, float]]:
     """Least-squares fit of a cause's parameters on the training records, from ``start``, or from the
     best of a few starting points: the corners of the realistic range (no ``start``), or, with
-    ``corners``, those and ``start`` with every sided parameter on either side; returns the values
-    and their standard uncertainties (linearised, from the Jacobian and the residual variance)."""
+    ``corners``, those and ``start`` with every sided parameter on either side; each side of the sided
+    parameters fitted from its best point within its bounds (:func:`_sides_apart`), the best kept
+    (from a ``start``, only its side and the best point's: a pair's causes fitted alone chose theirs);
+    returns the values and their standard uncertainties (linearised, from the Jacobian and the
+    residual variance)."""
     obj = _Objective(replay, base, cause, train)
     if start is None:
         grid = _grid(cause)
     else:
         grid = np.vstack([_sides(cause, start), _grid(cause)]) if corners else _to_fit(cause, start)[None]
-    z0 = grid[int(np.argmin((obj.residuals(grid) ** 2).sum(axis=1)))] if len(grid) > 1 else grid[0]
-    lo, hi = _coordinates(cause)
-    sol = least_squares(obj.fun, np.clip(z0, lo + 1e-9, hi - 1e-9), jac=obj.jac, bounds=(lo, hi),
-                        x_scale=1.0, max_nfev=max_nfev, method="trf", ftol=1e-6, xtol=1e-6)
+    costs = (obj.residuals(grid) ** 2).sum(axis=1) if len(grid) > 1 else np.zeros(1)
+    sides = _sides_apart(cause, grid)
+    if start is not None:   # only the side of the start (the row 0) and the best point's
+        sides = [side for side in sides if side[0][[0, int(np.argmin(costs))]].any()]
+    sol = None
+    for on, lo, hi in sides:
+        z0 = grid[on][int(np.argmin(costs[on]))]
+        side = least_squares(obj.fun, np.clip(z0, lo + 1e-9, hi - 1e-9), jac=lambda z, hi=hi: obj.jac(z, hi),
+                             bounds=(lo, hi), x_scale=1.0, max_nfev=max_nfev, method="trf", ftol=1e-6, xtol=1e-6)
+        sol = side if sol is None or side.cost < sol.cost else sol
     J = sol.jac
     dof = max(int((obj.w > 0).sum()) - len(sol.x), 1)
     # Residual variance, inflated for the residuals' correlation from sample to sample (a smooth
