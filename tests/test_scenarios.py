@@ -254,3 +254,20 @@ def test_missing_csv_names_the_scenario_key(tmp_path: Path) -> None:
     path = write(tmp_path, "type: csv\ncases:\n  - path: gone.csv\n")
     with pytest.raises(InputError, match=rf"^{path}:3: cases\[0\].path: no such CSV file"):
         load_scenario(path)
+
+
+def test_a_step_experiments_control_is_the_same_input_without_its_last_step() -> None:
+    """Case.without_last_step: a double rack step's control holds the first level through the second
+    hold (identical before the second ramp); a single step's control stays at rest; a sine has no step."""
+    double = load_scenario("double_rack_step_same").cases[0]
+    control = double.without_last_step()
+    t = np.linspace(0.0, double.duration_s, 2001)
+    first = double.parameters["first_mm"] * 1e-3
+    before_second = t <= double.waveform.times_s[2]
+    assert np.array_equal(control.inputs(t)[before_second], double.inputs(t)[before_second])
+    rack = control.inputs(t)[:, INPUT_CHANNELS.index("rack")]
+    assert np.allclose(rack[~before_second], first) and control.duration_s == double.duration_s
+    single = load_scenario("rack_step").cases[0].without_last_step()
+    assert not np.any(single.inputs(t))
+    with pytest.raises(ValueError, match="no last ramp"):
+        load_scenario("pumping").cases[0].without_last_step()

@@ -5,7 +5,8 @@ causes, the bushing's deflection following the pumping amplitude, the toe loop u
 carried by the front pivot bushing's lateral direction, and the laws' relaxation on the bench (RT
 more than STVS). After 50 ms rack steps the car's relaxation and the fading memory of two steps
 are not reproduced; what removes them, the corner's ringing working the laws to their relaxed state,
-is held on the bench and on the car, where both appear with steps ramped in 0.5 s."""
+is held on the bench and on the car, where both appear with steps ramped in 0.5 s: a step's own
+relaxation, taken from a control run without it, RT more than STVS as on the bench."""
 
 from __future__ import annotations
 
@@ -91,47 +92,74 @@ def test_the_rear_pivot_bushing_follows_the_pumping_amplitude():
     assert 2.5 <= pp[2] / pp[0] <= 3.3      # 30 mm against 10 mm
 
 
-def test_the_car_relaxes_after_a_smooth_rack_step_not_after_a_ringing_one():
-    """Figs. 4.32–4.39: a 10 mm rack step ramped in 50 ms rings the steered corner and then the E2
-    front bushing's force hardly moves; ramped in 0.5 s, it rings far less and gives back a share of
-    its step over the hold, as the law does on the bench (1.4 % measured against 0.002 %)."""
-    rack = parse_scenario(f"name: rack\ntype: rack_step\nvehicle: {DEFAULT_VEHICLE}\nbushings: stvs\n"
-                          "output_rate_hz: 200\nsettle: {before_bushings_s: 1.0, before_input_s: 1.0}\n"
-                          "cases: [{rack_mm: 10, rise_time_s: 0.05, hold_s: 5.0}, "
-                          "{rack_mm: 10, rise_time_s: 0.5, hold_s: 5.0}]\n", Path("rack.yaml"))
-    run = simulate(rack)
-    given_back, ringing = [], []
-    for c in cases(run):
-        on = case_mask(run, c)
-        t, force = run.t_s[on] - c["input_start_s"], run.signals["e2_front_left_y_force"][on]
-        settled = np.searchsorted(t, c["hold_from_s"] - c["input_start_s"] + 0.5)
-        given_back.append(-(force[-1] - force[settled]) / (force[-1] - force[np.searchsorted(t, 0.0)]))
-        ringing.append(np.ptp(force[np.searchsorted(t, c["hold_from_s"] - c["input_start_s"]):settled]))
-    fast, smooth = given_back
-    assert ringing[1] < 0.3 * ringing[0]
-    assert abs(fast) < 1e-3 and smooth > 0.005
+RACK = ("name: rack\ntype: rack_step\nvehicle: {vehicle}\nbushings: {law}\noutput_rate_hz: 200\n"
+        "settle: {{before_bushings_s: 1.0, before_input_s: 1.0}}\n"
+        "cases: [{{rack_mm: 10, rise_time_s: {rise}, hold_s: 5.0}}]\n")
 
 
-def _creep_after_second_step(way: str) -> float:
-    """E2 front's force change [N] from 0.5 s after a double rack step's second step (every step
-    ramped in 0.5 s, RT on every direction) to the end of its hold."""
-    shipped = load_scenario(f"double_rack_step_{way}")
-    smooth = shipped.text.replace("rise_time_s: 0.05", "rise_time_s: 0.5")
-    assert smooth != shipped.text
-    scenario = replace(parse_scenario(smooth, shipped.path), bushing_model="rt")
+def _after_transient(scenario: Scenario, signals: tuple[str, ...]) -> dict[str, tuple[float, float]]:
+    """Per signal, (its last step's own change from 0.5 s after that step's hold starts to the end,
+    the step's own size by then): the run's less its control's, the same run without the last step
+    (Case.without_last_step: the car settling, an earlier step still relaxing)."""
     run = simulate(scenario)
+    control = simulate(replace(scenario, cases=tuple(c.without_last_step() for c in scenario.cases)))
     (c,) = cases(run)
     on = case_mask(run, c)
-    t, force = run.t_s[on], run.signals["e2_front_left_y_force"][on]
-    return float(force[-1] - force[np.searchsorted(t, c["hold_from_s"] + 0.5)])
+    settled = np.searchsorted(run.t_s[on], c["hold_from_s"] + 0.5)
+    out = {}
+    for s in signals:
+        own = run.signals[s][on] - control.signals[s][on]   # 0 until the last step begins
+        out[s] = (float(own[-1] - own[settled]), float(own[settled]))
+    return out
+
+
+def test_the_car_does_not_relax_after_a_ringing_rack_step():
+    """Figs. 4.32–4.39: a 10 mm rack step ramped in 50 ms rings the steered corner and then the E2
+    front bushing's force hardly moves (the ringing works the laws to their relaxed state, the car's
+    own settling too); ramped in 0.5 s, it rings far less (and relaxes: the next test)."""
+    moved, ringing = [], []
+    for rise in (0.05, 0.5):
+        run = simulate(parse_scenario(RACK.format(vehicle=DEFAULT_VEHICLE, law="stvs", rise=rise), Path("rack.yaml")))
+        (c,) = cases(run)
+        on = case_mask(run, c)
+        t, force = run.t_s[on], run.signals["e2_front_left_y_force"][on]
+        hold, settled = np.searchsorted(t, c["hold_from_s"]), np.searchsorted(t, c["hold_from_s"] + 0.5)
+        at_rest = run.signals["e2_front_left_y_force"][np.searchsorted(run.t_s, c["input_start_s"])]
+        moved.append((force[-1] - force[settled]) / (force[-1] - at_rest))
+        ringing.append(np.ptp(force[hold:settled]))
+    assert ringing[1] < 0.3 * ringing[0]
+    assert abs(moved[0]) < 1e-3
+
+
+def test_after_a_smooth_rack_step_rt_relaxes_more_than_stvs():
+    """Fig. 4.32 on the car (report: the control): the 0.5 s step's own relaxation, the car's settling
+    taken away, gives back more of the force with RT than with STVS (1.86 % against 1.78 % of a 5.4 N
+    step measured), and its deflection creeps on by some 30 % of its step, far more than the force
+    relaxes: the corner sets the bushing's force, not its deflection."""
+    force, deflection = "e2_front_left_y_force", "e2_front_left_y_deflection"
+    share = {}
+    for law in ("stvs", "rt"):
+        own = _after_transient(parse_scenario(RACK.format(vehicle=DEFAULT_VEHICLE, law=law, rise=0.5),
+                                              Path("rack.yaml")), (force, deflection))
+        share[law] = {s: change / step for s, (change, step) in own.items()}
+    for law in share:
+        assert 0.01 < -share[law][force] < 0.03 and share[law][deflection] > 5.0 * -share[law][force]
+    assert -share["rt"][force] > -share["stvs"][force]
 
 
 def test_two_smooth_rack_steps_show_fading_memory():
-    """Figs. 4.36–4.39 (RT, as the thesis ran them): after a smaller second step the force creeps one
-    way when it goes on the way the first went, the other way when it goes back (+0.046 N and
-    −0.081 N measured): the response depends on the history, and fades."""
-    same, opposite = _creep_after_second_step("same"), _creep_after_second_step("opposite")
-    assert same * opposite < 0.0 and min(abs(same), abs(opposite)) > 0.01
+    """Figs. 4.36–4.39 (RT, as the thesis ran them; every step ramped in 0.5 s): taken apart from the
+    first step's relaxation (the control: the first step alone), a smaller second step relaxes back
+    towards where it started, whichever way it goes (+0.061 N after a step of −2.65 N, −0.065 N after
+    one of +2.71 N measured), while the first step's goes on under it."""
+    force = "e2_front_left_y_force"
+    for way in ("same", "opposite"):
+        shipped = load_scenario(f"double_rack_step_{way}")
+        smooth = shipped.text.replace("rise_time_s: 0.05", "rise_time_s: 0.5")
+        assert smooth != shipped.text
+        change, step = _after_transient(replace(parse_scenario(smooth, shipped.path), bushing_model="rt"),
+                                        (force,))[force]
+        assert 0.01 < -change / step < 0.05 and abs(change) > 0.01
 
 
 def _bench_relaxation(set_name: str, ringing_m: float = 0.0) -> float:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Mapping
 
@@ -104,6 +104,17 @@ class Case:
         """The longest time step [s] that resolves the input: its waveform's, or one step per sample
         of a table."""
         return self.waveform.longest_step_s() if self.table is None else shortest_gap_s(self.table.times_s)
+
+    def without_last_step(self) -> "Case":
+        """The control of a step experiment: this case with its last ramp taken out, the input held
+        at the level before it. What its run does over the last hold (the car settling on bushings
+        switched on shortly before, the earlier steps still relaxing) is what the run with the step
+        does besides the step's own response. ValueError for an input that does not end with a ramp
+        and a hold."""
+        w = self.waveform
+        if w is None or w.sines or len(w.values) < 3 or w.values[-1] != w.values[-2] or w.values[-2] == w.values[-3]:
+            raise ValueError(f"case {self.label!r}: its input does not end with a step held, no last ramp to take out")
+        return replace(self, waveform=replace(w, values=(*w.values[:-2], w.values[-3], w.values[-3])))
 
     def inputs(self, t_s: np.ndarray) -> np.ndarray:
         """Rig inputs (len(t_s), len(INPUT_CHANNELS)) at times since the input start [s], SI."""
