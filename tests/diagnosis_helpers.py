@@ -65,7 +65,7 @@ def hidden_truth(cause: str, seed: int) -> tuple[str, list[dict]]:
     ``none`` hides nothing; an OUTSIDE effect (e.g. backlash) or another form of a catalogued effect
     (truth_forms.FORMS) is drawn in its range likewise."""
     rng = np.random.default_rng([seed, sum(map(ord, cause))])
-    baseline = BASELINES.get(cause, DEFAULT_BASELINE)
+    baseline = BASELINES.get(FORMS[cause].family if cause in FORMS else cause, DEFAULT_BASELINE)
     if cause == "none":
         return baseline, []
     if cause in OUTSIDE:

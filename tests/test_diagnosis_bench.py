@@ -204,6 +204,20 @@ def test_mullins_recovery_is_the_power_of_its_shape(shape):
     np.testing.assert_allclose(tangent[1:-1], np.gradient(soft, e_back)[1:-1], rtol=5e-3)
 
 
+def test_a_parallel_dashpot_dissipates_pi_c_omega_a_squared_a_cycle():
+    """truth_forms' viscous_parallel: over a sine of amplitude A at ω the dashpot c adds a loop of
+    area π·c·ω·A² (the Kelvin–Voigt element's closed form), and no force at rest."""
+    c_mm, amplitude, omega = 0.7, 1.5e-3, 2.0 * np.pi * 3.0
+    dt = 2.0 * np.pi / omega / 4000
+    t = np.arange(0.0, 2.0 * np.pi / omega + dt / 2, dt)
+    x = amplitude * np.sin(omega * t)
+    force = FORMS["viscous_parallel"].change(x, np.zeros_like(x), 5e5, {"dashpot": c_mm}, {}, dt)
+    area = float(np.sum(0.5 * (force[1:] + force[:-1]) * np.diff(x)))
+    assert area == pytest.approx(np.pi * c_mm * 1e3 * omega * amplitude ** 2, rel=1e-3)
+    held = FORMS["viscous_parallel"].change(np.full(10, amplitude), np.ones(10), 5e5, {"dashpot": c_mm}, {}, dt)
+    assert np.array_equal(held, np.ones(10))
+
+
 def _named_as_family(result: dict, form: str) -> str:
     """AssertionError unless a drawn ``form`` is named as its family, or reported alike with the
     cause named ("reported alike"); a cause named over a rival that the held-out tests preferred was

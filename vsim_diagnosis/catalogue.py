@@ -95,7 +95,7 @@ def _add(mapping: dict[str, Any], key: str, value: float) -> dict[str, Any]:
 
 
 def _viscosity(params: dict, effects: dict, v: Mapping[str, float]) -> tuple[dict, dict]:
-    return {**params, "Co": v["Co"], "pw": v["pw"]}, effects
+    return {**params, "Co": v["Co"], "pw": v["pw"], "C": params.get("C", 0.0) + v.get("C", 0.0)}, effects
 
 
 def _friction(params: dict, effects: dict, v: Mapping[str, float]) -> tuple[dict, dict]:
@@ -132,13 +132,18 @@ def _heating(params: dict, effects: dict, v: Mapping[str, float]) -> tuple[dict,
 
 
 CAUSES: dict[str, Cause] = {c.id: c for c in (
+    # a family (issue 29): the rubber's rate dependence coupled to its hysteresis (the thesis's
+    # dampers in the ladder) and a linear dashpot in parallel with the whole law (the Kelvin-Voigt
+    # element, the damping C of the curve-based bushings of Adams/Car and Chrono::Vehicle)
     Cause("viscoelasticity_missing",
           "rate-dependent damping coupled to hysteresis: a power-law damper Co·|v|^pw at every ladder node "
-          "(STS -> STVS)",
+          "(STS -> STVS), and a linear dashpot C in parallel with the law",
           "loop width and slope grow with loading speed; force relaxes after a step",
           (Parameter("Co", "N/(mm/s)^pw", (0.1, 300.0), (15.0, 40.0), log=True,
                      description="damper coefficient at every ladder node"),
-           Parameter("pw", "-", (0.03, 1.0), (0.1, 0.3), description="damper exponent")),
+           Parameter("pw", "-", (0.03, 1.0), (0.1, 0.3), description="damper exponent"),
+           Parameter("C", "N·s/mm", (0.0, 10.0), (0.0, 1.0), default=0.0,
+                     description="linear dashpot in parallel with the whole law")),
           lambda b: _ladder(b) and b.values.get("Co", 0.0) == 0.0, _viscosity),
     Cause("viscoelasticity_excess",
           "the part is less viscous and more hysteretic than an RT-like law: slider threshold Ff added at every "

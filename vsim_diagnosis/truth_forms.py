@@ -1,8 +1,8 @@
 """Other forms of catalogued effects, that the virtual bench can hide (issue 29): each written here
 apart from the catalogue's families (``bushings.extended_bank``), as a change of the measured part's
 force along its deflection history, so that a test of "another form" cannot pass by fitting the
-very formula that made the data. The diagnosis fits none of them but the first, which is the
-asymmetry family's power 2 (written apart all the same).
+very formula that made the data. The diagnosis fits none of them but the first and the last, the
+asymmetry family's power 2 and the viscous family's dashpot alone (written apart all the same).
 
 * ``asymmetry_cubic``: one side stiffens as the square of the deflection (a bushing whose rubber
   reaches a stop gradually), F += |c|·K0·x³/3 on that side;
@@ -11,7 +11,9 @@ asymmetry family's power 2 (written apart all the same).
 * ``asymmetry_smooth_kink``: one side stiffer from about zero deflection, the step in tangent
   smoothed over a width w (a voided bushing closing its voids), tangent += |s|·K0·σ(∓x/w);
 * ``mullins_ogden``: Ogden–Roxburgh (1999) softening, η = 1 − erf((W_max − W)/(β·W_max))/r with
-  the elastic energy W ∝ x² and its largest value so far W_max.
+  the elastic energy W ∝ x² and its largest value so far W_max;
+* ``viscous_parallel``: a linear dashpot in parallel with the whole law and no damper in the ladder
+  (the Kelvin–Voigt element, the simplest viscoelastic solid), F += c·dx/dt.
 
 Signs as the catalogue's: a positive c or s stiffens compression (x < 0).
 """
@@ -25,7 +27,7 @@ from typing import Callable, Mapping
 import numpy as np
 from scipy.special import erf
 
-from vsim_core.units import MM
+from vsim_core.units import MM, MM_PER_M
 from vsim_diagnosis.catalogue import Parameter
 
 
@@ -38,8 +40,9 @@ class Form:
     family: str
     physics: str
     parameters: tuple[Parameter, ...]
-    #: (deflections [m], law's forces [N], K0 [N/m], values, state kept from test to test) -> forces [N]
-    change: Callable[[np.ndarray, np.ndarray, float, Mapping[str, float], dict], np.ndarray]
+    #: (deflections [m] every dt_s, law's forces [N], K0 [N/m], values, state kept from test to test,
+    #: dt_s [s]) -> forces [N]
+    change: Callable[[np.ndarray, np.ndarray, float, Mapping[str, float], dict, float], np.ndarray]
 
 
 def _stiff_side(x: np.ndarray, sign: float) -> np.ndarray:
@@ -47,19 +50,19 @@ def _stiff_side(x: np.ndarray, sign: float) -> np.ndarray:
     return -x if sign > 0.0 else x
 
 
-def _cubic(x, force, k0, v, state):
+def _cubic(x, force, k0, v, state, dt_s):
     c = v["asymmetry_cubic"] / MM ** 2
     side = _stiff_side(x, c)
     return force - c * k0 * np.where(side > 0.0, side, 0.0) ** 3 / 3.0   # c > 0: more compressive force
 
 
-def _exponential(x, force, k0, v, state):
+def _exponential(x, force, k0, v, state, dt_s):
     s, w = v["asymmetry_exp"], v["exp_length_mm"] * MM
     u = np.maximum(_stiff_side(x, s), 0.0)
     return force - s * k0 * w * (np.expm1(u / w) - u / w)
 
 
-def _smooth_kink(x, force, k0, v, state):
+def _smooth_kink(x, force, k0, v, state, dt_s):
     s, w = v["asymmetry_kink"], v["kink_width_mm"] * MM
     side = _stiff_side(x, s)
     # ∫ σ(u/w) du from 0 to side: w·(softplus(side/w) − ln 2), taken stably for large |side|/w
@@ -67,13 +70,18 @@ def _smooth_kink(x, force, k0, v, state):
     return force - s * k0 * grown
 
 
-def _ogden(x, force, k0, v, state):
+def _ogden(x, force, k0, v, state, dt_s):
     r, beta = v["ogden_r"], v["ogden_beta"]
     energy = x ** 2
     peak = np.maximum.accumulate(np.maximum(energy, state.get("peak", 0.0)))
     state["peak"] = float(peak[-1]) if len(peak) else state.get("peak", 0.0)
     eta = 1.0 - erf(np.divide(peak - energy, beta * peak, out=np.zeros_like(energy), where=peak > 0.0)) / r
     return force * eta
+
+
+
+def _viscous(x, force, k0, v, state, dt_s):
+    return force + v["dashpot"] * MM_PER_M * np.gradient(x, dt_s) if len(x) > 1 else force
 
 
 FORMS: dict[str, Form] = {f.id: f for f in (
@@ -95,4 +103,7 @@ FORMS: dict[str, Form] = {f.id: f for f in (
          (Parameter("ogden_r", "-", (1.0, 100.0), (3.0, 8.0), description="1/r: the largest softening fraction"),
           Parameter("ogden_beta", "-", (0.05, 10.0), (0.5, 1.5), description="width of the recovery, in W_max")),
          _ogden),
+    Form("viscous_parallel", "viscoelasticity_missing", "a linear dashpot in parallel with the whole law",
+         (Parameter("dashpot", "N·s/mm", (0.01, 10.0), (0.3, 1.0), log=True, description="damping coefficient"),),
+         _viscous),
 )}
