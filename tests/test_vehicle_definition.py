@@ -49,6 +49,7 @@ def _write(tmp_path: Path, edit) -> Path:
     (lambda d: d["bushings"][0]["directions"].update(rx={"set": "fig5_9"}), "bushings[0].directions.rx", "rotation"),
     (lambda d: d["bushings"][1]["directions"]["x"].update(model="magic"), "bushings[1].directions.x", "magic"),
     (lambda d: d["front"]["damper"].update(curve=[[1, 0], [0, 1]]), "front.damper.curve", "increasing"),
+    (lambda d: d["rear"].update(beam_bending_stiffness=-5e4), "rear.beam_bending_stiffness", "positive"),
     # inline parameters short of their own model's: an error, not the family set (which recursed)
     (lambda d: d["bushings"][0]["directions"].update(y={"model": "stvs", "params": {"K0": 500}}),
      "bushings[0].directions.y", "missing parameter"),

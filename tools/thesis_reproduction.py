@@ -28,7 +28,7 @@ from vehicle.model.file_overrides import lossier_places, vehicle_with  # noqa: E
 from vehicle.model.definition import DirectionDef  # noqa: E402
 from vehicle.model.vehicle_file import load_vehicle  # noqa: E402
 from vehicle.scenarios.scenario_file import load_scenario, parse_scenario  # noqa: E402
-from vsim_analysis.run_metrics import case_loop, case_mask, case_relaxation, cases  # noqa: E402
+from vsim_analysis.run_metrics import case_loop, case_mask, case_relaxation, cases, lag_behind_s  # noqa: E402
 from vsim_cluster.executor import executor  # noqa: E402
 from vsim_core.shipped import DEFAULT_VEHICLE  # noqa: E402
 from vsim_recordings.recorder import simulate  # noqa: E402
@@ -46,6 +46,9 @@ SOFTER = 0.9
 SETTLED_S = 0.5
 #: The slower ramp of the rack-step experiment [s].
 SLOW_RISE_S = 0.5
+#: The rear beam's bending stiffness of the fig. 4.30 experiment [N·m/rad] (EI/L of a 1.2 m cross
+#: member, EI ≈ 6e4 N·m²: an assumption).
+BEAM_BENDING_NM_PER_RAD = 5e4
 #: The shares of a rack step at which the toe's lag behind the rack is measured.
 LAG_AT = (0.1, 0.5, 0.9)
 #: Where a lossier law keeps its |K*| (bushings.frequency.lossier): amplitude [m] and frequency [Hz]
@@ -81,6 +84,15 @@ def _loss(direction: str, lossier_law: bool) -> tuple[float, float]:
     return float(k.imag / k.real), float(abs(k) / 1e3)
 
 
+def _bending_beam(text: str) -> str:
+    """The default car's file with its twist beam bending at :data:`BEAM_BENDING_NM_PER_RAD` (the file
+    leaves the key out: the beam rigid in bending)."""
+    anchor = "\n  beam_torsion_scale:"
+    if anchor not in text or "beam_bending_stiffness" in text:
+        raise RuntimeError(f"{DEFAULT_VEHICLE}: no rear 'beam_torsion_scale' line to put the beam's bending before")
+    return text.replace(anchor, f"\n  beam_bending_stiffness: {BEAM_BENDING_NM_PER_RAD}{anchor}", 1)
+
+
 def _run(job: tuple[str, str, str | None, tuple]) -> tuple[str, dict]:
     """One experiment: (label, scenario, bushing model or None for the file's, vehicle values) →
     (label, the numbers and traces the report reads). A label ending in ``_slow`` ramps its rack
@@ -96,7 +108,8 @@ def _run(job: tuple[str, str, str | None, tuple]) -> tuple[str, dict]:
         scenario = replace(scenario, output_rate_hz=1000.0)
     if model is not None:   # "file": the vehicle file's own laws, whatever the scenario says
         scenario = replace(scenario, bushing_model=None if model == "file" else model)
-    vehicle = vehicle_with(DEFAULT_VEHICLE.read_text(), DEFAULT_VEHICLE, dict(values), label)
+    text = _bending_beam(DEFAULT_VEHICLE.read_text()) if "_bending" in label else DEFAULT_VEHICLE.read_text()
+    vehicle = vehicle_with(text, DEFAULT_VEHICLE, dict(values), label)
     run = simulate(scenario, vehicle)
     steps = scenario.type in ("rack_step", "double_rack_step")
     # a step's own relaxation: the run's change over the hold less its control's, the same run
@@ -114,6 +127,7 @@ def _run(job: tuple[str, str, str | None, tuple]) -> tuple[str, dict]:
                 loop = case_loop(run, c, "pad_height_rr" if y.endswith("rr") else x, y,
                                  "pad_height_rr" if y.endswith("rr") else driver)
                 r[f"{y}_loop_deg"] = None if loop is None else loop.width
+            r["camber_rr_range_deg"] = float(np.ptp(run.signals["camber_rr"][on]))
             z = run.signals["e1_rear_right_z_deflection"][on]
             r["e1_rear_z_pp_mm"] = float(np.ptp(z))
             # how far the test works each front ladder direction: half its peak to peak [mm]
@@ -137,22 +151,14 @@ def _run(job: tuple[str, str, str | None, tuple]) -> tuple[str, dict]:
                 r[f"{s}_step"] = float(y[-1] - r[f"{s}_static"])
                 r[f"{s}_own_step"] = float((y - y0)[settled])   # the last step's (0 before it)
                 r[f"{s}_ringing"] = float(np.ptp(y[(t >= hold) & (t < hold + SETTLED_S)]))
-            ramp = (t >= 0.0) & (t <= hold + SETTLED_S)
-            r["toe_lag_ms"] = [1e3 * (_crossing(t[ramp], run.signals["toe_fl"][on][ramp], share)
-                                      - _crossing(t[ramp], run.signals["rack"][on][ramp], share)) for share in LAG_AT]
+            ramp = slice(rest, int(np.searchsorted(run.t_s, c["hold_from_s"] + SETTLED_S)))   # from rest
+            r["toe_lag_ms"] = [1e3 * lag_behind_s(run.t_s[ramp], run.signals["toe_fl"][ramp], run.signals["rack"][ramp],
+                                                  share) for share in LAG_AT]
             keep = t >= -0.5
             r["trace"] = {"t": t[keep][::4].tolist(),
                           **{s: run.signals[s][on][keep][::4].tolist() for s in ("e2_front_left_y_force", "toe_fl")}}
         out[k] = r
     return label, out
-
-
-def _crossing(t: np.ndarray, y: np.ndarray, share: float) -> float:
-    """The time [s] at which ``y`` first reaches ``share`` of its change from its first sample to its
-    last (linear between samples)."""
-    y = (y - y[0]) / (y[-1] - y[0])
-    i = int(np.flatnonzero(y >= share)[0])
-    return float(t[i - 1] + (share - y[i - 1]) / (y[i] - y[i - 1]) * (t[i] - t[i - 1]))
 
 
 def jobs() -> list[tuple[str, str, str | None, tuple]]:
@@ -174,6 +180,8 @@ JOBS = [
     ("speeds_stvs", "pumping_speeds", "stvs", ()),
     ("speeds_rt", "pumping_speeds", "rt", ()),
     ("speeds_stvs_no_dampers", "pumping_speeds", "stvs", tuple(NO_DAMPERS.items())),
+    ("speeds_stvs_bending", "pumping_speeds", "stvs", ()),
+    ("speeds_stvs_bending_no_dampers", "pumping_speeds", "stvs", tuple(NO_DAMPERS.items())),
     ("speeds_sts", "pumping_speeds", "sts", ()),
     ("speeds_sts_no_dampers", "pumping_speeds", "sts", tuple(NO_DAMPERS.items())),
     ("speeds_linear", "pumping_speeds", "linear", ()),
@@ -274,6 +282,9 @@ def report(r: dict, files: dict[str, str]) -> str:
     softer = [100.0 * (w / f - 1.0) for w, f in zip(toe["lateral_softer_e1_front.y"], toe["lateral_file"])]
     roll_rear = [r["roll_stvs"][c]["camber_rr_loop_deg"] for c in sorted(r["roll_stvs"])]
     speeds_rear = [r["speeds_stvs"][c]["camber_rr_loop_deg"] for c in (1, 2, 3)]
+    bent_rear = [r["speeds_stvs_bending"][c]["camber_rr_loop_deg"] for c in (1, 2, 3)]
+    bent_rear_free = [r["speeds_stvs_bending_no_dampers"][c]["camber_rr_loop_deg"] for c in (1, 2, 3)]
+    rigid_range, bent_range = (r[label][1]["camber_rr_range_deg"] for label in ("speeds_stvs", "speeds_stvs_bending"))
     lines = [
         "# The thesis's vehicle-level phenomena, reproduced",
         "",
@@ -349,7 +360,19 @@ def report(r: dict, files: dict[str, str]) -> str:
         "camber relative to the body beyond the kinematics. In roll, where the beam twists, the rear camber "
         "loop is " + ", ".join(_fmt(v, 5) for v in roll_rear) + " deg over the roll amplitudes: the rear "
         "bushings do make a loop once the beam lets the arms move apart. A rear camber loop in pumping needs "
-        "what this model lacks, a beam (or arms) that bends, as a flexible twist beam in Adams would.",
+        "a beam that bends, as a flexible twist beam in Adams would. The experiment: the same car with its "
+        f"beam bending about x at {BEAM_BENDING_NM_PER_RAD / 1e3:.0f} kN·m/rad (`rear.beam_bending_stiffness`; "
+        "EI/L of a 1.2 m cross member of EI ≈ 6·10⁴ N·m², an assumption: the thesis gives no figure) "
+        "cambers the rear wheels by " + _fmt(bent_range, 3) + " deg over the pumping (against "
+        + _fmt(rigid_range, 3) + " rigid), and its camber loop [deg] is "
+        + ", ".join(_fmt(v, 5) for v in bent_rear) + " at the three speeds ("
+        + ", ".join(_fmt(v, 5) for v in bent_rear_free) + " without dampers): "
+        + ("**with a bending beam the rear loop changes with the speed, as in the thesis**"
+           + (", thinning as the speed rises as the front loop does (the dampers' loop against the bushings')"
+              if bent_rear[2] < bent_rear[0] < bent_rear_free[0] else "")
+           + "; the default car keeps its beam rigid, having no measured bending stiffness to give it."
+           if max(bent_rear) > 1.2 * min(bent_rear) and min(bent_rear) > 20 * max(speeds_rear) else
+           "even with a bending beam the rear loop hardly changes with the speed."),
         "",
         "## Fig. 4.31 — toe against lateral force, two bushings of different loss",
         "",

@@ -157,6 +157,19 @@ def case_relaxation(run: Run, case: Mapping[str, Any], name: str) -> float | Non
     return relaxation_amplitude(run.t_s[mask], run.signals[name][mask], hold)
 
 
+def _crossing_s(t_s: np.ndarray, y: np.ndarray, share: float) -> float:
+    y = (y - y[0]) / (y[-1] - y[0])
+    i = int(np.flatnonzero(y >= share)[0])
+    return float(t_s[i - 1] + (share - y[i - 1]) / (y[i] - y[i - 1]) * (t_s[i] - t_s[i - 1]))
+
+
+def lag_behind_s(t_s: np.ndarray, follower: np.ndarray, leader: np.ndarray, share: float) -> float:
+    """How long after ``leader`` the ``follower`` first reaches ``share`` (0–1) of its change from its
+    first sample to its last [s], each linear between samples: a response's lag behind its input
+    (the toe behind a rack step, thesis fig. 4.35). The samples must start before both move."""
+    return _crossing_s(t_s, follower, share) - _crossing_s(t_s, leader, share)
+
+
 def sine_frequency_hz(run: Run, case: Mapping[str, Any]) -> float | None:
     """Frequency of ``case``'s input as played [Hz] if it is a single sine, else None."""
     parameters = case["parameters"]

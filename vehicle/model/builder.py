@@ -326,13 +326,17 @@ class _Builder:
         self.wheel(hub, f"rear_{side}", wc, r.static_toe, r.static_camber, sign)
 
     def beam(self):
-        """The cross beam's torsion: a hinge about the beam axis between the two arms."""
+        """The cross beam's torsion: a hinge about the beam axis between the two arms; and, if the
+        beam bends, a hinge about the car's x axis with its bending stiffness."""
         r = self.v.rear
         centre = np.array(r.hardpoints["beam_centre"])
         # the middle of the beam, taken from the arms' masses: its inertia stiffens the weld in rotation
         self.body("arm_left", "beam_centre", centre, np.eye(3), 2 * BEAM_CENTRE_MASS, centre, [0.25, 0.01, 0.25])
         j = self.bodies["beam_centre"].add_joint(name="beam_torsion", type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 1, 0])
         j.stiffness = [r.beam_torsion, 0.0, 0.0]
+        if r.beam_bending_stiffness is not None:
+            j = self.bodies["beam_centre"].add_joint(name="beam_bending", type=mujoco.mjtJoint.mjJNT_HINGE, axis=[1, 0, 0])
+            j.stiffness = [r.beam_bending_stiffness, 0.0, 0.0]
         self.closure("beam_weld", mujoco.mjtEq.mjEQ_WELD, "beam_centre", "arm_right")
 
     def anti_roll_bar(self):

@@ -243,6 +243,9 @@ class RearAxle:
     spring: Spring
     damper: Damper
     beam_torsion_scale: float = 1.0      #: factor on beam_torsional_stiffness (an error of the beam's design value)
+    #: [N·m/rad] of relative arm rotation about the car's x axis at the beam centre: the beam bending in
+    #: the vertical plane, which cambers both wheels alike in parallel bump; None: rigid in bending
+    beam_bending_stiffness: float | None = None
 
     @property
     def beam_torsion(self) -> float:

@@ -72,7 +72,7 @@ def parse_vehicle(text: str, path: Path, source: str | None = None) -> VehicleDe
             "rack_travel_per_rev", positive=True, at_most=MAX_RACK_TRAVEL_M, unit="m"),
         strut_friction=_per_side(f, "strut_friction", 0.0))
     rr = top.fields("rear", ("hardpoints", "static_toe", "static_camber", "masses", "beam_torsional_stiffness",
-                             "beam_torsion_scale", "spring", "damper"))
+                             "beam_torsion_scale", "beam_bending_stiffness", "spring", "damper"))
     rear = RearAxle(
         hardpoints=_points(rr.fields("hardpoints", REAR_POINTS), REAR_POINTS),
         static_toe=_angle(rr, "static_toe", MAX_TOE_DEG), static_camber=_angle(rr, "static_camber", MAX_CAMBER_DEG),
@@ -81,7 +81,9 @@ def parse_vehicle(text: str, path: Path, source: str | None = None) -> VehicleDe
                                            unit="N·m/rad"),
         spring=_spring(rr.fields("spring", ("rate", "curve", "preload"))),
         damper=Damper(_curve(rr.fields("damper", ("curve",)), "curve")),
-        beam_torsion_scale=rr.number("beam_torsion_scale", 1.0, positive=True, at_most=MAX_SCALE))
+        beam_torsion_scale=rr.number("beam_torsion_scale", 1.0, positive=True, at_most=MAX_SCALE),
+        beam_bending_stiffness=rr.number("beam_bending_stiffness", positive=True, at_most=MAX_TORSION_NM_PER_RAD,
+                                         unit="N·m/rad") if rr.has("beam_bending_stiffness") else None)
 
     points = {f"front.{k}": np.array(v) for k, v in front.hardpoints.items()}
     points |= {f"rear.{k}": np.array(v) for k, v in rear.hardpoints.items()}
