@@ -147,18 +147,18 @@ def test_the_car_does_not_relax_after_a_ringing_rack_step():
     """Figs. 4.32–4.39: a 10 mm rack step ramped in 50 ms rings the steered corner and then the E2
     front bushing's force hardly moves (the ringing works the laws to their relaxed state, the car's
     own settling too); ramped in 0.5 s, it rings far less (and relaxes: the next test)."""
-    moved, ringing = [], []
+    ringing = []
     for rise in (0.05, 0.5):
         run = simulate(parse_scenario(RACK.format(vehicle=DEFAULT_VEHICLE, law="stvs", rise=rise), Path("rack.yaml")))
         (c,) = cases(run)
         on = case_mask(run, c)
         t, force = run.t_s[on], run.signals["e2_front_left_y_force"][on]
         hold, settled = np.searchsorted(t, c["hold_from_s"]), np.searchsorted(t, c["hold_from_s"] + 0.5)
-        at_rest = run.signals["e2_front_left_y_force"][np.searchsorted(run.t_s, c["input_start_s"])]
-        moved.append((force[-1] - force[settled]) / (force[-1] - at_rest))
         ringing.append(np.ptp(force[hold:settled]))
+        if rise == 0.05:
+            at_rest = run.signals["e2_front_left_y_force"][np.searchsorted(run.t_s, c["input_start_s"])]
+            assert abs(force[-1] - force[settled]) < 1e-3 * abs(force[-1] - at_rest)
     assert ringing[1] < 0.3 * ringing[0]
-    assert abs(moved[0]) < 1e-3
 
 
 def test_after_a_smooth_rack_step_rt_relaxes_more_than_stvs():
@@ -179,8 +179,8 @@ def test_after_a_smooth_rack_step_rt_relaxes_more_than_stvs():
 
 def test_the_toe_lags_the_rack_more_with_viscoelastic_bushings():
     """Fig. 4.35: after a 50 ms rack ramp the toe reaches half its step a few milliseconds after the
-    rack (the corner's inertia and compliant joints; 2.1 ms with linear bushings measured), later with
-    STVS on every direction (3.6 ms)."""
+    rack (the corner's inertia and compliant joints; 2.6 ms with linear bushings measured), later with
+    STVS on every direction (4.1 ms)."""
     lag = {}
     for law in ("linear", "stvs"):
         scenario = parse_scenario(RACK.format(vehicle=DEFAULT_VEHICLE, law=law, rise=0.05), Path("rack.yaml"))
@@ -198,11 +198,11 @@ def test_the_rt_camber_loop_is_thicker_than_the_stvs_one_at_low_speed():
     assert 1.0 < rt[0] / stvs[0] < 1.2
 
 
-def test_two_smooth_rack_steps_show_fading_memory():
-    """Figs. 4.36–4.39 (RT, as the thesis ran them; every step ramped in 0.5 s): taken apart from the
-    first step's relaxation (the control: the first step alone), a smaller second step relaxes back
-    towards where it started, whichever way it goes (+0.061 N after a step of −2.65 N, −0.065 N after
-    one of +2.71 N measured), while the first step's goes on under it."""
+def test_a_second_smooth_rack_step_relaxes_back_whichever_way_it_goes():
+    """Figs. 4.36–4.39 (RT, as the thesis ran them; every step ramped in 0.5 s): taken apart from what
+    goes on from before it (the control: the first step alone, the car settling too), a smaller second
+    step relaxes back towards where it started, whichever way it goes (+0.061 N after a step of
+    −2.65 N, −0.065 N after one of +2.71 N measured)."""
     force = "e2_front_left_y_force"
     for way in ("same", "opposite"):
         shipped = load_scenario(f"double_rack_step_{way}")

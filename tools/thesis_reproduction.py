@@ -88,7 +88,9 @@ def _bending_beam(text: str) -> str:
     """The default car's file with its twist beam bending at :data:`BEAM_BENDING_NM_PER_RAD` (the file
     leaves the key out: the beam rigid in bending)."""
     anchor = "\n  beam_torsion_scale:"
-    if anchor not in text or "beam_bending_stiffness" in text:
+    if "beam_bending_stiffness" in text:
+        raise RuntimeError(f"{DEFAULT_VEHICLE}: the file bends its beam already; the experiment needs it rigid")
+    if anchor not in text:
         raise RuntimeError(f"{DEFAULT_VEHICLE}: no rear 'beam_torsion_scale' line to put the beam's bending before")
     return text.replace(anchor, f"\n  beam_bending_stiffness: {BEAM_BENDING_NM_PER_RAD}{anchor}", 1)
 
@@ -111,7 +113,7 @@ def _run(job: tuple[str, str, str | None, tuple]) -> tuple[str, dict]:
     text = _bending_beam(DEFAULT_VEHICLE.read_text()) if "_bending" in label else DEFAULT_VEHICLE.read_text()
     vehicle = vehicle_with(text, DEFAULT_VEHICLE, dict(values), label)
     run = simulate(scenario, vehicle)
-    steps = scenario.type in ("rack_step", "double_rack_step")
+    steps = scenario.type in ("rack_step", "double_rack_step") and not label.startswith("toe_lag")
     # a step's own relaxation: the run's change over the hold less its control's, the same run
     # without the last step (the car settling under its bushings, the first of two steps relaxing)
     control = simulate(replace(scenario, cases=tuple(c.without_last_step() for c in scenario.cases)),
@@ -135,6 +137,11 @@ def _run(job: tuple[str, str, str | None, tuple]) -> tuple[str, dict]:
                                  for d in FRONT_LADDERS}
             last = case_mask(run, c, last_cycle=True)
             r["trace"] = {s: run.signals[s][last][::5].tolist() for s in (x, "camber_fl", "toe_fl")}
+        elif control is None:   # a toe-lag run: the toe behind the rack, from rest to the transient's end
+            ramp = slice(int(np.searchsorted(run.t_s, c["input_start_s"])),
+                         int(np.searchsorted(run.t_s, c["hold_from_s"] + SETTLED_S)))
+            r["toe_lag_ms"] = [1e3 * lag_behind_s(run.t_s[ramp], run.signals["toe_fl"][ramp],
+                                                  run.signals["rack"][ramp], share) for share in LAG_AT]
         else:
             t = run.t_s[on] - c["input_start_s"]
             hold = c["hold_from_s"] - c["input_start_s"]
@@ -151,9 +158,6 @@ def _run(job: tuple[str, str, str | None, tuple]) -> tuple[str, dict]:
                 r[f"{s}_step"] = float(y[-1] - r[f"{s}_static"])
                 r[f"{s}_own_step"] = float((y - y0)[settled])   # the last step's (0 before it)
                 r[f"{s}_ringing"] = float(np.ptp(y[(t >= hold) & (t < hold + SETTLED_S)]))
-            ramp = slice(rest, int(np.searchsorted(run.t_s, c["hold_from_s"] + SETTLED_S)))   # from rest
-            r["toe_lag_ms"] = [1e3 * lag_behind_s(run.t_s[ramp], run.signals["toe_fl"][ramp], run.signals["rack"][ramp],
-                                                  share) for share in LAG_AT]
             keep = t >= -0.5
             r["trace"] = {"t": t[keep][::4].tolist(),
                           **{s: run.signals[s][on][keep][::4].tolist() for s in ("e2_front_left_y_force", "toe_fl")}}
@@ -436,7 +440,10 @@ def _steps_section(r: dict, files: dict[str, str]) -> list[str]:
     own, dashpots = r["rack_file"][1], r["rack_file_linear_dashpots"][1]
     f, d = "e2_front_left_y_force", "e2_front_left_y_deflection"
     rt_more = _relaxed(slow_rt) > _relaxed(slow)
+    still = abs(rs[f + "_settled_relax"]) < 1e-3 * abs(rs[f + "_step"])   # the 50 ms step: nothing after
     lag = {law: r[f"toe_lag_{law}"][1]["toe_lag_ms"] for law in ("linear", "stvs")}
+    added = [a - b for a, b in zip(lag["stvs"], lag["linear"])]
+    rest_s = load_scenario("rack_step").settle.before_input_s
     double = {(way, law): r[f"double_{way}_{law}_slow"][1] for way in ("same", "opposite") for law in ("stvs", "rt")}
     follows = all(x[f"{f}_settled_own"] * x[f"{f}_own_step"] < 0.0 for x in double.values())
     return [
@@ -452,7 +459,7 @@ def _steps_section(r: dict, files: dict[str, str]) -> list[str]:
         "(50 ms), or to the transient's end, the control's change taken away (smooth ramps); the "
         f"ringing is the peak-to-peak change in the {SETTLED_S} s after the ramp; the changes are taken "
         f"from then (the transient over) to the end of the hold: in the run, in its control (the same run "
-        "without the step: the car settling on bushing laws switched on 1 s before the input), and the "
+        f"without the step: the car settling on bushing laws switched on {rest_s:g} s before the input), and the "
         "step's own (the run's less the control's), in % of the step given back (force) or crept on "
         "(deflection):",
         "",
@@ -469,7 +476,8 @@ def _steps_section(r: dict, files: dict[str, str]) -> list[str]:
           for name, x, smooth in (("STVS, 50 ms", rs, False), ("RT, 50 ms", rr, False),
                                   (f"STVS, {SLOW_RISE_S} s", slow, True), (f"RT, {SLOW_RISE_S} s", slow_rt, True))],
         "",
-        ("**Disagrees with the 50 ms ramp, agrees with a smooth one.** " if rt_more else "**Disagrees.** ")
+        ("**Disagrees with the 50 ms ramp, " if still else "**Agrees with the 50 ms ramp, ")
+        + ("agrees with a smooth one.** " if rt_more else "disagrees with a smooth one.** ")
         + "With the 50 ms ramp, what moves during the hold is the transient: the ramp rings a lightly damped "
         f"mode of the steered corner ({rs[f + '_ringing']:.0f} N peak to peak in the E2 front bushing), and "
         f"once it has died out, {SETTLED_S} s later, the force and the toe hardly move ({rs[f + '_settled_relax']:+.4f} N, "
@@ -496,7 +504,7 @@ def _steps_section(r: dict, files: dict[str, str]) -> list[str]:
         f"with STVS and {slow_rt[f + '_settled_control']:+.3f} N with RT over the same time, so that the run "
         f"alone had RT give back {-100 * slow_rt[f + '_settled_relax'] / slow_rt[f + '_step']:.1f} % of its step "
         f"against STVS's {-100 * slow[f + '_settled_relax'] / slow[f + '_step']:.1f} %. That the deflection creeps "
-        f"{-_relaxed(slow, d) / _relaxed(slow):.0f} times more than the force relaxes (in shares of the step) "
+        f"{abs(_relaxed(slow, d) / _relaxed(slow)):.0f} times more than the force relaxes (in shares of the step) "
         "says how the bushing is loaded: through the corner, its force set by the rack and the wheel's "
         "contact, not held at a deflection as on the bench. Left to find: whether the 50 ms ramp's ringing is right, its damping "
         "against a measured rig (the thesis's response was smoothed, 'filtered by the suspension's structure "
@@ -505,8 +513,10 @@ def _steps_section(r: dict, files: dict[str, str]) -> list[str]:
         f"The toe lags the rack (4.35): sampled at 1 kHz, after the 50 ms ramp it reaches {LAG_AT[0]:.0%}, "
         f"{LAG_AT[1]:.0%} and {LAG_AT[2]:.0%} of its step {_lags(lag['stvs'])} ms after the rack with STVS "
         f"against {_lags(lag['linear'])} ms with linear bushings (the corner's inertia and its compliant "
-        f"joints): **agrees in kind, small in size** — the laws change the lag by "
-        f"{_lags([a - b for a, b in zip(lag['stvs'], lag['linear'])])} ms, and the toe's own change after the smooth step's transient is "
+        f"joints): " + ("**agrees in kind, small in size** — " if added[1] > 0.0 else "**disagrees** — ")
+        + f"the laws change the lag by {_lags(added)} ms"
+        + (" (a delay at half the step, none at its ends)" if added[1] > 0.0 and min(added) <= 0.0 else "")
+        + f", and the toe's own change after the smooth step's transient is "
         f"{slow['toe_fl_settled_own']:+.1e} deg ({100 * abs(slow['toe_fl_settled_own'] / slow['toe_fl_own_step']):.0e} % "
         "of its step): the rack sets the toe through the tie rod, and E2 front's creep of "
         f"{abs(slow[d + '_settled_own']) * 1e3:.1f} µm barely turns the wheel. The thesis's delay, from a figure "
@@ -534,7 +544,7 @@ def _steps_section(r: dict, files: dict[str, str]) -> list[str]:
         "nothing creeps once the second step's transient is over. Fading memory needs that creep; the ringing "
         f"of each step works it off, as above. With every step ramped in {SLOW_RISE_S} s, the force does "
         "creep after the second step; its control here is the first step alone (the same run without the "
-        "second), whose own relaxation goes on through the second hold:",
+        "second), in which the first step's relaxation and the car's settling go on through the second hold:",
         "",
         "| law, second step | second step [N] | after the transient [N] | control: the first step alone [N] | "
         "the second step's own [N] | own [% of its step] |",
@@ -543,12 +553,11 @@ def _steps_section(r: dict, files: dict[str, str]) -> list[str]:
           f"{x[f + '_settled_relax']:+.3f} | {x[f + '_settled_control']:+.3f} | {x[f + '_settled_own']:+.3f} | "
           f"{_relaxed(x):+.1f} |" for (way, law), x in double.items()],
         "",
-        ("**With smooth steps it agrees in kind**: taken apart from the first step's relaxation, the second "
+        ("**With smooth steps it agrees in kind**: taken apart from what goes on from before it, the second "
          "step relaxes towards where it started, either way and with either law (RT, the law the thesis ran "
-         f"these steps with, by {_span(double, 'rt')} of its step, STVS by {_span(double, 'stvs')}), while the "
-         "first step's relaxation goes on under it: the response "
-         "after the second step is the sum of two relaxations of different ages, the older fading, as fading "
-         "memory has it." if follows else
+         f"these steps with, by {_span(double, 'rt')} of its step, STVS by {_span(double, 'stvs')}): what the "
+         "force does after the second step is that relaxation added to what goes on from before it, the "
+         "history the response depends on." if follows else
          "With smooth steps the second step's own creep does not always run back towards where it started."),
         "",
     ]

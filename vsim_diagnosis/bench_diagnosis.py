@@ -37,8 +37,8 @@ from vsim_recordings.bench_dataset import BenchDataset
 #: Penalty per fitted parameter on the held-out error used for ranking.
 PARAMETER_PENALTY = 0.02
 #: Function evaluations of a pair's fit, which starts from its two causes' own fits or the best
-#: corner of their range (less than half a single cause's 15: each evaluation of a 4-parameter pair
-#: costs 5 replays, and the pair stage fits up to 15 pairs).
+#: corner of their range (less than half a single cause's 15: each evaluation of a pair of up to 6
+#: parameters costs up to 7 replays, and the pair stage fits up to 15 pairs).
 PAIR_NFEV = 6
 #: Longest step used to simulate a rest between tests [s].
 REST_STEP_S = 0.05

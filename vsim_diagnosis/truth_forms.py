@@ -1,8 +1,9 @@
 """Other forms of catalogued effects, that the virtual bench can hide (issue 29): each written here
 apart from the catalogue's families (``bushings.extended_bank``), as a change of the measured part's
 force along its deflection history, so that a test of "another form" cannot pass by fitting the
-very formula that made the data. The diagnosis fits none of them but the first and the last, the
-asymmetry family's power 2 and the viscous family's dashpot alone (written apart all the same).
+very formula that made the data. Two of them the diagnosis's families can write (written apart all
+the same): ``asymmetry_cubic``, the asymmetry family's power 2, and ``viscous_parallel``, the
+viscous family's dashpot (the family keeps a little ladder damping, Co ≥ 0.1).
 
 * ``asymmetry_cubic``: one side stiffens as the square of the deflection (a bushing whose rubber
   reaches a stop gradually), F += |c|·K0·x³/3 on that side;
@@ -12,8 +13,8 @@ asymmetry family's power 2 and the viscous family's dashpot alone (written apart
   smoothed over a width w (a voided bushing closing its voids), tangent += |s|·K0·σ(∓x/w);
 * ``mullins_ogden``: Ogden–Roxburgh (1999) softening, η = 1 − erf((W_max − W)/(β·W_max))/r with
   the elastic energy W ∝ x² and its largest value so far W_max;
-* ``viscous_parallel``: a linear dashpot in parallel with the whole law and no damper in the ladder
-  (the Kelvin–Voigt element, the simplest viscoelastic solid), F += c·dx/dt.
+* ``viscous_parallel``: a linear dashpot in parallel with the whole law (the Kelvin–Voigt element,
+  the simplest viscoelastic solid), F += c·dx/dt.
 
 Signs as the catalogue's: a positive c or s stiffens compression (x < 0).
 """
@@ -77,7 +78,6 @@ def _ogden(x, force, k0, v, state, dt_s):
     state["peak"] = float(peak[-1]) if len(peak) else state.get("peak", 0.0)
     eta = 1.0 - erf(np.divide(peak - energy, beta * peak, out=np.zeros_like(energy), where=peak > 0.0)) / r
     return force * eta
-
 
 
 def _viscous(x, force, k0, v, state, dt_s):
