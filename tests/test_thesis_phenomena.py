@@ -22,7 +22,7 @@ from vehicle.scenarios.scenario import Scenario
 from vehicle.scenarios.scenario_file import load_scenario, parse_scenario
 from bushings.bank import BushingBank
 from bushings.parameter_sets import load_parameter_set
-from vsim_analysis.run_metrics import case_loop, case_mask, cases, lag_behind_s
+from vsim_analysis.run_metrics import case_lag_s, case_loop, case_mask, cases
 from vsim_core.shipped import DEFAULT_VEHICLE
 from vsim_recordings.recorder import simulate
 
@@ -130,9 +130,9 @@ RACK = ("name: rack\ntype: rack_step\nvehicle: {vehicle}\nbushings: {law}\noutpu
 def _after_transient(scenario: Scenario, signals: tuple[str, ...]) -> dict[str, tuple[float, float]]:
     """Per signal, (its last step's own change from 0.5 s after that step's hold starts to the end,
     the step's own size by then): the run's less its control's, the same run without the last step
-    (Case.without_last_step: the car settling, an earlier step still relaxing)."""
+    (Scenario.without_last_steps: the car settling, an earlier step still relaxing)."""
     run = simulate(scenario)
-    control = simulate(replace(scenario, cases=tuple(c.without_last_step() for c in scenario.cases)))
+    control = simulate(scenario.without_last_steps())
     (c,) = cases(run)
     on = case_mask(run, c)
     settled = np.searchsorted(run.t_s[on], c["hold_from_s"] + 0.5)
@@ -186,8 +186,7 @@ def test_the_toe_lags_the_rack_more_with_viscoelastic_bushings():
         scenario = parse_scenario(RACK.format(vehicle=DEFAULT_VEHICLE, law=law, rise=0.05), Path("rack.yaml"))
         run = simulate(replace(scenario, output_rate_hz=1000.0))
         (c,) = cases(run)
-        window = slice(np.searchsorted(run.t_s, c["input_start_s"]), np.searchsorted(run.t_s, c["hold_from_s"] + 0.5))
-        lag[law] = lag_behind_s(run.t_s[window], run.signals["toe_fl"][window], run.signals["rack"][window], 0.5)
+        lag[law] = case_lag_s(run, c, "toe_fl", "rack", 0.5, 0.5)
     assert 1e-3 < lag["linear"] < lag["stvs"] - 0.5e-3 and lag["stvs"] < 10e-3
 
 

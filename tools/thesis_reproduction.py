@@ -28,7 +28,7 @@ from vehicle.model.file_overrides import lossier_places, vehicle_with  # noqa: E
 from vehicle.model.definition import DirectionDef  # noqa: E402
 from vehicle.model.vehicle_file import load_vehicle  # noqa: E402
 from vehicle.scenarios.scenario_file import load_scenario, parse_scenario  # noqa: E402
-from vsim_analysis.run_metrics import case_loop, case_mask, case_relaxation, cases, lag_behind_s  # noqa: E402
+from vsim_analysis.run_metrics import case_lag_s, case_loop, case_mask, case_relaxation, cases  # noqa: E402
 from vsim_cluster.executor import executor  # noqa: E402
 from vsim_core.shipped import DEFAULT_VEHICLE  # noqa: E402
 from vsim_recordings.recorder import simulate  # noqa: E402
@@ -116,8 +116,7 @@ def _run(job: tuple[str, str, str | None, tuple]) -> tuple[str, dict]:
     steps = scenario.type in ("rack_step", "double_rack_step") and not label.startswith("toe_lag")
     # a step's own relaxation: the run's change over the hold less its control's, the same run
     # without the last step (the car settling under its bushings, the first of two steps relaxing)
-    control = simulate(replace(scenario, cases=tuple(c.without_last_step() for c in scenario.cases)),
-                       vehicle) if steps else None
+    control = simulate(scenario.without_last_steps(), vehicle) if steps else None
     out: dict = {}
     for c in cases(run):
         k, on = c["case"], case_mask(run, c)
@@ -138,10 +137,7 @@ def _run(job: tuple[str, str, str | None, tuple]) -> tuple[str, dict]:
             last = case_mask(run, c, last_cycle=True)
             r["trace"] = {s: run.signals[s][last][::5].tolist() for s in (x, "camber_fl", "toe_fl")}
         elif control is None:   # a toe-lag run: the toe behind the rack, from rest to the transient's end
-            ramp = slice(int(np.searchsorted(run.t_s, c["input_start_s"])),
-                         int(np.searchsorted(run.t_s, c["hold_from_s"] + SETTLED_S)))
-            r["toe_lag_ms"] = [1e3 * lag_behind_s(run.t_s[ramp], run.signals["toe_fl"][ramp],
-                                                  run.signals["rack"][ramp], share) for share in LAG_AT]
+            r["toe_lag_ms"] = [1e3 * case_lag_s(run, c, "toe_fl", "rack", share, SETTLED_S) for share in LAG_AT]
         else:
             t = run.t_s[on] - c["input_start_s"]
             hold = c["hold_from_s"] - c["input_start_s"]

@@ -163,11 +163,16 @@ def _crossing_s(t_s: np.ndarray, y: np.ndarray, share: float) -> float:
     return float(t_s[i - 1] + (share - y[i - 1]) / (y[i] - y[i - 1]) * (t_s[i] - t_s[i - 1]))
 
 
-def lag_behind_s(t_s: np.ndarray, follower: np.ndarray, leader: np.ndarray, share: float) -> float:
-    """How long after ``leader`` the ``follower`` first reaches ``share`` (0–1) of its change from its
-    first sample to its last [s], each linear between samples: a response's lag behind its input
-    (the toe behind a rack step, thesis fig. 4.35). The samples must start before both move."""
-    return _crossing_s(t_s, follower, share) - _crossing_s(t_s, leader, share)
+def case_lag_s(run: Run, case: Mapping[str, Any], follower: str, leader: str, share: float,
+               after_hold_s: float) -> float:
+    """How long after signal ``leader`` the ``follower`` first reaches ``share`` (0–1) of its change
+    [s], from the last sample at rest before the case's input to ``after_hold_s`` into its hold,
+    each linear between samples: a response's lag behind its input (the toe behind a rack step,
+    thesis fig. 4.35)."""
+    window = slice(int(np.searchsorted(run.t_s, case["input_start_s"])),
+                   int(np.searchsorted(run.t_s, case["hold_from_s"] + after_hold_s)))
+    t = run.t_s[window]
+    return _crossing_s(t, run.signals[follower][window], share) - _crossing_s(t, run.signals[leader][window], share)
 
 
 def sine_frequency_hz(run: Run, case: Mapping[str, Any]) -> float | None:

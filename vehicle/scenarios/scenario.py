@@ -166,3 +166,8 @@ class Scenario:
         kind = self.cases[0].parameters.get("input", self.type) if self.type == "bisine" else self.type
         driven = SIGNAL_TYPES.get(kind)
         return None if driven is None else ("wheel_travel" if driven == "pad_z" else driven)
+
+    def without_last_steps(self) -> "Scenario":
+        """The control of a step experiment: every case without its last step
+        (:meth:`Case.without_last_step`)."""
+        return replace(self, cases=tuple(c.without_last_step() for c in self.cases))
