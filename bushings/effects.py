@@ -7,7 +7,8 @@ Two kinds, both switched on per channel and off by default:
   slider friction on them (:func:`with_friction`), and broad-spectrum relaxation as a Prony series
   fitted to a fractional (power-law) relaxation modulus (:func:`with_broad_relaxation`);
 * state extensions (:class:`Effects`): preload (operating-point shift), tension/compression
-  asymmetry, Mullins softening, self-heating and a backlash dead band, applied around the base law
+  asymmetry, Mullins softening, self-heating, a slipping interface and a backlash dead band, applied
+  around the base law
   by the compiled wrapper of :mod:`bushings.extended_bank`.
 """
 
@@ -28,7 +29,10 @@ class Effects:
     """State extensions of one channel's law (SI: m or rad, N or N·m, J, s); zeros switch them off.
 
     With ``x = e + preload`` (after the backlash dead band) the force is
-    ``η_mullins(x)·η_heat(Q)·(F_base(x) + F_asym(x)) − F_tare``.
+    ``η_mullins(x)·η_heat(Q)·(F_base(x) + F_asym(x)) + F_slip − F_tare``, where F_slip is the force of a
+    Jenkins element (a spring in series with a Coulomb slider, Berg 1998's frictional element) in
+    parallel: an interface of the part that slips (a bonded sleeve, a clamped face). Its force is
+    neither softened by η nor does its dissipation heat the part: it acts at a face, not in the rubber.
     """
 
     preload: float = 0.0          #: operating point of the mounted part on its law [m or rad]
@@ -45,6 +49,8 @@ class Effects:
     #: part stays soft further up; < 1 would make the force's slope infinite at x = 0)
     heating: float = 0.0          #: softening per joule of heat held, κ = β/C_th [1/J]: η = 1/(1 + κQ)
     heating_tau_s: float = 300.0  #: thermal time constant of the heat held Q [s]
+    slip_force: float = 0.0       #: force at which the parallel interface slips [N or N·m]
+    slip_stiffness: float = 1.0   #: the interface's stiffness before it slips, a fraction of K0 [-]
     backlash: float = 0.0         #: half-width of a dead band in series with the part [m or rad]
 
     @property
@@ -54,7 +60,7 @@ class Effects:
 
 
 #: Fields that shape an effect but switch none on.
-_SETTINGS = ("heating_tau_s", "mullins_shape", "asymmetry_power")
+_SETTINGS = ("heating_tau_s", "mullins_shape", "asymmetry_power", "slip_stiffness")
 #: Largest power of an asymmetry's progressive part: a stop's force grows at most as the fourth power
 #: of its deflection; beyond, a typing error (and overflow far from the reference deflection).
 MAX_ASYMMETRY_POWER = 5.0
@@ -71,6 +77,8 @@ EFFECT_KEYS: dict[str, tuple[str, int, str, str, float]] = {
     "mullins_shape": ("mullins_shape", 0, "-", "-", 1.0),
     "heating": ("heating", 0, "1/kJ", "1/kJ", 0.0),
     "heating_tau_s": ("heating_tau_s", 0, "s", "s", 1e-9),
+    "slip_force": ("slip_force", 0, "N", "N·m", 0.0),
+    "slip_stiffness": ("slip_stiffness", 0, "-", "-", 1e-9),
     "backlash": ("backlash", 1, "mm", "deg", 0.0),
 }
 

@@ -16,11 +16,11 @@ from bushings.parameters import LENGTH_UNIT_SI, ChannelParams
 from vsim_core.compiled_cache import follow
 
 # Columns of the effect parameter matrix (one row per channel) and of the effect state.
-(E_PRELOAD, E_ASYM, E_ASYM_POWER, E_ASYM_STEP, E_MULLINS, E_MULLINS_SHAPE, E_HEAT, E_HEAT_TAU, E_BACKLASH,
- E_TARE) = range(10)
-N_ECOLS = 10
-S_XMAX, S_HEAT, S_DISS = range(3)
-N_SCOLS = 3
+(E_PRELOAD, E_ASYM, E_ASYM_POWER, E_ASYM_STEP, E_MULLINS, E_MULLINS_SHAPE, E_HEAT, E_HEAT_TAU, E_SLIP,
+ E_SLIP_K, E_BACKLASH, E_TARE) = range(12)
+N_ECOLS = 12
+S_XMAX, S_HEAT, S_DISS, S_SLIP_F, S_SLIP_X = range(5)
+N_SCOLS = 5
 #: Duration and steps of the quasi-static mounting ramp to the preload deflection.
 MOUNT_S, MOUNT_STEPS = 10.0, 200
 
@@ -79,6 +79,15 @@ def _effects_out(h, e, X, EP, ES, P, diss, F, K, Fout, Kout):
             f *= eta
             k *= eta
         ES[c, S_DISS] = diss[c]
+        fs = EP[c, E_SLIP]
+        if fs > 0.0:
+            # Jenkins element: its spring follows x until its force reaches ±fs, then it slips.
+            ks = EP[c, E_SLIP_K] * P[c, kn.P_K0]
+            trial = ES[c, S_SLIP_F] + ks * (x - ES[c, S_SLIP_X])
+            ES[c, S_SLIP_X] = x
+            ES[c, S_SLIP_F] = min(max(trial, -fs), fs)
+            f += ES[c, S_SLIP_F]
+            k += ks if abs(trial) < fs else 0.0
         b = EP[c, E_BACKLASH]
         if b > 0.0 and abs(e[c]) <= b:
             k = 0.0
@@ -127,7 +136,8 @@ class ExtendedBank:
             # the asymmetry's rate is given at the parameter sets' unit of deflection r: a·r^(1−n) per (m or rad)^n
             rate = fx.asymmetry * LENGTH_UNIT_SI[ch.quantity] ** (1.0 - fx.asymmetry_power)
             self.EP[c, :E_TARE] = (fx.preload, rate, fx.asymmetry_power, fx.asymmetry_step, fx.mullins,
-                                   fx.mullins_shape, fx.heating, fx.heating_tau_s, fx.backlash)
+                                   fx.mullins_shape, fx.heating, fx.heating_tau_s, fx.slip_force,
+                                   fx.slip_stiffness, fx.backlash)
         self.ES = np.zeros((M, N_SCOLS))
         self._X = np.zeros(M)
         self.force = np.zeros(M)

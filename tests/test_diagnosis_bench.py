@@ -23,8 +23,9 @@ from tests.diagnosis_helpers import (MIN_PAIR_SUCCESS_RATE, MIN_SUCCESS_RATE, PA
                                      diagnose_fresh, measure)
 from vsim_diagnosis.bench_alike import REST_BEFORE_S, Programme, extra_programmes, load_cell_noise_n, separations
 from vsim_diagnosis.catalogue import CAUSES, PAIR_SEPARATOR
-from vsim_diagnosis.truth_forms import FORMS
+from vsim_diagnosis.truth_forms import BOX_PER_DECADE, BOX_TAU_MIN_S, FORMS
 from vsim_diagnosis.verdict import pair_shares
+from vsim_diagnosis.virtual_bench import OUTSIDE
 
 BENCH_CAUSES = sorted(CAUSES)
 #: Seeds per cause in the default suite (one, for time: each diagnosis takes 15-60 s); the slow
@@ -211,11 +212,116 @@ def test_a_parallel_dashpot_dissipates_pi_c_omega_a_squared_a_cycle():
     dt = 2.0 * np.pi / omega / 4000
     t = np.arange(0.0, 2.0 * np.pi / omega + dt / 2, dt)
     x = amplitude * np.sin(omega * t)
-    force = FORMS["viscous_parallel"].change(x, np.zeros_like(x), 5e5, {"dashpot": c_mm}, {}, dt)
+    force = FORMS["viscous_parallel"].change(x, np.zeros_like(x), 5e5, {"dashpot": c_mm}, {}, dt, 0.0)
     area = float(np.sum(0.5 * (force[1:] + force[:-1]) * np.diff(x)))
     assert area == pytest.approx(np.pi * c_mm * 1e3 * omega * amplitude ** 2, rel=1e-3)
-    held = FORMS["viscous_parallel"].change(np.full(10, amplitude), np.ones(10), 5e5, {"dashpot": c_mm}, {}, dt)
+    held = FORMS["viscous_parallel"].change(np.full(10, amplitude), np.ones(10), 5e5, {"dashpot": c_mm}, {}, dt, 0.0)
     assert np.array_equal(held, np.ones(10))
+
+
+def _cycled(change, amplitude_m: float, cycles: int = 2, per_cycle: int = 4000) -> tuple[np.ndarray, np.ndarray]:
+    """(deflection, force) of the last of ``cycles`` sine cycles of ``amplitude_m`` through ``change``
+    (deflections [m] -> forces [N]), started from rest at zero deflection."""
+    x = amplitude_m * np.sin(2.0 * np.pi * np.arange(cycles * per_cycle + 1) / per_cycle)
+    force = change(x)
+    return x[-per_cycle - 1:], force[-per_cycle - 1:]
+
+
+def _loop_area(x: np.ndarray, force: np.ndarray) -> float:
+    """∮F dx [J] by the trapezoidal rule: positive for a loop that dissipates."""
+    return float(np.sum(0.5 * (force[1:] + force[:-1]) * np.diff(x)))
+
+
+def test_a_slipping_interface_adds_the_elastoplastic_loop_and_its_tangent():
+    """bushings.effects' slip element (a spring k_s in series with a slider F_s, in parallel with the
+    law): cycled between ±A it adds the parallelogram of area 4·F_s·(A − F_s/k_s), whatever the rate;
+    the tangent is k_s while it sticks, 0 while it slips."""
+    ch = load_parameter_set("fig5_9_progressive").channel("elastic")
+    fs, fraction, amplitude = 8.0, 0.3, 0.5e-3
+    si = effects_to_si({"slip_force": fs, "slip_stiffness": fraction})
+    assert (si.slip_force, si.slip_stiffness) == (fs, fraction) and si.active
+    assert not effects_to_si({"slip_stiffness": fraction}).active
+    ks = fraction * ch.K0
+    for period_s in (0.5, 50.0):
+        run = lambda effects: (lambda x: ExtendedBank([ch], [effects]).run(x, period_s / 4000)[:, 0])
+        x, slipping = _cycled(run(si), amplitude)
+        _, law = _cycled(run(Effects()), amplitude)
+        assert _loop_area(x, slipping) - _loop_area(x, law) == pytest.approx(4 * fs * (amplitude - fs / ks), rel=2e-3)
+    e, force, tangent = _reloaded(si, amplitude, -amplitude)
+    _, law, law_tangent = _reloaded(Effects(), amplitude, -amplitude)
+    down = amplitude - e   # from the top, where it was slipping, the first 2F_s/k_s stick
+    sticks = (down > 0.0) & (down < 2 * fs / ks - 1e-7)
+    np.testing.assert_allclose((tangent - law_tangent)[sticks], ks, rtol=1e-12)
+    np.testing.assert_allclose((tangent - law_tangent)[down > 2 * fs / ks + 1e-7], 0.0, atol=1e-9)
+    np.testing.assert_allclose((force - law)[-1], -fs, rtol=1e-12)
+
+
+def test_dahl_friction_closes_its_loop_at_fc_tanh():
+    """truth_forms' dahl_parallel, cycled between ±A: the force at the top of the loop is
+    F_c·tanh(σA/F_c) and the loop's area 2·(2A·F_c − (F_c + F_top)·F_c/σ·(1 − e^{−2σA/F_c}))
+    (dF/dx = σ(1 − F/F_c·sgn ẋ) integrated along each branch)."""
+    k0, fc, fraction = 5e5, 12.0, 0.3
+    sigma = fraction * k0
+    amplitude = 2.0 * fc / sigma          # σA/F_c = 2: the loop's corners are round
+    change = lambda x: FORMS["dahl_parallel"].change(x, np.zeros_like(x), k0, {"dahl_force": fc,
+                                                     "dahl_stiffness": fraction}, {}, 1e-3, 0.0)
+    x, force = _cycled(change, amplitude)
+    top = fc * np.tanh(sigma * amplitude / fc)
+    assert force[np.argmax(x)] == pytest.approx(top, rel=1e-4)
+    decay = 1.0 - np.exp(-2.0 * sigma * amplitude / fc)
+    area = 2.0 * (2.0 * amplitude * fc - (fc + top) * fc / sigma * decay)
+    assert _loop_area(x, force) > 0.0
+    assert _loop_area(x, force) == pytest.approx(area, rel=1e-3)
+    assert np.array_equal(FORMS["dahl_parallel"].change(x, force, k0, {"dahl_force": 0.0, "dahl_stiffness": 0.3},
+                                                        {}, 1e-3, 0.0), force)
+
+
+def test_two_node_heating_softens_as_the_core_heat_of_the_mean_power():
+    """truth_forms' heating_two_node through a dashpot law F = c·ẋ cycled at ω for whole cycles
+    (where the secant's stored energy is zero): the core holds the heat of the mean power
+    P = c·ω²·A²/2 fed through the network (Q̇ = R·Q + (P, 0)), and the force falls by exp(−κ·Q_core)."""
+    c, amplitude, omega, kappa = 2e4, 5e-3, 2.0 * np.pi * 2.0, 1.0
+    core_tau, shell_tau, duration = 20.0, 300.0, 30.0
+    dt = 2.0 * np.pi / omega / 400
+    t = np.arange(0.0, duration + dt / 2, dt)
+    x, law = amplitude * np.sin(omega * t), c * amplitude * omega * np.cos(omega * t)
+    values = {"heating_exp": kappa, "core_tau_s": core_tau, "shell_tau_s": shell_tau}
+    softened = FORMS["heating_two_node"].change(x, law, 1.0, values, {}, dt, 0.0)
+    rates = np.array([[-1 / core_tau, 1 / core_tau], [1 / core_tau, -1 / core_tau - 1 / shell_tau]])
+    power = c * omega ** 2 * amplitude ** 2 / 2.0
+    w, v = np.linalg.eig(rates)   # Q(T) = V·diag((e^{λT} − 1)/λ)·V⁻¹·(P, 0)
+    core = float((v @ np.diag(np.expm1(w * t[-1]) / w) @ np.linalg.solve(v, [power, 0.0]))[0].real)
+    ratio = softened[-1] / law[-1]
+    assert ratio < 0.9    # the test sees the softening, not a rounding
+    assert ratio == pytest.approx(np.exp(-kappa * 1e-3 * core), rel=2e-3)
+
+
+def test_box_relaxation_falls_by_a_decades_branches_each_decade_and_relaxes_at_rest():
+    """truth_forms' relaxation_box: after a step x0 the force falls, each decade of time well inside
+    the box, by the stiffness of the branches in a decade times x0 (a box spectrum's force is linear
+    in log t); a rest at zero deflection before the next test relaxes each branch from its force
+    less k·x0 (what the jump back to zero adds) by e^{−t/τ}."""
+    k_mm, tau_max, x0, dt = 100.0, 300.0, 1e-3, 1e-3
+    values = {"box_k": k_mm, "box_tau_max_s": tau_max}
+    t = np.arange(0.0, 10.0 + dt / 2, dt)
+    x = np.where(t > 0.0, x0, 0.0)
+    state: dict = {}
+    force = FORMS["relaxation_box"].change(x, np.zeros_like(x), 1.0, values, state, dt, 0.0)
+    taus = BOX_TAU_MIN_S * 10.0 ** ((np.arange(BOX_PER_DECADE * 12) + 0.5) / BOX_PER_DECADE)
+    taus = taus[taus < tau_max]
+    per_decade = k_mm * 1e3 * BOX_PER_DECADE / len(taus) * x0
+    at = lambda s: force[int(round(s / dt))]
+    for start in (0.1, 1.0):
+        assert at(start) - at(10 * start) == pytest.approx(per_decade, rel=0.06)
+    # each branch after the step over one sample (dx/dt constant within it), then held
+    k = k_mm * 1e3 / len(taus)
+    held = k * x0 * taus / dt * (1 - np.exp(-dt / taus)) * np.exp(-(t[-1] - dt) / taus)
+    np.testing.assert_allclose(force[-1], held.sum(), rtol=1e-9)
+    rest = 5.0
+    after = FORMS["relaxation_box"].change(np.zeros(3), np.zeros(3), 1.0, values, state, dt, rest)
+    expected = ((held - k * x0) * np.exp(-(rest + dt) / taus)).sum()
+    assert after[0] == pytest.approx(expected, rel=1e-9)
+    assert after[0] < 0.0    # the branches' memory of the step, pulling back after the jump to zero
 
 
 def _named_as_family(result: dict, form: str) -> str:
@@ -233,11 +339,16 @@ def _named_as_family(result: dict, form: str) -> str:
     return ""
 
 
-@pytest.mark.parametrize("form", ["asymmetry_smooth_kink", "asymmetry_exponential", "mullins_ogden"])
+#: Other forms drawn in the default suite (all of truth_forms.FORMS in the slow one: the two-node
+#: heating's and the box spectrum's diagnoses take a minute each on 2 cores).
+DEFAULT_FORMS = ["asymmetry_smooth_kink", "asymmetry_exponential", "mullins_ogden", "dahl_parallel"]
+
+
+@pytest.mark.parametrize("form", DEFAULT_FORMS)
 def test_another_form_of_a_family_is_named_as_the_family(tmp_path, form):
     """A form the catalogue does not write (truth_forms: a kink smoothed over a width, an exponential
-    stiffening, Ogden-Roxburgh softening) is named as its family, explained, with the noise left (not
-    a confident other cause)."""
+    stiffening, Ogden-Roxburgh softening, Dahl's friction) is named as its family, explained at least
+    in part, with most of the mismatch beyond the noise removed (not a confident other cause)."""
     baseline, _, measured = measure(tmp_path, form, SEEDS[0])
     result = diagnose_fresh(measured, baseline)
     _named_as_family(result, form)
@@ -263,16 +374,21 @@ def test_a_stiffening_the_held_out_tests_cannot_place_is_judged_on_both_halves(t
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("cause", BENCH_CAUSES + ["none", PAIR, *FORMS])
+@pytest.mark.parametrize("cause", BENCH_CAUSES + ["none", PAIR, *FORMS, *OUTSIDE])
 def test_success_rate_over_many_seeds(tmp_path, record_property, cause):
-    """At least 90 % of 20 draws per cause diagnosed right, and both causes of 80 % of 20 pairs; a
-    form the catalogue does not write (truth_forms.FORMS) named as its family (the tally goes to the
-    run's summary)."""
+    """At least the required share (MIN_SUCCESS_RATE) of 20 draws per cause diagnosed right, and
+    both causes of MIN_PAIR_SUCCESS_RATE of 20 pairs; a form the catalogue does not write
+    (truth_forms.FORMS) named as its family; an effect outside the catalogue (backlash) never
+    presented as the whole story: unexplained, explained in part, or too small to see ("none");
+    the tally goes to the run's summary."""
     def attempt(case: Path, seed: int) -> str | None:
         baseline, effects, measured = measure(case, cause, seed)
         result = diagnose_fresh(measured, baseline)
         if cause in FORMS:
             return _named_as_family(result, cause)
+        elif cause in OUTSIDE:
+            assert result["cause"] in ("unexplained", "none") or result["explained"] == "partial", result["ranking"][:3]
+            return result["cause"] if result["cause"] in ("unexplained", "none") else "partial"
         elif cause == "none":
             assert result["cause"] == "none", result["ranking"][:3]
         elif cause == PAIR:

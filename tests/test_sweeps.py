@@ -369,3 +369,7 @@ def test_places_of_the_vehicle_file():
     assert law(same).channel() == law(base).channel() and law(same).effects_si() == law(base).effects_si()
     assert law(changed).channel().Kr == pytest.approx(3500.0e3)
     assert changed.front.hardpoints["tie_rod_inner"][2] == 0.2 and "3500.0" in changed.text
+    # an optional key the file leaves out (the beam rigid in bending) is set where the file would write it
+    assert "beam_bending_stiffness" not in text and base.rear.beam_bending_stiffness is None
+    bent = vehicle_with(text, DEFAULT_VEHICLE, {"rear.beam_bending_stiffness": 5e4}, "test")
+    assert bent.rear.beam_bending_stiffness == 5e4

@@ -78,13 +78,9 @@ def _toe_loop(directions: tuple[str, ...]) -> float:
 def _rear_camber(bending_nm_per_rad: float | None, model: str) -> tuple[float, float]:
     """(range, loop width) [deg] of the rear left camber in 20 mm pumping of the rear axle at 20 mm/s,
     the twist beam bending at ``bending_nm_per_rad`` (None: rigid), ``model`` on every direction."""
-    text = DEFAULT_VEHICLE.read_text()
-    if bending_nm_per_rad is not None:
-        text = text.replace("\n  beam_torsion_scale:", f"\n  beam_bending_stiffness: {bending_nm_per_rad}\n"
-                                                         "  beam_torsion_scale:", 1)
-        assert "beam_bending_stiffness" in text
+    bending = {} if bending_nm_per_rad is None else {"rear.beam_bending_stiffness": bending_nm_per_rad}
     scenario = replace(_front_axle("pumping", "[{amplitude_mm: 20, speed_mm_s: 20}]", axle="rear"), bushing_model=model)
-    run = simulate(scenario, vehicle_with(text, DEFAULT_VEHICLE, {}, "test"))
+    run = simulate(scenario, vehicle_with(DEFAULT_VEHICLE.read_text(), DEFAULT_VEHICLE, bending, "test"))
     (c,) = cases(run)
     camber = run.signals["camber_rl"][case_mask(run, c)]
     return float(np.ptp(camber)), case_loop(run, c, "pad_height_rl", "camber_rl", "pad_height_rl").width

@@ -84,17 +84,6 @@ def _loss(direction: str, lossier_law: bool) -> tuple[float, float]:
     return float(k.imag / k.real), float(abs(k) / 1e3)
 
 
-def _bending_beam(text: str) -> str:
-    """The default car's file with its twist beam bending at :data:`BEAM_BENDING_NM_PER_RAD` (the file
-    leaves the key out: the beam rigid in bending)."""
-    anchor = "\n  beam_torsion_scale:"
-    if "beam_bending_stiffness" in text:
-        raise RuntimeError(f"{DEFAULT_VEHICLE}: the file bends its beam already; the experiment needs it rigid")
-    if anchor not in text:
-        raise RuntimeError(f"{DEFAULT_VEHICLE}: no rear 'beam_torsion_scale' line to put the beam's bending before")
-    return text.replace(anchor, f"\n  beam_bending_stiffness: {BEAM_BENDING_NM_PER_RAD}{anchor}", 1)
-
-
 def _run(job: tuple[str, str, str | None, tuple]) -> tuple[str, dict]:
     """One experiment: (label, scenario, bushing model or None for the file's, vehicle values) →
     (label, the numbers and traces the report reads). A label ending in ``_slow`` ramps its rack
@@ -110,8 +99,9 @@ def _run(job: tuple[str, str, str | None, tuple]) -> tuple[str, dict]:
         scenario = replace(scenario, output_rate_hz=1000.0)
     if model is not None:   # "file": the vehicle file's own laws, whatever the scenario says
         scenario = replace(scenario, bushing_model=None if model == "file" else model)
-    text = _bending_beam(DEFAULT_VEHICLE.read_text()) if "_bending" in label else DEFAULT_VEHICLE.read_text()
-    vehicle = vehicle_with(text, DEFAULT_VEHICLE, dict(values), label)
+    # the default file leaves the beam's bending out (rigid): a bending run sets it
+    bending = {"rear.beam_bending_stiffness": BEAM_BENDING_NM_PER_RAD} if "_bending" in label else {}
+    vehicle = vehicle_with(DEFAULT_VEHICLE.read_text(), DEFAULT_VEHICLE, {**dict(values), **bending}, label)
     run = simulate(scenario, vehicle)
     steps = scenario.type in ("rack_step", "double_rack_step") and not label.startswith("toe_lag")
     # a step's own relaxation: the run's change over the hold less its control's, the same run

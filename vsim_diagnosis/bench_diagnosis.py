@@ -30,6 +30,7 @@ from bushings.extended_bank import ExtendedBank
 from bushings.parameter_sets import ParameterSet
 from vsim_diagnosis.catalogue import PAIR_SEPARATOR, Cause, applicable, combined, parts
 from vsim_diagnosis.bench_alike import extra_programmes, load_cell_noise_n, separations
+from vsim_diagnosis.fit_starts import corner_starts, side_starts, sides_apart, to_fit
 from vsim_diagnosis.verdict import (Outcome, Separation, alike, decide, explained, pair_named, pair_shares,
                                     second_cause_wanted, split)
 from vsim_recordings.bench_dataset import BenchDataset
@@ -239,76 +240,23 @@ class _Objective:
         return ((r - r0) / h[:, None]).T
 
 
-def _coordinates(cause: Cause) -> tuple[np.ndarray, np.ndarray]:
-    lo = np.array([math.log(p.bounds[0]) if p.log else p.bounds[0] for p in cause.parameters])
-    hi = np.array([math.log(p.bounds[1]) if p.log else p.bounds[1] for p in cause.parameters])
-    return lo, hi
-
-
-def _grid(cause: Cause) -> np.ndarray:
-    """Starting points: the corners of the realistic range (both signs for signed parameters)."""
-    axes = []
-    for p in cause.parameters:
-        pts = np.log(p.draw) if p.log else np.array(p.draw, dtype=float)
-        if len(cause.parameters) == 1:
-            pts = np.array([pts.mean()])
-        axes.append(np.r_[-pts[::-1], pts] if p.signed else pts)
-    return _points(axes)
-
-
-def _points(axes: list[np.ndarray]) -> np.ndarray:
-    """Every combination of the values on each axis, one point a row."""
-    return np.array(np.meshgrid(*axes, indexing="ij")).reshape(len(axes), -1).T
-
-
-def _to_fit(cause: Cause, values: dict[str, float]) -> np.ndarray:
-    return np.array([math.log(values[p.name]) if p.log else values[p.name] for p in cause.parameters])
-
-
-def _sides(cause: Cause, values: dict[str, float]) -> np.ndarray:
-    """Starting points from ``values``, with every sided parameter also on its other side (a
-    least-squares fit cannot cross zero to the other effect; at zero, both sides at the weak end of
-    its realistic range)."""
-    axes = []
-    for p, z in zip(cause.parameters, _to_fit(cause, values)):
-        if p.sided:
-            z = z if abs(z) > 1e-12 else p.draw[0]
-            axes.append(np.array([z, -z]))
-        else:
-            axes.append(np.array([z]))
-    return _points(axes)
-
-
-def _sides_apart(cause: Cause, grid: np.ndarray) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
-    """(which points of ``grid``, lower and upper fit bounds) for each side of the sided parameters
-    the points take, zero the bound between the sides. A sided parameter's effect switches sides at
-    zero, a cusp in the cost that a least-squares fit cannot cross, or crosses into the wrong basin
-    (an asymmetry's kink fitted on one side and its progressive part on the other): each side is
-    fitted within its own bounds."""
-    lo, hi = _coordinates(cause)
-    sided = np.array([p.sided for p in cause.parameters])
-    keys = np.where(sided, grid >= 0.0, True)
-    return [((keys == key).all(axis=1), np.where(sided & key, 0.0, lo), np.where(sided & ~key, 0.0, hi))
-            for key in np.unique(keys, axis=0)]
-
-
 def fit_cause(replay: Replay, base: ParameterSet, cause: Cause, train: np.ndarray,
               start: dict[str, float] | None = None, max_nfev: int = 15, corners: bool = False
               ) -> tuple[dict[str, float], dict[str, float]]:
     """Least-squares fit of a cause's parameters on the training records, from ``start``, or from the
     best of a few starting points: the corners of the realistic range (no ``start``), or, with
-    ``corners``, those and ``start`` with every sided parameter on either side; each side of the sided
-    parameters fitted from its best point within its bounds (:func:`_sides_apart`), the best kept
+    ``corners``, those and ``start`` with each family's sided parameters on either side; each side
+    fitted from its best point within its bounds (:mod:`vsim_diagnosis.fit_starts`), the best kept
     (from a ``start``, only its side and the best point's: a pair's causes fitted alone chose theirs);
     returns the values and their standard uncertainties (linearised, from the Jacobian and the
     residual variance)."""
     obj = _Objective(replay, base, cause, train)
     if start is None:
-        grid = _grid(cause)
+        grid = corner_starts(cause)
     else:
-        grid = np.vstack([_sides(cause, start), _grid(cause)]) if corners else _to_fit(cause, start)[None]
+        grid = np.vstack([side_starts(cause, start), corner_starts(cause)]) if corners else to_fit(cause, start)[None]
     costs = (obj.residuals(grid) ** 2).sum(axis=1) if len(grid) > 1 else np.zeros(1)
-    sides = _sides_apart(cause, grid)
+    sides = sides_apart(cause, grid)
     if start is not None:   # only the side of the start (the row 0) and the best point's
         sides = [side for side in sides if side[0][[0, int(np.argmin(costs))]].any()]
     sol = None
@@ -324,11 +272,14 @@ def fit_cause(replay: Replay, base: ParameterSet, cause: Cause, train: np.ndarra
     r = sol.fun[obj.w > 0]
     rho = float(np.clip(np.dot(r[1:], r[:-1]) / max(np.dot(r, r), 1e-300), 0.0, 0.999))
     s2 = 2.0 * sol.cost / dof * (1.0 + rho) / (1.0 - rho)
+    # A parameter the training tests cannot see (a slip stiffness with no slip force) has no column
+    # in J: its uncertainty is unbounded, the others' taken from the rest of J.
+    seen = np.linalg.norm(J, axis=0) > 1e-9 * max(float(np.linalg.norm(J)), 1e-300)
+    std_z = np.full(len(sol.x), np.inf)
     try:
-        cov = np.linalg.inv(J.T @ J) * s2
-        std_z = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+        std_z[seen] = np.sqrt(np.clip(np.diag(np.linalg.inv(J[:, seen].T @ J[:, seen])) * s2, 0.0, None))
     except np.linalg.LinAlgError:
-        std_z = np.full(len(sol.x), np.inf)
+        pass
     values = obj.values(sol.x)
     std = {p.name: float(values[p.name] * s if p.log else s) for p, s in zip(cause.parameters, std_z)}
     return values, std

@@ -99,7 +99,8 @@ def _viscosity(params: dict, effects: dict, v: Mapping[str, float]) -> tuple[dic
 
 
 def _friction(params: dict, effects: dict, v: Mapping[str, float]) -> tuple[dict, dict]:
-    return {**params, "Ff": v["Ff"], "Co": params["Co"] * v["co_scale"]}, effects
+    slip = {"slip_force": v.get("slip_force", 0.0), "slip_stiffness": v.get("slip_stiffness", NO_EFFECTS.slip_stiffness)}
+    return {**params, "Ff": v["Ff"], "Co": params["Co"] * v["co_scale"]}, {**effects, **slip}
 
 
 def _broad(params: dict, effects: dict, v: Mapping[str, float]) -> tuple[dict, dict]:
@@ -145,13 +146,21 @@ CAUSES: dict[str, Cause] = {c.id: c for c in (
            Parameter("C", "N·s/mm", (0.0, 10.0), (0.0, 1.0), default=0.0,
                      description="linear dashpot in parallel with the whole law")),
           lambda b: _ladder(b) and b.values.get("Co", 0.0) == 0.0, _viscosity),
+    # a family (issue 29): friction inside the rubber (the ladder's sliders, the thesis's STVS) and at
+    # an interface of the part that slips as a whole (a Jenkins element, spring and Coulomb slider, in
+    # parallel: Berg 1998's frictional element), whose stiffness before slip sets how round the
+    # loop's corners are (Dahl's and Bouc-Wen's smooth friction lie between its stiff and soft ends)
     Cause("viscoelasticity_excess",
           "the part is less viscous and more hysteretic than an RT-like law: slider threshold Ff added at every "
-          "ladder node, dampers scaled",
+          "ladder node, dampers scaled, and an interface that slips in parallel with the law",
           "simulated loops too round; measured hysteresis persists at low speed",
           (Parameter("Ff", "N", (0.0, 200.0), (5.0, 15.0), description="slider threshold added at every node"),
            Parameter("co_scale", "-", (0.02, 3.0), (0.4, 0.8), log=True, factor=True,
-                     description="factor on the damper Co")),
+                     description="factor on the damper Co"),
+           Parameter("slip_force", "N", (0.0, 200.0), (2.0, 10.0), default=0.0,
+                     description="force at which an interface in parallel with the law slips"),
+           Parameter("slip_stiffness", "-", (0.01, 5.0), (0.2, 0.5), log=True, default=1.0,
+                     description="the interface's stiffness before it slips, a fraction of K0")),
           lambda b: _ladder(b) and b.values.get("Co", 0.0) > 0.0, _friction),
     Cause("preload",
           "static load shifts the part's operating point along its nonlinear elastic law and leaves its "

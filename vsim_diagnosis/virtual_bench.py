@@ -166,7 +166,8 @@ def measure_bench(truth: Truth, output: Path, *, overwrite: bool = False, tests:
         t_fine, e_fine = test.signal(test.dt_s / OVERSAMPLING)
         force = bank.run(e_fine, test.dt_s / OVERSAMPLING)[:, 0]
         for form, values, state in forms:
-            force = form.change(e_fine, force, channel.K0, values, state, test.dt_s / OVERSAMPLING)
+            force = form.change(e_fine, force, channel.K0, values, state, test.dt_s / OVERSAMPLING,
+                                test.rest_before_s)
         t, e, F = t_fine[::OVERSAMPLING], e_fine[::OVERSAMPLING], force[::OVERSAMPLING]
         e_mm = quantise(e * MM_PER_M + e_offset_mm + rng.normal(0.0, m["displacement_noise_mm"], len(e)),
                          m["displacement_resolution_mm"])
