@@ -30,9 +30,12 @@ class Effects:
 
     With ``x = e + preload`` (after the backlash dead band) the force is
     ``η_mullins(x)·η_heat(Q)·(F_base(x) + F_asym(x)) + F_slip − F_tare``, where F_slip is the force of a
-    Jenkins element (a spring in series with a Coulomb slider, Berg 1998's frictional element) in
-    parallel: an interface of the part that slips (a bonded sleeve, a clamped face). Its force is
-    neither softened by η nor does its dissipation heat the part: it acts at a face, not in the rubber.
+    Jenkins element (a spring in series with a Coulomb slider: one element of Iwan's 1966 model, the
+    sharp limit of Berg's 1998 smooth friction element) in parallel: an interface of the part that
+    slips (a bonded sleeve, a clamped face), clamped unloaded at the mounted position. Its force is
+    neither softened by η nor does its dissipation heat the part: it acts at a face, not in the
+    rubber. In a backlash dead band the part is held at x = 0, where a hysteretic law and the
+    interface keep the force they had there.
     """
 
     preload: float = 0.0          #: operating point of the mounted part on its law [m or rad]

@@ -87,7 +87,7 @@ def _effects_out(h, e, X, EP, ES, P, diss, F, K, Fout, Kout):
             ES[c, S_SLIP_X] = x
             ES[c, S_SLIP_F] = min(max(trial, -fs), fs)
             f += ES[c, S_SLIP_F]
-            k += ks if abs(trial) < fs else 0.0
+            k += ks if abs(trial) <= fs else 0.0   # at the limit unloading sticks: the larger tangent
         b = EP[c, E_BACKLASH]
         if b > 0.0 and abs(e[c]) <= b:
             k = 0.0
@@ -161,7 +161,10 @@ class ExtendedBank:
         for i in range(1, MOUNT_STEPS + 1):
             self.EP[:, E_PRELOAD] = preload * i / MOUNT_STEPS
             self.step(zero, MOUNT_S / MOUNT_STEPS)
-        self.EP[:, E_TARE] = self.force
+        # a slipping interface is clamped at the mounted position: unloaded there, whatever the ramp did
+        slip = self.ES[:, S_SLIP_F].copy()
+        self.ES[:, S_SLIP_F], self.ES[:, S_SLIP_X] = 0.0, self._X
+        self.EP[:, E_TARE] = self.force - slip
 
     def kernel_args(self) -> tuple[np.ndarray, ...]:
         """Arguments of :func:`step_extended` after (e, h): the effect arrays, ``force`` and

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import os
+from dataclasses import replace
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -31,6 +32,8 @@ BENCH_CAUSES = sorted(CAUSES)
 #: Seeds per cause in the default suite (one, for time: each diagnosis takes 15-60 s); the slow
 #: suite (``pytest -m slow``) runs SLOW_SEEDS more.
 SEEDS = [int(os.environ.get("VSIM_TEST_SEED", "1"))]
+#: The slow suite's rate for a catalogue cause hidden in its own form (issue 29: single causes ≥ 95 %).
+OWN_FORM_SUCCESS_RATE = 0.95
 
 
 def _check_named(result: dict, cause: str, effects: list[dict]) -> None:
@@ -46,7 +49,8 @@ def _check_named(result: dict, cause: str, effects: list[dict]) -> None:
     for name, fitted in result["parameters"].items():
         # The fitted magnitude is the hidden one, within 4 standard uncertainties or 25 % (the
         # self-heating rate and time constant trade off against each other over a 30 s endurance run).
-        tolerance = max(4.0 * fitted["std"], 0.25 * abs(truth[name]))
+        # (a null uncertainty: a parameter the tests do not see, e.g. a slip stiffness with no slip force)
+        tolerance = max(4.0 * (fitted["std"] if fitted["std"] is not None else np.inf), 0.25 * abs(truth[name]))
         assert abs(fitted["value"] - truth[name]) <= tolerance, (name, fitted, truth[name])
 
 
@@ -249,11 +253,18 @@ def test_a_slipping_interface_adds_the_elastoplastic_loop_and_its_tangent():
         assert _loop_area(x, slipping) - _loop_area(x, law) == pytest.approx(4 * fs * (amplitude - fs / ks), rel=2e-3)
     e, force, tangent = _reloaded(si, amplitude, -amplitude)
     _, law, law_tangent = _reloaded(Effects(), amplitude, -amplitude)
-    down = amplitude - e   # from the top, where it was slipping, the first 2F_s/k_s stick
-    sticks = (down > 0.0) & (down < 2 * fs / ks - 1e-7)
+    down = amplitude - e   # from the top (at the limit: unloading sticks), the first 2F_s/k_s stick
+    sticks = down < 2 * fs / ks - 1e-7
+    assert sticks[0] and sticks.sum() > 10
     np.testing.assert_allclose((tangent - law_tangent)[sticks], ks, rtol=1e-12)
     np.testing.assert_allclose((tangent - law_tangent)[down > 2 * fs / ks + 1e-7], 0.0, atol=1e-9)
     np.testing.assert_allclose((force - law)[-1], -fs, rtol=1e-12)
+    # mounted on a preload far beyond F_s/k_s, the interface is clamped unloaded there: ±k_s·δ either way
+    delta = 0.25 * fs / ks
+    for sign in (1.0, -1.0):
+        moved = [ExtendedBank([ch], [replace(fx, preload=1e-3)]).step(np.array([sign * delta]), 0.01)[0][0]
+                 for fx in (si, Effects())]
+        assert moved[0] - moved[1] == pytest.approx(sign * ks * delta, rel=1e-9)
 
 
 def test_dahl_friction_closes_its_loop_at_fc_tanh():
@@ -376,7 +387,8 @@ def test_a_stiffening_the_held_out_tests_cannot_place_is_judged_on_both_halves(t
 @pytest.mark.slow
 @pytest.mark.parametrize("cause", BENCH_CAUSES + ["none", PAIR, *FORMS, *OUTSIDE])
 def test_success_rate_over_many_seeds(tmp_path, record_property, cause):
-    """At least the required share (MIN_SUCCESS_RATE) of 20 draws per cause diagnosed right, and
+    """At least OWN_FORM_SUCCESS_RATE of 20 draws per catalogue cause diagnosed right (and of clean
+    draws naming nothing), MIN_SUCCESS_RATE per other form or outside effect, and
     both causes of MIN_PAIR_SUCCESS_RATE of 20 pairs; a form the catalogue does not write
     (truth_forms.FORMS) named as its family; an effect outside the catalogue (backlash) never
     presented as the whole story: unexplained, explained in part, or too small to see ("none");
@@ -396,8 +408,11 @@ def test_success_rate_over_many_seeds(tmp_path, record_property, cause):
         else:
             _check_named(result, cause, effects)
 
+    # the issue's 95 % for a catalogue cause in its own form (and clean data), measured 20/20 each;
+    # MIN_SUCCESS_RATE for other forms and effects outside the catalogue
+    own = cause in CAUSES or cause == "none"
     assert_success_rate(cause, SLOW_SEEDS, tmp_path, attempt, record_property,
-                        MIN_PAIR_SUCCESS_RATE if cause == PAIR else MIN_SUCCESS_RATE)
+                        MIN_PAIR_SUCCESS_RATE if cause == PAIR else OWN_FORM_SUCCESS_RATE if own else MIN_SUCCESS_RATE)
 
 
 def test_the_separating_programme_is_the_one_where_the_rivals_differ_most():

@@ -102,6 +102,8 @@ def _run(job: tuple[str, str, str | None, tuple]) -> tuple[str, dict]:
     # the default file leaves the beam's bending out (rigid): a bending run sets it
     bending = {"rear.beam_bending_stiffness": BEAM_BENDING_NM_PER_RAD} if "_bending" in label else {}
     vehicle = vehicle_with(DEFAULT_VEHICLE.read_text(), DEFAULT_VEHICLE, {**dict(values), **bending}, label)
+    if not bending and vehicle.rear.beam_bending_stiffness is not None:
+        raise RuntimeError(f"{DEFAULT_VEHICLE}: the file bends its beam; the experiments without bending need it rigid")
     run = simulate(scenario, vehicle)
     steps = scenario.type in ("rack_step", "double_rack_step") and not label.startswith("toe_lag")
     # a step's own relaxation: the run's change over the hold less its control's, the same run

@@ -99,7 +99,8 @@ def _viscosity(params: dict, effects: dict, v: Mapping[str, float]) -> tuple[dic
 
 
 def _friction(params: dict, effects: dict, v: Mapping[str, float]) -> tuple[dict, dict]:
-    slip = {"slip_force": v.get("slip_force", 0.0), "slip_stiffness": v.get("slip_stiffness", NO_EFFECTS.slip_stiffness)}
+    # the interface only where the values give it a force (a K&C hypothesis fits the first two only)
+    slip = {k: v[k] for k in ("slip_force", "slip_stiffness") if k in v} if v.get("slip_force", 0.0) > 0.0 else {}
     return {**params, "Ff": v["Ff"], "Co": params["Co"] * v["co_scale"]}, {**effects, **slip}
 
 
@@ -148,8 +149,9 @@ CAUSES: dict[str, Cause] = {c.id: c for c in (
           lambda b: _ladder(b) and b.values.get("Co", 0.0) == 0.0, _viscosity),
     # a family (issue 29): friction inside the rubber (the ladder's sliders, the thesis's STVS) and at
     # an interface of the part that slips as a whole (a Jenkins element, spring and Coulomb slider, in
-    # parallel: Berg 1998's frictional element), whose stiffness before slip sets how round the
-    # loop's corners are (Dahl's and Bouc-Wen's smooth friction lie between its stiff and soft ends)
+    # parallel: Iwan 1966's element, the sharp limit of Berg 1998's), whose stiffness before slip sets
+    # how round the loop's corners are (Dahl's and Bouc-Wen's smooth friction lie between its stiff
+    # and soft ends)
     Cause("viscoelasticity_excess",
           "the part is less viscous and more hysteretic than an RT-like law: slider threshold Ff added at every "
           "ladder node, dampers scaled, and an interface that slips in parallel with the law",

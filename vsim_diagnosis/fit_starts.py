@@ -80,7 +80,8 @@ def to_fit(cause: Cause, values: dict[str, float]) -> np.ndarray:
 def side_starts(cause: Cause, values: dict[str, float]) -> np.ndarray:
     """Starting points from ``values``, with each family's sided parameters also on their other side
     (a least-squares fit cannot cross zero to the other effect); a sided parameter at zero starts at
-    the weak end of its realistic range, on its family's side."""
+    the weak end of its realistic range, on its family's side (taken from its first nonzero sided
+    parameter: ``values`` come from a fit, whose families each keep one side)."""
     z = to_fit(cause, values)
     families = _families(cause)
     for idx, positive in zip(families, _family_sides(cause, z[None])[0]):
@@ -97,6 +98,8 @@ def side_starts(cause: Cause, values: dict[str, float]) -> np.ndarray:
 def sides_apart(cause: Cause, starts: np.ndarray) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
     """(which of ``starts``, lower and upper fit bounds) for each combination of its families' sides
     that the starts take, zero the bound between the sides."""
+    if not len(starts):
+        raise ValueError(f"{cause.id}: no starting point to fit from")
     lo, hi = fit_bounds(cause)
     keys = _family_sides(cause, starts)
     out = []

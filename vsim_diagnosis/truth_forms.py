@@ -17,9 +17,10 @@ viscous family's dashpot (the family keeps a little ladder damping, Co ≥ 0.1).
   the simplest viscoelastic solid), F += c·dx/dt;
 * ``dahl_parallel``: Dahl's friction element in parallel with the whole law (rate-independent
   hysteresis of one slipping interface, not the ladder's sliders), dF_d/dx = σ·(1 − F_d/F_c·sgn ẋ);
-* ``heating_two_node``: the heat dissipated feeds a core that passes it to a shell that loses it to
-  the air (a two-node thermal network, two time constants where the family has one), and the
-  force softens exponentially with the core's heat, η = exp(−κ·Q_core);
+* ``heating_two_node``: the heat the law dissipates (before its softening, as the catalogue's
+  self-heating takes it) feeds a core that passes it to a shell that loses it to the air (a
+  two-node thermal network, two time constants where the family has one), and the force softens
+  exponentially with the core's heat, η = exp(−κ·Q_core);
 * ``relaxation_box``: relaxation with a box spectrum, moduli spread evenly over log τ from 10 ms to
   τ_max (Tobolsky's box: a force falling linearly with log t, where the family's is a power of t).
 
@@ -148,8 +149,9 @@ def _network_run(heat_in: np.ndarray, held: np.ndarray, step: np.ndarray, feed: 
 def _two_node(x, force, k0, v, state, dt_s, rest_s):
     rates = _network(v["core_tau_s"], v["shell_tau_s"])
     held = expm(rates * rest_s) @ state.get("held", np.zeros(2))
-    # Heat dissipated [J]: the work done on the part less the energy it holds elastically, taken as
-    # the secant's ½·F·x (exact for a spring; bounded, not accumulating, for the hysteretic law).
+    # Heat dissipated [J] by the law before softening: the work done less the energy held
+    # elastically, taken as the secant's ½·F·x (exact for a spring; bounded, not accumulating, for
+    # the hysteretic law).
     work = np.concatenate([[0.0], np.cumsum(0.5 * (force[1:] + force[:-1]) * np.diff(x))])
     dissipated = work - 0.5 * force * x
     heat_in = np.diff(dissipated, prepend=dissipated[:1])

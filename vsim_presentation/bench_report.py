@@ -41,7 +41,9 @@ def _parameters(d: BenchDiagnosis, cause: Cause | None = None) -> dict[str, Any]
     """The named causes' fitted values (of ``cause`` only, one of them, if given)."""
     if not d.named:
         return {}
-    return {p.name: {"value": d.best.final[p.name], "std": d.best.std.get(p.name, math.nan), "unit": p.unit}
+    # an uncertainty the tests cannot bound (a parameter they do not see) is null: JSON has no infinity
+    std = lambda name: d.best.std.get(name) if math.isfinite(d.best.std.get(name, math.nan)) else None
+    return {p.name: {"value": d.best.final[p.name], "std": std(p.name), "unit": p.unit}
             for p in (cause or d.best.cause).parameters}
 
 
@@ -88,7 +90,8 @@ def verdict_sentence(d: BenchDiagnosis) -> str:
         best = d.ranking[0] if d.ranking else None
         partial = f"; the best catalogue cause, {best.cause.id}, only brings it to {best.heldout_error:.2%}" if best else ""
         return f"The mismatch is real ({before:.2%} held-out error) but no catalogue cause explains it{partial}."
-    named = " and ".join(f"**{c.id}** (" + ", ".join(f"{k} = {v['value']:.4g} ± {v['std']:.2g} {v['unit']}"
+    pm = lambda v: f"± {v['std']:.2g} {v['unit']}" if v["std"] is not None else f"{v['unit']}, not seen by the tests"
+    named = " and ".join(f"**{c.id}** (" + ", ".join(f"{k} = {v['value']:.4g} {pm(v)}"
                                                      for k, v in _parameters(d, c).items()) + ")"
                          for c in parts(d.verdict))
     sentence = (f"Cause{'s' if PAIR_SEPARATOR in d.verdict else ''}: {named}; held-out error {before:.2%} → "

@@ -10,7 +10,8 @@ joint stiffness and damping implicitly, forces written to ``qfrc_applied`` expli
   its state extensions, if any) gives F(e) at the current deflections and only F(e) − K_ref·e is
   applied explicitly. That remainder's stiffness lies in [−Kpa, 0] ⊂ (−K_ref, 0], so the explicit
   part can never destabilise the implicit one (laws that may stiffen beyond K_ref, the nonlinear
-  elastic saturation and any law with effects, get K_ref raised to their current tangent each step);
+  elastic saturation and any law with effects, get K_ref raised to their current tangent each step,
+  never below K0 + Kpa plus the stiffness of a slipping interface, which comes back at every reversal);
 * a bushing's directional coupling (cross stiffness k between two of its directions) is applied
   explicitly; k² < K0_a·K0_b (checked on loading) keeps the coupled tangent positive definite,
   which is also what keeps that explicit term below the implicit diagonal;
@@ -80,6 +81,10 @@ class BushingForces:
         self.K_ref = self.K[self.bank_idx].copy()
         self.saturating = np.array([math.isfinite(p.S_sup) or math.isfinite(p.S_inf) or fx.active
                                     for p, fx in zip(params, effects)], dtype=np.bool_)
+        #: the least K_ref of each bank channel [N/m or N·m/rad]: its joint's, and a slipping interface's
+        #: stiffness on top (its tangent comes back at every reversal, a step before K_ref would follow)
+        self.K_floor = self.K[self.bank_idx] + np.array([fx.slip_stiffness * p.K0 if fx.slip_force > 0.0 else 0.0
+                                                         for p, fx in zip(params, effects)])
         index = {c.joint: i for i, c in enumerate(channels)}
         #: (P, 2) channel indices of each cross term's two directions, and its stiffness k (P,)
         self.cross_channels = np.array([[index[t.joint_a], index[t.joint_b]] for t in cross],
@@ -94,7 +99,7 @@ class BushingForces:
             e = d.qpos[self.bank_qpos]
             force, tangent = self.bank.step(e, dt)
             if self.saturating.any():
-                self.K_ref[:] = np.where(self.saturating, np.maximum(self.K[self.bank_idx], tangent), self.K_ref)
+                self.K_ref[:] = np.where(self.saturating, np.maximum(self.K_floor, tangent), self.K_ref)
                 self.model.jnt_stiffness[self.bank_jnt] = self.K_ref
             d.qfrc_applied[self.bank_dof] += self.K_ref * e - force
         if self.cross_k.size:

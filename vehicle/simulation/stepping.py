@@ -66,7 +66,7 @@ def coupling_step(h, qpos, qvel, qfrc, ten_length, ten_velocity, ten_J, ten_J_ro
                   jnt_stiffness, dof_damping, tendon_damping, bush, bank, cross, damp, spring):
     """Write the non-implicit forces for the next step of ``h`` [s] (see vehicle.simulation.coupling).
 
-    ``bush`` = (qpos adr, dof adr, joint ids, base stiffness, K_ref, saturating, e work) of the
+    ``bush`` = (qpos adr, dof adr, joint ids, least K_ref, K_ref, saturating, e work) of the
     bank channels, ``bank`` = :meth:`bushings.extended_bank.ExtendedBank.kernel_args`, ``cross`` = (qpos adr
     (P, 2), dof adr (P, 2), stiffness (P,)) of the cross stiffnesses, ``damp`` = (is joint, dof or
     tendon index, sign, xs, ys, intercept out [N], work), ``spring`` = (is joint, index, qpos adr,
@@ -263,8 +263,9 @@ def coupling_arrays(coupling) -> tuple:
     b = coupling.bushings
     on = b.bank is not None  # None: laws off, every direction linear in its joint
     idx = b.bank_idx if on else np.zeros(0, np.int64)
-    bush = (b.qpos[idx].astype(np.int64), b.dof[idx].astype(np.int64), b.jnt[idx].astype(np.int64), b.K[idx].copy(),
-            b.K_ref if on else np.zeros(0), b.saturating if on else np.zeros(0, np.bool_), np.zeros(idx.size))
+    bush = (b.qpos[idx].astype(np.int64), b.dof[idx].astype(np.int64), b.jnt[idx].astype(np.int64),
+            b.K_floor if on else np.zeros(0), b.K_ref if on else np.zeros(0),
+            b.saturating if on else np.zeros(0, np.bool_), np.zeros(idx.size))
     bank = (b.bank if on else _xb.ExtendedBank([])).kernel_args()
     # the cross stiffnesses are linear and stay on when the laws are off
     cross = (b.qpos[b.cross_channels].astype(np.int64), b.dof[b.cross_channels].astype(np.int64), b.cross_k)

@@ -1,0 +1,63 @@
+"""Where a cause's fit starts and within which bounds (vsim_diagnosis.fit_starts): one side per
+catalogue family for its sided parameters, each side fitted within bounds that stop at zero."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from vsim_diagnosis.catalogue import CAUSES, combined
+from vsim_diagnosis.fit_starts import corner_starts, fit_bounds, side_starts, sides_apart, to_fit
+
+ASYMMETRY, PRELOAD, MULLINS = CAUSES["asymmetry"], CAUSES["preload"], CAUSES["mullins"]
+
+
+def test_corners_keep_a_family_on_one_side():
+    """Asymmetry (rate and kink sided, power not): 2 sides × 2 × 2 magnitudes × 2 powers = 16
+    corners, never the kink on one side and the progressive part on the other."""
+    starts = corner_starts(ASYMMETRY)
+    assert starts.shape == (16, 3)
+    rate, kink, power = starts.T
+    assert np.all(np.sign(rate) == np.sign(kink)) and (rate > 0).sum() == 8
+    np.testing.assert_allclose(np.unique(np.abs(kink)), ASYMMETRY.parameters[1].draw)
+    np.testing.assert_allclose(np.unique(power), ASYMMETRY.parameters[2].draw)
+
+
+def test_a_pair_of_sided_families_is_fitted_on_each_of_its_four_sides():
+    pair = combined(ASYMMETRY, PRELOAD)
+    starts = corner_starts(pair)
+    sides = sides_apart(pair, starts)
+    assert len(sides) == 4 and sum(on.sum() for on, _, _ in sides) == len(starts) == 16 * 4
+    lo, hi = fit_bounds(pair)
+    for on, lo_k, hi_k in sides:
+        z = starts[on]
+        assert np.all((z >= lo_k) & (z <= hi_k))
+        for idx in ([0, 1], [3]):   # each family's sided parameters bounded at zero on their side
+            positive = z[0, idx[0]] > 0
+            np.testing.assert_array_equal(lo_k[idx], 0.0 if positive else lo[idx])
+            np.testing.assert_array_equal(hi_k[idx], hi[idx] if positive else 0.0)
+        assert (lo_k[2], hi_k[2]) == (lo[2], hi[2])   # the power is not sided
+
+
+def test_a_start_is_tried_on_each_side_and_a_zero_takes_the_weak_end_of_its_range():
+    values = {"asymmetry": 0.1, "asymmetry_step": 0.0, "asymmetry_power": 1.5, "preload": -2.0}
+    pair = combined(ASYMMETRY, PRELOAD)
+    starts = side_starts(pair, values)
+    weak = ASYMMETRY.parameters[1].draw[0]
+    assert starts.shape == (4, 4)
+    assert {tuple(np.sign(s[[0, 1, 3]])) for s in starts} == {(1, 1, 1), (1, 1, -1), (-1, -1, 1), (-1, -1, -1)}
+    np.testing.assert_allclose(np.abs(starts), np.tile([0.1, weak, 1.5, 2.0], (4, 1)))
+    assert any(np.array_equal(s, [0.1, weak, 1.5, -2.0]) for s in starts)   # the start itself, kept
+
+
+def test_a_cause_without_a_sided_parameter_has_one_side_and_its_own_bounds():
+    starts = corner_starts(MULLINS)
+    (on, lo, hi), = sides_apart(MULLINS, starts)
+    assert on.all()
+    np.testing.assert_array_equal(np.c_[lo, hi], np.c_[fit_bounds(MULLINS)])
+    np.testing.assert_allclose(np.unique(starts[:, 1]), np.log(MULLINS.parameters[1].draw))
+    np.testing.assert_allclose(to_fit(MULLINS, {"mullins": 0.2, "mullins_shape": math.e}), [0.2, 1.0])
+    with pytest.raises(ValueError, match="no starting point"):
+        sides_apart(MULLINS, starts[:0])
