@@ -7,9 +7,8 @@ Two kinds, both switched on per channel and off by default:
   slider friction on them (:func:`with_friction`), and broad-spectrum relaxation as a Prony series
   fitted to a fractional (power-law) relaxation modulus (:func:`with_broad_relaxation`);
 * state extensions (:class:`Effects`): preload (operating-point shift), tension/compression
-  asymmetry, Mullins softening, self-heating, a slipping interface and a backlash dead band, applied
-  around the base law
-  by the compiled wrapper of :mod:`bushings.extended_bank`.
+  asymmetry, Mullins softening, self-heating, a slipping interface and a backlash dead band,
+  applied around the base law by the compiled wrapper of :mod:`bushings.extended_bank`.
 """
 
 from __future__ import annotations
