@@ -24,7 +24,7 @@ from tests.diagnosis_helpers import (MIN_PAIR_SUCCESS_RATE, MIN_SUCCESS_RATE, PA
                                      diagnose_fresh, measure)
 from vsim_diagnosis.bench_alike import REST_BEFORE_S, Programme, extra_programmes, load_cell_noise_n, separations
 from vsim_diagnosis.catalogue import CAUSES, PAIR_SEPARATOR
-from vsim_diagnosis.truth_forms import BOX_PER_DECADE, BOX_TAU_MIN_S, FORMS
+from vsim_diagnosis.truth_forms import BOX_PER_DECADE, BOX_TAU_MIN_S, FORMS, box_taus
 from vsim_diagnosis.verdict import pair_shares
 from vsim_diagnosis.virtual_bench import OUTSIDE
 
@@ -217,8 +217,7 @@ def test_a_parallel_dashpot_dissipates_pi_c_omega_a_squared_a_cycle():
     t = np.arange(0.0, 2.0 * np.pi / omega + dt / 2, dt)
     x = amplitude * np.sin(omega * t)
     force = FORMS["viscous_parallel"].change(x, np.zeros_like(x), 5e5, {"dashpot": c_mm}, {}, dt, 0.0)
-    area = float(np.sum(0.5 * (force[1:] + force[:-1]) * np.diff(x)))
-    assert area == pytest.approx(np.pi * c_mm * 1e3 * omega * amplitude ** 2, rel=1e-3)
+    assert _loop_area(x, force) == pytest.approx(np.pi * c_mm * 1e3 * omega * amplitude ** 2, rel=1e-3)
     held = FORMS["viscous_parallel"].change(np.full(10, amplitude), np.ones(10), 5e5, {"dashpot": c_mm}, {}, dt, 0.0)
     assert np.array_equal(held, np.ones(10))
 
@@ -318,8 +317,8 @@ def test_box_relaxation_falls_by_a_decades_branches_each_decade_and_relaxes_at_r
     x = np.where(t > 0.0, x0, 0.0)
     state: dict = {}
     force = FORMS["relaxation_box"].change(x, np.zeros_like(x), 1.0, values, state, dt, 0.0)
-    taus = BOX_TAU_MIN_S * 10.0 ** ((np.arange(BOX_PER_DECADE * 12) + 0.5) / BOX_PER_DECADE)
-    taus = taus[taus < tau_max]
+    taus = box_taus(tau_max)
+    assert taus[0] == pytest.approx(BOX_TAU_MIN_S * 10 ** (0.5 / BOX_PER_DECADE)) and taus[-1] < tau_max
     per_decade = k_mm * 1e3 * BOX_PER_DECADE / len(taus) * x0
     at = lambda s: force[int(round(s / dt))]
     for start in (0.1, 1.0):

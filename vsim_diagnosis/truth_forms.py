@@ -162,9 +162,15 @@ def _two_node(x, force, k0, v, state, dt_s, rest_s):
     return force * np.exp(-v["heating_exp"] * 1e-3 * np.maximum(core, 0.0))
 
 
-def _box(x, force, k0, v, state, dt_s, rest_s):
+def box_taus(tau_max_s: float) -> np.ndarray:
+    """Relaxation times [s] of the box spectrum's branches up to ``tau_max_s``: BOX_PER_DECADE a
+    decade from BOX_TAU_MIN_S, at the middle of each slice of log τ."""
     taus = BOX_TAU_MIN_S * 10.0 ** ((np.arange(BOX_PER_DECADE * 12) + 0.5) / BOX_PER_DECADE)
-    taus = taus[taus < v["box_tau_max_s"]]
+    return taus[taus < tau_max_s]
+
+
+def _box(x, force, k0, v, state, dt_s, rest_s):
+    taus = box_taus(v["box_tau_max_s"])
     k = v["box_k"] * MM_PER_M / len(taus)   # N/m each branch
     branch = state.get("branch", np.zeros(len(taus)))
     x_last = state.get("x", 0.0)
