@@ -351,14 +351,15 @@ def _named_as_family(result: dict, form: str) -> str:
 
 #: Other forms drawn in the default suite (all of truth_forms.FORMS in the slow one: the two-node
 #: heating's and the box spectrum's diagnoses take a minute each on 2 cores).
-DEFAULT_FORMS = ["asymmetry_smooth_kink", "asymmetry_exponential", "mullins_ogden", "dahl_parallel"]
+DEFAULT_FORMS = ["asymmetry_smooth_kink", "asymmetry_exponential", "mullins_ogden", "dahl_parallel", "viscous_parallel"]
 
 
 @pytest.mark.parametrize("form", DEFAULT_FORMS)
 def test_another_form_of_a_family_is_named_as_the_family(tmp_path, form):
     """A form the catalogue does not write (truth_forms: a kink smoothed over a width, an exponential
-    stiffening, Ogden-Roxburgh softening, Dahl's friction) is named as its family, explained at least
-    in part, with most of the mismatch beyond the noise removed (not a confident other cause)."""
+    stiffening, Ogden-Roxburgh softening, Dahl's friction, a dashpot alone) is named as its family,
+    explained at least in part, with most of the mismatch beyond the noise removed (not a confident
+    other cause)."""
     baseline, _, measured = measure(tmp_path, form, SEEDS[0])
     result = diagnose_fresh(measured, baseline)
     _named_as_family(result, form)

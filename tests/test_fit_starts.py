@@ -14,15 +14,32 @@ from vsim_diagnosis.fit_starts import corner_starts, fit_bounds, side_starts, si
 ASYMMETRY, PRELOAD, MULLINS = CAUSES["asymmetry"], CAUSES["preload"], CAUSES["mullins"]
 
 
-def test_corners_keep_a_family_on_one_side():
+def test_corners_keep_a_family_on_one_side_and_start_its_other_form_alone():
     """Asymmetry (rate and kink sided, power not): 2 sides × 2 × 2 magnitudes × 2 powers = 16
-    corners, never the kink on one side and the progressive part on the other."""
+    corners, never the kink on one side and the progressive part on the other; then the kink alone
+    (the progressive part off, its power at rest) at its 2 × 2 signed magnitudes, each point once."""
     starts = corner_starts(ASYMMETRY)
-    assert starts.shape == (16, 3)
+    assert starts.shape == (16 + 4, 3) and len(np.unique(starts, axis=0)) == len(starts)
     rate, kink, power = starts.T
-    assert np.all(np.sign(rate) == np.sign(kink)) and (rate > 0).sum() == 8
+    assert np.all(np.sign(rate[:16]) == np.sign(kink[:16])) and (rate > 0).sum() == 8
     np.testing.assert_allclose(np.unique(np.abs(kink)), ASYMMETRY.parameters[1].draw)
     np.testing.assert_allclose(np.unique(power), ASYMMETRY.parameters[2].draw)
+    alone = starts[16:]
+    np.testing.assert_array_equal(alone[:, [0, 2]], np.tile([0.0, 1.0], (4, 1)))
+    np.testing.assert_allclose(np.sort(alone[:, 1]), np.r_[-np.array(ASYMMETRY.parameters[1].draw)[::-1],
+                                                         ASYMMETRY.parameters[1].draw])
+    # one side per point: the kink alone takes its side from the kink (the rate is zero)
+    assert len(sides_apart(ASYMMETRY, starts)) == 2
+
+
+def test_the_viscous_family_starts_its_dashpot_alone():
+    """The dashpot alone (the ladder's dampers at the bound Co = 0.1) is a start, with the dashpot at
+    each end of its realistic range: a fit from the dampers' corners stops far from it."""
+    cause = CAUSES["viscoelasticity_missing"]
+    starts = corner_starts(cause)
+    alone = starts[np.isclose(starts[:, 0], math.log(cause.parameters[0].bounds[0]))]
+    np.testing.assert_allclose(alone[:, 2], cause.parameters[2].draw)
+    assert len(starts) == 8 + 2
 
 
 def test_a_pair_of_sided_families_is_fitted_on_each_of_its_four_sides():

@@ -99,6 +99,38 @@ def test_mullins_and_heating_act_in_the_vehicle_as_in_their_extended_bank(vehicl
             assert np.abs(vehicle_force - bare).max() > 0.03 * peak, target
 
 
+def test_a_slipping_interface_acts_as_in_its_bank_and_the_reference_stiffness_holds_its_stick(vehicle):
+    """An interface slipping at 80 N with 2·K0 before slip on e1_rear.z: the vehicle's force
+    history equals its ExtendedBank replayed on the recorded deflections (1e-9 of the peak), and the
+    force's slope from step to step never exceeds the reference stiffness K_ref the joint carried
+    (1e-6), whose floor is the joint's K plus the interface's 2·K0: at every reversal the stuck
+    interface brings its stiffness back at once, 1.5 times and more the joint's alone."""
+    target = "e1_rear.z"
+    v = with_extensions(vehicle, effects={target: {"slip_force": 80.0, "slip_stiffness": 2.0}})
+    rig = KCRig(v)
+    b = rig.coupling.bushings
+    i = [ch.name for ch in rig.car.channels].index("e1_rear_left.z")
+    j = list(b.bank_idx).index(i)
+    K0 = rig.car.channels[i].params.K0
+    assert b.K_floor[j] == pytest.approx(b.K[i] + 2.0 * K0, rel=1e-12)
+    h, steps = rig.model.opt.timestep, 3000
+    e, f, k_ref = np.empty(steps), np.empty(steps), np.empty(steps)
+    for s in range(steps):
+        t = s * h
+        rig.set_pads([0.03 * t / (steps * h) * math.sin(4 * math.pi * t)] * 4)
+        e[s], k_ref[s] = b.deflections()[i], b.K_ref[j]   # the stiffness the joint carries in this step
+        rig.step(1)
+        f[s] = b.bank.force[j]
+    bushing, direction = target.split(".")
+    law = next(bu for bu in v.bushings if bu.name == bushing).directions[direction]
+    replay = ExtendedBank([law.channel()], [law.effects_si()]).run(e, h)[:, 0]
+    assert np.abs(f - replay).max() <= 1e-9 * np.abs(f).max() and np.abs(f).max() > 500.0
+    moved = np.abs(np.diff(e)) > 1e-7
+    secant = (np.diff(f) / np.where(moved, np.diff(e), 1.0))[moved]
+    assert np.all(secant <= k_ref[1:][moved] * (1.0 + 1e-6))
+    assert secant.max() > 1.5 * b.K[i]   # the stick the floor holds: a tangent-following K_ref lags it
+
+
 def test_preload_keeps_design_pad_forces_and_moves_the_tangent_along_the_elastic_law(tmp_path):
     """e1_rear.z on a progressive law (fig5_6_progressive), with and without a 4 mm preload from
     the vehicle file: mounted at design with zero force, so the pad forces at design height stay

@@ -68,6 +68,11 @@ class Cause(Entry):
     applies: Callable[[ParameterSet], bool]
     #: (params, effects, fitted values) -> extended (params, effects), all in parameter-set units
     extend: Callable[[dict[str, Any], dict[str, Any], Mapping[str, float]], tuple[dict[str, Any], dict[str, Any]]]
+    #: a family's other forms alone: each the values that switch its first form off (and leave its shape
+    #: parameters at rest), a start of the fits over the corners of the parameters it leaves
+    #: (:func:`vsim_diagnosis.fit_starts.corner_starts`): a fit from the first form's corners does not
+    #: reach a form that needs them off
+    other_forms: tuple[Mapping[str, float], ...] = ()
 
     def apply(self, base: ParameterSet, values: Mapping[str, float], source: str = "") -> ParameterSet:
         """The baseline set extended by this cause with ``values``."""
@@ -146,7 +151,8 @@ CAUSES: dict[str, Cause] = {c.id: c for c in (
            Parameter("pw", "-", (0.03, 1.0), (0.1, 0.3), description="damper exponent"),
            Parameter("C", "N·s/mm", (0.0, 10.0), (0.0, 1.0), default=0.0,
                      description="linear dashpot in parallel with the whole law")),
-          lambda b: _ladder(b) and b.values.get("Co", 0.0) == 0.0, _viscosity),
+          lambda b: _ladder(b) and b.values.get("Co", 0.0) == 0.0, _viscosity,
+          ({"Co": 0.1, "pw": 0.1},)),     # the dashpot alone: the ladder's dampers at their least
     # a family (issue 29): friction inside the rubber (the ladder's sliders, the thesis's STVS) and at
     # an interface of the part that slips as a whole (a Jenkins element, spring and Coulomb slider, in
     # parallel: Iwan 1966's element, the sharp limit of Berg 1998's), whose stiffness before slip sets
@@ -163,7 +169,8 @@ CAUSES: dict[str, Cause] = {c.id: c for c in (
                      description="force at which an interface in parallel with the law slips"),
            Parameter("slip_stiffness", "-", (0.01, 5.0), (0.2, 0.5), log=True, default=1.0,
                      description="the interface's stiffness before it slips, a fraction of K0")),
-          lambda b: _ladder(b) and b.values.get("Co", 0.0) > 0.0, _friction),
+          lambda b: _ladder(b) and b.values.get("Co", 0.0) > 0.0, _friction,
+          ({"Ff": 0.0, "co_scale": 1.0},)),     # the slipping interface alone
     Cause("preload",
           "static load shifts the part's operating point along its nonlinear elastic law and leaves its "
           "hysteresis on a loading branch",
@@ -185,7 +192,8 @@ CAUSES: dict[str, Cause] = {c.id: c for c in (
                      description="extra tangent fraction of K0 from zero deflection; > 0 stiffens compression"),
            Parameter("asymmetry_power", "-", (1.0, 3.0), (1.0, 2.0), default=1.0,
                      description="power n of the progressive part: the extra tangent grows as |x|^n")),
-          lambda b: b.values.get("K0", 0.0) > 0.0, _asymmetry),
+          lambda b: b.values.get("K0", 0.0) > 0.0, _asymmetry,
+          ({"asymmetry": 0.0, "asymmetry_power": 1.0},)),     # the kink alone
     # the recovery's shape (issue 29): a power of |x|/x_max, 1 the linear recovery, as the families of
     # Ogden & Roxburgh (1999) and Dorfmann & Ogden (2004) bend it with the past maximum's energy
     Cause("mullins",

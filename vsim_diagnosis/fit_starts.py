@@ -15,7 +15,7 @@ import math
 
 import numpy as np
 
-from vsim_diagnosis.catalogue import Cause, parts
+from vsim_diagnosis.catalogue import Cause, Parameter, parts
 
 
 def fit_bounds(cause: Cause) -> tuple[np.ndarray, np.ndarray]:
@@ -62,19 +62,31 @@ def _points(axes: list[np.ndarray]) -> np.ndarray:
 
 def corner_starts(cause: Cause) -> np.ndarray:
     """Starting points: the corners of the realistic range (both signs for signed parameters, one
-    side per family for sided ones; the middle of the range for a cause of one parameter)."""
+    side per family for sided ones; the middle of the range for a cause of one parameter), then each
+    of the family's other forms alone (``Cause.other_forms``) over the corners of the parameters it
+    leaves, each point once."""
     axes = []
     for p in cause.parameters:
         pts = np.log(p.draw) if p.log else np.array(p.draw, dtype=float)
         if len(cause.parameters) == 1:
             pts = np.array([pts.mean()])
         axes.append(np.r_[-pts[::-1], pts] if p.signed else pts)
-    return _one_side_per_family(cause, _points(axes))
+    grids = [_points(axes)]
+    for form in cause.other_forms:
+        grids.append(_points([np.array([_coordinate(p, form[p.name])]) if p.name in form else axis
+                              for p, axis in zip(cause.parameters, axes)]))
+    points = _one_side_per_family(cause, np.vstack(grids))
+    return points[np.sort(np.unique(points, axis=0, return_index=True)[1])]
 
 
 def to_fit(cause: Cause, values: dict[str, float]) -> np.ndarray:
     """``values`` of ``cause``'s parameters in fit coordinates."""
-    return np.array([math.log(values[p.name]) if p.log else values[p.name] for p in cause.parameters])
+    return np.array([_coordinate(p, values[p.name]) for p in cause.parameters])
+
+
+def _coordinate(p: Parameter, value: float) -> float:
+    """A parameter's ``value`` in fit coordinates."""
+    return math.log(value) if p.log else value
 
 
 def side_starts(cause: Cause, values: dict[str, float]) -> np.ndarray:
