@@ -13,7 +13,7 @@ import pytest
 from vehicle.model.definition import CORNERS
 from vehicle.scenarios.channels import CORNER_TAGS, INPUT_CHANNELS, csv_columns
 from vehicle.scenarios.scenario import MAX_TIMESTEP_S, MIN_TIMESTEP_S
-from vehicle.scenarios.scenario_file import load_scenario, parse_scenario
+from vehicle.scenarios.scenario_file import load_scenario, parse_scenario, with_case_values
 from vehicle.scenarios.schedule import check_timestep, output_interval, timestep
 from vsim_core.errors import InputError
 from vsim_core.shipped import DEFAULT_VEHICLE
@@ -271,3 +271,22 @@ def test_a_step_experiments_control_is_the_same_input_without_its_last_step() ->
     assert not np.any(single.inputs(t))
     with pytest.raises(ValueError, match="no last ramp"):
         load_scenario("pumping").cases[0].without_last_step()
+
+
+def test_a_value_set_in_every_case_ramps_each_step_over_it_and_a_key_the_cases_lack_is_refused() -> None:
+    """with_case_values: each step of a double rack step ramped in 0.5 s instead of 0.05 (its level
+    reached 0.5 s after each ramp starts, half of it a quarter of a second in: a linear ramp), the
+    holds as they were; the changed text is the scenario's; a key its cases do not take names it."""
+    shipped = load_scenario("double_rack_step_opposite")
+    slow = with_case_values(shipped, {"rise_time_s": 0.5}, "slow steps")
+    case, before = slow.cases[0], shipped.cases[0]
+    np.testing.assert_allclose(np.diff(case.waveform.times_s)[1::2], np.diff(before.waveform.times_s)[1::2])
+    rack = INPUT_CHANNELS.index("rack")
+    for start, level, previous in ((0.0, case.waveform.values[1], 0.0),
+                                   (case.waveform.times_s[2], case.waveform.values[3], case.waveform.values[1])):
+        at = case.inputs(np.array([start + 0.25, start + 0.5]))[:, rack]
+        np.testing.assert_allclose(at, [0.5 * (previous + level), level], rtol=1e-12)
+    assert case.duration_s == pytest.approx(before.duration_s + 2 * 0.45)
+    assert "rise_time_s: 0.5" in slow.text and slow.path == shipped.path
+    with pytest.raises(InputError, match=r"^slow steps:\d+: .*amplitude_mm"):
+        with_case_values(shipped, {"amplitude_mm": 1.0}, "slow steps")

@@ -27,7 +27,7 @@ from bushings.parameter_sets import load_parameter_set  # noqa: E402
 from vehicle.model.file_overrides import lossier_places, vehicle_with  # noqa: E402
 from vehicle.model.definition import DirectionDef  # noqa: E402
 from vehicle.model.vehicle_file import load_vehicle  # noqa: E402
-from vehicle.scenarios.scenario_file import load_scenario, parse_scenario  # noqa: E402
+from vehicle.scenarios.scenario_file import load_scenario, with_case_values  # noqa: E402
 from vsim_analysis.run_metrics import case_lag_s, case_loop, case_mask, case_relaxation, cases  # noqa: E402
 from vsim_cluster.executor import executor  # noqa: E402
 from vsim_core.shipped import DEFAULT_VEHICLE  # noqa: E402
@@ -91,10 +91,7 @@ def _run(job: tuple[str, str, str | None, tuple]) -> tuple[str, dict]:
     label, name, model, values = job
     scenario = load_scenario(name)
     if label.endswith("_slow"):
-        slow = scenario.text.replace("rise_time_s: 0.05", f"rise_time_s: {SLOW_RISE_S}")
-        if slow == scenario.text:
-            raise RuntimeError(f"{name}: no 'rise_time_s: 0.05' to slow down in the scenario file")
-        scenario = parse_scenario(slow, scenario.path)
+        scenario = with_case_values(scenario, {"rise_time_s": SLOW_RISE_S}, f"{name} ({label})")
     if label.startswith("toe_lag"):   # the toe's lag is a few milliseconds: sampled every one
         scenario = replace(scenario, output_rate_hz=1000.0)
     if model is not None:   # "file": the vehicle file's own laws, whatever the scenario says

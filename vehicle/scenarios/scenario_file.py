@@ -9,6 +9,7 @@ Values in the file carry their unit in the key name (``amplitude_mm``, ``amplitu
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Mapping
 
 import numpy as np
 
@@ -20,7 +21,7 @@ from vehicle.scenarios.scenario import (BISINE_INPUTS, MAX_FREQUENCY_HZ, MAX_INP
                                         SIGNAL_TYPES, TYPES, Case, InputTable, Limits, Scenario, Settle, Waveform)
 from vehicle.scenarios.scenario_fields import LIMIT_KEYS, case_fields, limit_values, output_rate, scenario_name, vehicle_file
 from vsim_core import units
-from vsim_core.documents import Document, Fields
+from vsim_core.documents import Document, Fields, dump_yaml
 from vsim_core.errors import InputError
 from vsim_core.files import is_file, read_text
 from vsim_core.shipped import SCENARIO_DIR, resolve
@@ -211,6 +212,16 @@ def load_scenario(path: str | Path) -> Scenario | RoadScenario:
     key and value."""
     path = resolve(path, SCENARIO_DIR, "scenario")
     return parse_scenario(read_text(path), path)
+
+
+def with_case_values(scenario: Scenario, values: Mapping[str, float], source: str) -> Scenario:
+    """``scenario`` with ``values`` set in every case (``{"rise_time_s": 0.5}``: each step ramped in
+    0.5 s), read again from its changed text, which its recordings then carry; errors (a key its
+    cases do not take, a value out of range) name ``source``."""
+    data = Document(scenario.text, str(scenario.path)).data
+    for case in data["cases"]:
+        case.update({key: float(value) for key, value in values.items()})
+    return parse_scenario(dump_yaml(data, sort_keys=False), scenario.path, source)
 
 
 def parse_scenario(text: str, path: Path, source: str | None = None) -> Scenario | RoadScenario:
