@@ -20,8 +20,8 @@ from bushings.effects import Effects, broad_relaxation_branches, effects_to_si
 from bushings.extended_bank import ExtendedBank
 from bushings.parameter_sets import load_parameter_set
 from vsim_core.errors import InputError
-from tests.diagnosis_helpers import (MIN_PAIR_SUCCESS_RATE, MIN_SUCCESS_RATE, PAIR, SLOW_SEEDS, assert_success_rate,
-                                     diagnose_fresh, measure)
+from tests.diagnosis_helpers import (MIN_PAIR_SUCCESS_RATE, MIN_SUCCESS_RATE, OWN_FORM_SUCCESS_RATE, PAIR, SLOW_SEEDS,
+                                     assert_success_rate, diagnose_fresh, measure)
 from vsim_diagnosis.bench_alike import REST_BEFORE_S, Programme, extra_programmes, load_cell_noise_n, separations
 from vsim_diagnosis.catalogue import CAUSES, PAIR_SEPARATOR
 from vsim_diagnosis.truth_forms import BOX_PER_DECADE, BOX_TAU_MIN_S, FORMS, box_taus
@@ -32,8 +32,6 @@ BENCH_CAUSES = sorted(CAUSES)
 #: Seeds per cause in the default suite (one, for time: each diagnosis takes 15-60 s); the slow
 #: suite (``pytest -m slow``) runs SLOW_SEEDS more.
 SEEDS = [int(os.environ.get("VSIM_TEST_SEED", "1"))]
-#: The slow suite's rate for a catalogue cause hidden in its own form (issue 29: single causes ≥ 95 %).
-OWN_FORM_SUCCESS_RATE = 0.95
 
 
 def _check_named(result: dict, cause: str, effects: list[dict]) -> None:
