@@ -7,15 +7,16 @@ process on a copied directory."""
 from __future__ import annotations
 
 import json
+import math
 import os
 from dataclasses import replace
 from pathlib import Path
-from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
 from bushings.bench.programmes import TimeSeries
+from bushings.bench.records import sample_steps
 from bushings.effects import Effects, broad_relaxation_branches, effects_to_si
 from bushings.extended_bank import ExtendedBank
 from bushings.parameter_sets import load_parameter_set
@@ -23,6 +24,7 @@ from vsim_core.errors import InputError
 from tests.diagnosis_helpers import (MIN_PAIR_SUCCESS_RATE, MIN_SUCCESS_RATE, OWN_FORM_SUCCESS_RATE, PAIR, SLOW_SEEDS,
                                      assert_success_rate, diagnose_fresh, measure)
 from vsim_diagnosis.bench_alike import REST_BEFORE_S, Programme, extra_programmes, load_cell_noise_n, separations
+from vsim_diagnosis.bench_diagnosis import REST_STEP_S, Replay
 from vsim_diagnosis.catalogue import CAUSES, PAIR_SEPARATOR
 from vsim_diagnosis.truth_forms import BOX_PER_DECADE, BOX_TAU_MIN_S, FORMS, box_taus
 from vsim_diagnosis.verdict import pair_shares
@@ -413,6 +415,30 @@ def test_success_rate_over_many_seeds(tmp_path, record_property, cause):
                         MIN_PAIR_SUCCESS_RATE if cause == PAIR else OWN_FORM_SUCCESS_RATE if own else MIN_SUCCESS_RATE)
 
 
+def test_programmes_continue_the_history_as_one_replay_of_it_and_each_would():
+    """Replay.continued plays the history and the rest once and each programme from a copy of the
+    state they left: the forces are bit for bit those of one replay of history, rest and programme,
+    for parts whose state carries over (Mullins softening, heat, a slipping interface, a preload)."""
+    t = np.arange(0.0, 2.0, 1e-3)
+    history = 1e-3 * np.sin(2 * np.pi * 3 * t) * (1 + t)
+    replay = Replay(history, np.full(len(t), 1e-3), np.zeros(len(t), dtype=int), np.zeros(len(t)), ["one"],
+                    np.ones(1))
+    base = load_parameter_set("fig5_9_progressive")
+    models = [base, replace(base, effects={"mullins": 0.3, "heating": 2.0, "heating_tau_s": 20.0}),
+              replace(base, effects={"slip_force": 20.0, "slip_stiffness": 0.5, "preload": 1.0})]
+    signals = [(np.arange(0.0, 0.5, 2e-3), 5e-4 * np.sin(np.arange(0.0, 0.5, 2e-3) * 20)),
+               (np.arange(0.0, 1.0, 5e-3), np.full(200, 8e-4))]
+    continued = replay.continued(models, REST_BEFORE_S, signals)
+    n = math.ceil(REST_BEFORE_S / REST_STEP_S - 1e-9)
+    for (t_s, e_m), forces in zip(signals, continued):
+        whole = Replay(np.r_[history, np.zeros(n), e_m], np.r_[replay.dts, np.full(n, REST_BEFORE_S / n),
+                       sample_steps(t_s)], np.zeros(len(t) + n + len(t_s), dtype=int), np.zeros(len(t) + n + len(t_s)),
+                       ["one"], np.ones(1))
+        assert forces.shape == (3, len(t_s))
+        assert np.array_equal(forces, whole.simulate(models)[:, -len(t_s):])
+    assert not np.allclose(continued[1][0], continued[1][1], rtol=0.01)   # the effects' state shows
+
+
 def test_the_separating_programme_is_the_one_where_the_rivals_differ_most():
     """bench_alike.separations: every programme played after the part's history and a rest, the
     largest RMS difference in units of the load cell's noise, each prediction's mean removed; the
@@ -423,17 +449,16 @@ def test_the_separating_programme_is_the_one_where_the_rivals_differ_most():
     played = []
 
     class History:
-        def followed_by(self, t_s, e_m, rest_s):
+        def continued(self, models, rest_s, signals):
             played.append(rest_s)
-            return SimpleNamespace(simulate=lambda models: np.vstack(
-                [np.r_[np.zeros(7), m(e_m)] for m in models]))   # the history's samples come first
+            return [np.vstack([m(e_m) for m in models]) for _, e_m in signals]
 
     best, rival = (lambda e: 0 * e), (lambda e: 3.0 + 2.0 * e)   # the offset is a zero error: no difference
     (sep,) = separations(History(), [best, rival], 2.0, programmes)
     d = 2.0 * np.sin(6 * t) / 2.0
     assert sep.test == "apart" and sep.path == Path("apart.yaml")
     assert sep.difference == pytest.approx(np.sqrt(np.mean((d - d.mean()) ** 2)))
-    assert played == [REST_BEFORE_S] * 3
+    assert played == [REST_BEFORE_S]
     assert separations(History(), [best, rival], 2.0, []) == [None]
     assert load_cell_noise_n(np.array([0.01, 0.02, 0.04]), np.array([100.0, 100.0, 10.0])) == pytest.approx(1.0)
     # every shipped time-series programme is offered, the frequency sweep is not

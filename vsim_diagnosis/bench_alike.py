@@ -60,11 +60,10 @@ def load_cell_noise_n(noise: np.ndarray, scale: np.ndarray) -> float:
 class History(Protocol):
     """A part's history that the models can play (:class:`~vsim_diagnosis.bench_diagnosis.Replay`)."""
 
-    def followed_by(self, t_s: np.ndarray, e_m: np.ndarray, rest_s: float) -> "History":
-        """The history, a rest of ``rest_s`` [s] at zero deflection, then deflections ``e_m`` [m] at ``t_s`` [s]."""
-
-    def simulate(self, models: Sequence[ParameterSet]) -> np.ndarray:
-        """The forces [N] of every model along the history, one row each, from a virgin part."""
+    def continued(self, models: Sequence[ParameterSet], rest_s: float,
+                  signals: Sequence[tuple[np.ndarray, np.ndarray]]) -> list[np.ndarray]:
+        """The forces [N] of every model (one row each) along each signal (times [s], deflections
+        [m]) played after the history and a rest of ``rest_s`` [s] at zero deflection."""
 
 
 def separations(history: History, models: Sequence[ParameterSet], noise_n: float,
@@ -75,8 +74,8 @@ def separations(history: History, models: Sequence[ParameterSet], noise_n: float
     there is no programme."""
     if not programmes:
         return [None] * (len(models) - 1)
-    forces = [history.followed_by(p.signal.t_s, p.signal.e_m, REST_BEFORE_S).simulate(models)[:, -len(p.signal.t_s):]
-              for p in programmes]                                  # each (K, samples of the programme)
+    # each (K, samples of the programme)
+    forces = history.continued(models, REST_BEFORE_S, [(p.signal.t_s, p.signal.e_m) for p in programmes])
     out: list[Separation | None] = []
     for k in range(1, len(models)):
         apart = [difference(f[0][:, None], f[k][:, None], noise_n) for f in forces]

@@ -13,6 +13,7 @@ load-cell zero error is a nuisance fitted in closed form for every model alike.
 
 from __future__ import annotations
 
+import copy
 import itertools
 import math
 import os
@@ -78,20 +79,23 @@ class Replay:
         return cls(np.concatenate(e), np.concatenate(dts), np.concatenate(rec), np.concatenate(meas),
                    [r.name for r in data.records], scale)
 
-    def followed_by(self, t_s: np.ndarray, e_m: np.ndarray, rest_s: float) -> "Replay":
-        """The history to be played with, after it, a rest of ``rest_s`` at zero deflection and the
-        deflections ``e_m`` [m] at times ``t_s`` [s] (a uniform grid): for :meth:`simulate` only (no
-        record, no measured force)."""
+    def continued(self, models: Sequence[ParameterSet], rest_s: float,
+                  signals: Sequence[tuple[np.ndarray, np.ndarray]]) -> list[np.ndarray]:
+        """Forces (K, samples) of K candidate models along each signal (times [s] on a uniform grid,
+        deflections [m]) played after the history and a rest of ``rest_s`` at zero deflection, each
+        from the state the history and the rest left (the history played once)."""
+        bank = self._bank(models)
         n = max(1, math.ceil(rest_s / REST_STEP_S - 1e-9))
-        return Replay(np.concatenate([self.e, np.zeros(n), e_m]),
-                      np.concatenate([self.dts, np.full(n, rest_s / n), sample_steps(t_s)]),
-                      np.concatenate([self.record, np.full(n + len(t_s), -1)]),
-                      np.concatenate([self.measured, np.zeros(n + len(t_s))]), self.names, self.scale)
+        bank.run(np.r_[self.e, np.zeros(n)], np.r_[self.dts, np.full(n, rest_s / n)])
+        return [copy.deepcopy(bank).run(e_m, sample_steps(t_s)).T for t_s, e_m in signals]
 
     def simulate(self, models: Sequence[ParameterSet]) -> np.ndarray:
         """Forces (K, T) of K candidate models along the history, each from a virgin part."""
-        bank = ExtendedBank([m.channel() for m in models], [m.effects_si() for m in models], REPLAY_TOLERANCE_M)
-        return bank.run(np.repeat(self.e[:, None], len(models), axis=1), self.dts).T
+        return self._bank(models).run(self.e, self.dts).T
+
+    @staticmethod
+    def _bank(models: Sequence[ParameterSet]) -> ExtendedBank:
+        return ExtendedBank([m.channel() for m in models], [m.effects_si() for m in models], REPLAY_TOLERANCE_M)
 
     @cached_property
     def weights(self) -> np.ndarray:
