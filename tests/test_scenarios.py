@@ -281,6 +281,7 @@ def test_a_value_set_in_every_case_ramps_each_step_over_it_and_a_key_the_cases_l
     slow = with_case_values(shipped, {"rise_time_s": 0.5}, "slow steps")
     case, before = slow.cases[0], shipped.cases[0]
     np.testing.assert_allclose(np.diff(case.waveform.times_s)[1::2], np.diff(before.waveform.times_s)[1::2])
+    assert case.waveform.values == before.waveform.values   # the same levels, reached more slowly
     rack = INPUT_CHANNELS.index("rack")
     for start, level, previous in ((0.0, case.waveform.values[1], 0.0),
                                    (case.waveform.times_s[2], case.waveform.values[3], case.waveform.values[1])):
