@@ -20,8 +20,8 @@ from vsim_diagnosis.catalogue import Cause, Parameter, parts
 
 def fit_bounds(cause: Cause) -> tuple[np.ndarray, np.ndarray]:
     """Lower and upper bounds of ``cause``'s parameters in fit coordinates."""
-    lo = np.array([math.log(p.bounds[0]) if p.log else p.bounds[0] for p in cause.parameters])
-    hi = np.array([math.log(p.bounds[1]) if p.log else p.bounds[1] for p in cause.parameters])
+    lo = np.array([_coordinate(p, p.bounds[0]) for p in cause.parameters])
+    hi = np.array([_coordinate(p, p.bounds[1]) for p in cause.parameters])
     return lo, hi
 
 
