@@ -1,7 +1,8 @@
 """Diagnosis of a bushing-bench dataset (spec measured-data §2): replay the measured deflections
 through the baseline law, quantify the mismatch, fit every applicable cause of the catalogue on
-half of the tests, score it on the other half, and name the cause that explains the mismatch, or
-say that nothing significant is missing, or that the mismatch is real but unexplained. When the
+half of the tests, score it on the other half, and name the cause that explains the mismatch (or
+most of it, in part), or say that nothing significant is missing, or that the mismatch is real but
+unexplained (:func:`vsim_diagnosis.verdict.single_verdict`). When the
 best cause leaves a mismatch beyond the noise, every pair of causes is fitted the same way, and
 two are named when the pair removes most of what the best one left. A rival the tests cannot tell
 from a named cause is reported with the shipped programme that would (:mod:`vsim_diagnosis.bench_alike`).
@@ -32,8 +33,8 @@ from bushings.parameter_sets import ParameterSet
 from vsim_diagnosis.catalogue import PAIR_SEPARATOR, Cause, applicable, combined, parts
 from vsim_diagnosis.bench_alike import extra_programmes, load_cell_noise_n, separations
 from vsim_diagnosis.fit_starts import corner_starts, side_starts, sides_apart, to_fit
-from vsim_diagnosis.verdict import (Outcome, Separation, alike, decide, explained, pair_named, pair_shares,
-                                    second_cause_wanted, split)
+from vsim_diagnosis.verdict import (Outcome, Separation, alike, explained, pair_named, pair_shares, second_cause_wanted,
+                                    single_verdict, split)
 from vsim_recordings.bench_dataset import BenchDataset
 
 #: Penalty per fitted parameter on the held-out error used for ranking.
@@ -330,7 +331,7 @@ def diagnose_bench(data: BenchDataset, baseline: ParameterSet,
         before = aggregate(base_errors, heldout)
         floor = aggregate(noise, heldout)
         best = ranking[0] if ranking else None
-        verdict = decide(before, best.heldout_error if best else before, floor)
+        verdict = single_verdict(before, best.heldout_error if best else before, floor)
         pairs: list[Candidate] = []
         if best is not None and second_cause_wanted(before, best.heldout_error, floor):
             say(f"{best.cause.id} leaves {best.heldout_error:.4f} (noise {floor:.4f}): fitting every pair of causes")

@@ -28,7 +28,7 @@ a constant probe force is absorbed by the stick phase, and the mapped prediction
 the rear pivot bushing came out up to 18 times too small, with the wrong sign in half of the
 channels. Full runs cost more and are right.
 
-The verdict follows :func:`vsim_diagnosis.verdict.decide` with the noise as the floor. Every test
+The verdict follows :func:`vsim_diagnosis.verdict.single_verdict` with the noise as the floor. Every test
 the baseline does not fit is found (the baseline fitted nothing: training tests count), with where
 in it the misfit sits; a misfit the held-out tests taken together do not show (confined to a
 training test, or to a stretch) makes the verdict "unexplained", not "none".
@@ -53,7 +53,7 @@ from vsim_diagnosis.kc_catalogue import (BUSHING_CAUSES, VEHICLE_CAUSES, Hypothe
 from vsim_diagnosis.kc_fits import Candidate, Scorer, fit, fit_pair, kept, nominal, nudged, verify
 from vsim_diagnosis.kc_layout import Layout, run_job
 from vsim_diagnosis.verdict import (Outcome, Separation, decide, explained, misfit, misfit_stretch, pair_named,
-                                    pair_shares, second_cause_wanted, split)
+                                    pair_shares, second_cause_wanted, single_verdict, split)
 from vsim_recordings.kc_dataset import KCDataset
 
 #: Hypotheses re-run on the full vehicle after the screening.
@@ -248,7 +248,7 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, executor: Execut
             f"{best.heldout_error:.3f} -> {second.heldout_error:.3f}: both named")
         left = located_misfits(layout, scorer, second.simulated)
     else:
-        verdict = decide(before, best.heldout_error, 1.0, bool(found))
+        verdict = single_verdict(before, best.heldout_error, 1.0, bool(found))
         say(f"{best.hypothesis.label}: held-out error {before:.3f} -> {best.heldout_error:.3f}: {verdict}")
     left = left if verdict == "named" else []
     for m in left:

@@ -18,6 +18,11 @@ MIN_GAIN = 0.10
 #: A cause is named when the mismatch beyond noise it leaves on held-out tests is at most this
 #: fraction of the baseline's (i.e. it explains at least 1 − 0.35² ≈ 88 % of the excess variance).
 MAX_EXCESS_LEFT = 0.35
+#: A cause that leaves more is still named, as explaining the mismatch in part, when the mismatch is
+#: significant and it leaves at most this fraction of its excess (explains at least 75 % of the excess
+#: variance): another form of a catalogued effect that its family follows only in part is its family's,
+#: not "unexplained" (single_verdict).
+MAX_EXCESS_LEFT_IN_PART = 0.5
 #: A baseline whose held-out error is within this factor of the noise floor fits the data.
 NOISE_FACTOR = 1.5
 #: The verdicts that name no cause (any other verdict is a catalogue id).
@@ -91,14 +96,22 @@ def explained(verdict: str, before: float, after: float, floor: float, misfit_le
     """How much of the mismatch a verdict explains: ``full``, ``partial`` or ``none``, and the share
     of the baseline's excess over the noise (in variance, on the held-out tests) that the named
     cause removes: 1 − excess_after² / excess_before². A named cause explains partly when the
-    held-out error it leaves is beyond NOISE_FACTOR times the noise ``floor`` or ``misfit_left``
-    (a test it still does not fit); "none" (nothing missing) is fully explained by the baseline,
+    held-out error it leaves is beyond NOISE_FACTOR times the noise ``floor``, ``misfit_left`` (a
+    test it still does not fit), or it leaves more of the excess than MAX_EXCESS_LEFT (named by
+    :func:`single_verdict` in part); "none" (nothing missing) is fully explained by the baseline,
     "unexplained" not at all."""
     if verdict == "none":
         return "full", 1.0
     if verdict == "unexplained":
         return "none", 0.0
-    return ("partial" if after > NOISE_FACTOR * floor or misfit_left else "full"), share(before, after, floor)
+    in_part = (after > NOISE_FACTOR * floor or misfit_left
+               or _excess(after, floor) > MAX_EXCESS_LEFT * _excess(before, floor))
+    return ("partial" if in_part else "full"), share(before, after, floor)
+
+
+def _excess(error: float, floor: float) -> float:
+    """The part of a relative RMS ``error`` beyond the noise ``floor``: √(error² − floor²), or 0."""
+    return math.sqrt(max(error ** 2 - floor ** 2, 0.0))
 
 
 def decide(before: float, after: float, floor: float, misfit_seen: bool = False) -> str:
@@ -106,11 +119,22 @@ def decide(before: float, after: float, floor: float, misfit_seen: bool = False)
     and the noise floor (all relative RMS); ``misfit_seen``: the baseline does not fit some test
     (:func:`misfit`, training or held out): then a baseline that fits the held-out tests taken
     together is not "none" but "unexplained" (a local misfit, on which no cause can be judged)."""
-    excess_before = math.sqrt(max(before ** 2 - floor ** 2, 0.0))
-    excess_after = math.sqrt(max(after ** 2 - floor ** 2, 0.0))
-    if after <= before * (1.0 - MIN_GAIN) and excess_after <= MAX_EXCESS_LEFT * excess_before:
+    if after <= before * (1.0 - MIN_GAIN) and _excess(after, floor) <= MAX_EXCESS_LEFT * _excess(before, floor):
         return "named"
     return "none" if before <= NOISE_FACTOR * floor and not misfit_seen else "unexplained"
+
+
+def single_verdict(before: float, after: float, floor: float, misfit_seen: bool = False) -> str:
+    """The verdict on the best single cause: :func:`decide`'s, or ``named`` in part where decide
+    finds it unexplained but the baseline's mismatch is significant (``before`` beyond NOISE_FACTOR
+    × the ``floor``) and the cause removes most of it (gains MIN_GAIN and leaves at most
+    MAX_EXCESS_LEFT_IN_PART of its excess; :func:`explained` then says ``partial``). Comparisons of
+    causes (rivals, pairs) keep decide's stricter test."""
+    verdict = decide(before, after, floor, misfit_seen)
+    if (verdict == "unexplained" and before > NOISE_FACTOR * floor and after <= before * (1.0 - MIN_GAIN)
+            and _excess(after, floor) <= MAX_EXCESS_LEFT_IN_PART * _excess(before, floor)):
+        return "named"
+    return verdict
 
 
 def told_apart(rival: float, best: float, floor: float) -> bool:
