@@ -46,6 +46,9 @@ class Effects:
     #: to the deflection; 2: as its square, a stop met gradually)
     asymmetry_step: float = 0.0   #: extra tangent fraction from zero deflection on one side [-] (a kink
     #: in the law), signs as ``asymmetry``: F_asym += |s|·K0·x on that side
+    asymmetry_step_width: float = 0.0   #: width w over which the step's extra tangent rises linearly,
+    #: centred on zero deflection [m or rad] (0: a kink; > 0 a part whose voids close gradually): the
+    #: fraction 1/2 + u/w of |s|·K0 for |u| < w/2, u the deflection towards the stiffened side
     mullins: float = 0.0          #: softening μ below the largest |x| seen: η = 1 − μ(1 − (|x|/x_max)^p)
     mullins_shape: float = 1.0    #: p >= 1, the shape of the recovery towards x_max (1: linear; > 1: the
     #: part stays soft further up; < 1 would make the force's slope infinite at x = 0)
@@ -62,7 +65,7 @@ class Effects:
 
 
 #: Fields that shape an effect but switch none on.
-_SETTINGS = ("heating_tau_s", "mullins_shape", "asymmetry_power", "slip_stiffness")
+_SETTINGS = ("heating_tau_s", "mullins_shape", "asymmetry_power", "asymmetry_step_width", "slip_stiffness")
 #: Largest power of an asymmetry's progressive part: a stop's force grows at most as the fourth power
 #: of its deflection; beyond, a typing error (and overflow far from the reference deflection).
 MAX_ASYMMETRY_POWER = 5.0
@@ -75,6 +78,7 @@ EFFECT_KEYS: dict[str, tuple[str, int, str, str, float]] = {
     "asymmetry": ("asymmetry", -1, "1/mm", "1/deg", -math.inf),
     "asymmetry_step": ("asymmetry_step", 0, "-", "-", -math.inf),
     "asymmetry_power": ("asymmetry_power", 0, "-", "-", 1.0),
+    "asymmetry_step_width": ("asymmetry_step_width", 1, "mm", "deg", 0.0),
     "mullins": ("mullins", 0, "-", "-", 0.0),
     "mullins_shape": ("mullins_shape", 0, "-", "-", 1.0),
     "heating": ("heating", 0, "1/kJ", "1/kJ", 0.0),

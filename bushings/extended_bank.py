@@ -16,9 +16,9 @@ from bushings.parameters import LENGTH_UNIT_SI, ChannelParams
 from vsim_core.compiled_cache import follow
 
 # Columns of the effect parameter matrix (one row per channel) and of the effect state.
-(E_PRELOAD, E_ASYM, E_ASYM_POWER, E_ASYM_STEP, E_MULLINS, E_MULLINS_SHAPE, E_HEAT, E_HEAT_TAU, E_SLIP,
- E_SLIP_K, E_BACKLASH, E_TARE) = range(12)
-N_ECOLS = 12
+(E_PRELOAD, E_ASYM, E_ASYM_POWER, E_ASYM_STEP, E_ASYM_STEP_WIDTH, E_MULLINS, E_MULLINS_SHAPE, E_HEAT, E_HEAT_TAU,
+ E_SLIP, E_SLIP_K, E_BACKLASH, E_TARE) = range(13)
+N_ECOLS = 13
 S_XMAX, S_HEAT, S_DISS, S_SLIP_F, S_SLIP_X = range(5)
 N_SCOLS = 5
 #: Duration and steps of the quasi-static mounting ramp to the preload deflection.
@@ -53,7 +53,16 @@ def _effects_out(h, e, X, EP, ES, P, diss, F, K, Fout, Kout):
             f += extra * x / (n + 1.0)
             k += extra
         s = EP[c, E_ASYM_STEP]
-        if s != 0.0 and (x < 0.0) == (s > 0.0):
+        w = EP[c, E_ASYM_STEP_WIDTH]
+        if s != 0.0 and w > 0.0:
+            # the step's tangent rising linearly over w, centred on zero deflection: r = 1/2 + v/w
+            # along u (towards the stiff side), F_asym = −s·K0·∫_0^u r (u − w/8 beyond, −w/8 before)
+            u = -x if s > 0.0 else x
+            v = min(max(u, -0.5 * w), 0.5 * w)
+            k0 = P[c, kn.P_K0]
+            f -= s * k0 * (0.5 * v + v * v / (2.0 * w) + max(u - 0.5 * w, 0.0))
+            k += abs(s) * k0 * (0.5 + v / w)
+        elif s != 0.0 and (x < 0.0) == (s > 0.0):
             k0 = P[c, kn.P_K0]
             f += abs(s) * k0 * x
             k += abs(s) * k0
@@ -135,8 +144,8 @@ class ExtendedBank:
         for c, (ch, fx) in enumerate(zip(channels, self.effects)):
             # the asymmetry's rate is given at the parameter sets' unit of deflection r: a·r^(1−n) per (m or rad)^n
             rate = fx.asymmetry * LENGTH_UNIT_SI[ch.quantity] ** (1.0 - fx.asymmetry_power)
-            self.EP[c, :E_TARE] = (fx.preload, rate, fx.asymmetry_power, fx.asymmetry_step, fx.mullins,
-                                   fx.mullins_shape, fx.heating, fx.heating_tau_s, fx.slip_force,
+            self.EP[c, :E_TARE] = (fx.preload, rate, fx.asymmetry_power, fx.asymmetry_step, fx.asymmetry_step_width,
+                                   fx.mullins, fx.mullins_shape, fx.heating, fx.heating_tau_s, fx.slip_force,
                                    fx.slip_stiffness, fx.backlash)
         self.ES = np.zeros((M, N_SCOLS))
         self._X = np.zeros(M)

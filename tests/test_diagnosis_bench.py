@@ -175,6 +175,29 @@ def test_asymmetry_family_adds_a_kink_and_a_progressive_part_on_one_side():
     np.testing.assert_allclose(tension, tension_law, rtol=1e-12)
 
 
+@pytest.mark.parametrize("sign", [1.0, -1.0])
+def test_asymmetry_step_spread_over_a_width_rises_linearly_and_keeps_the_kinks_slope_beyond(sign):
+    """A step s spread over w: towards the stiffened side (u = ∓x), the extra tangent is
+    |s|·K0·(1/2 + u/w) within |u| < w/2, |s|·K0 beyond and 0 before; the extra force its integral
+    from zero, −s·K0·(u − w/8) beyond (the kink's, shifted by a constant) and s·K0·w/8 before."""
+    ch = load_parameter_set("fig5_9_progressive").channel("elastic")
+    s, w = 0.08 * sign, 0.4e-3
+    toward = -sign        # deflection direction of the stiffened side
+    e, law, law_tangent = _reloaded(Effects(), 0.0, 1.5e-3 * toward)
+    _, spread, tangent = _reloaded(Effects(asymmetry_step=s, asymmetry_step_width=w), 0.0, 1.5e-3 * toward)
+    u = e * toward
+    fraction = np.clip(0.5 + u / w, 0.0, 1.0)
+    np.testing.assert_allclose(tangent - law_tangent, abs(s) * ch.K0 * fraction, rtol=1e-9, atol=1e-6)
+    np.testing.assert_allclose(tangent[1:-1], np.gradient(spread, e)[1:-1], rtol=2e-3)
+    beyond = u > w / 2
+    np.testing.assert_allclose((spread - law)[beyond], -s * ch.K0 * (u[beyond] - w / 8.0), rtol=1e-9)
+    # the same law loaded the other way: the soft side, a constant w/8 of the step's force before it
+    _, back, _ = _reloaded(Effects(asymmetry_step=s, asymmetry_step_width=w), 0.0, -1.5e-3 * toward)
+    e_back, back_law, _ = _reloaded(Effects(), 0.0, -1.5e-3 * toward)
+    before = e_back * toward < -w / 2
+    np.testing.assert_allclose((back - back_law)[before], s * ch.K0 * w / 8.0, rtol=1e-9)
+
+
 @pytest.mark.parametrize("power", [1.0, 1.5, 2.0, 3.0])
 def test_asymmetry_progressive_part_grows_as_its_power(power):
     """With power n the extra tangent is |a|·K0·r·(|x|/r)^n (r = 1 mm: ``a`` keeps its meaning, the
@@ -195,6 +218,10 @@ def test_a_parameter_set_refuses_an_asymmetry_power_out_of_range():
     for bad in (0.5, 6.0, float("nan")):
         with pytest.raises(InputError, match="asymmetry_power"):
             effects_to_si({"asymmetry": 0.1, "asymmetry_power": bad}, source="set.yaml")
+    # the kink's width in mm (deg for a rotation), never negative
+    assert effects_to_si({"asymmetry_step": 0.1, "asymmetry_step_width": 0.5}).asymmetry_step_width == pytest.approx(5e-4)
+    with pytest.raises(InputError, match="asymmetry_step_width"):
+        effects_to_si({"asymmetry_step": 0.1, "asymmetry_step_width": -0.2}, source="set.yaml")
 
 
 @pytest.mark.parametrize("shape", [1.0, 2.5, 4.0])

@@ -125,8 +125,9 @@ def _effect(key: str, parameter: str) -> Callable[[dict, dict, Mapping[str, floa
 def _asymmetry(params: dict, effects: dict, v: Mapping[str, float]) -> tuple[dict, dict]:
     step = v.get("asymmetry_step", NO_EFFECTS.asymmetry_step)
     power = v.get("asymmetry_power", NO_EFFECTS.asymmetry_power)
+    width = {"asymmetry_step_width": v["asymmetry_step_width"]} if v.get("asymmetry_step_width") else {}
     return params, {**_add(_add(dict(effects), "asymmetry", v["asymmetry"]), "asymmetry_step", step),
-                    "asymmetry_power": power}
+                    "asymmetry_power": power, **width}
 
 
 def _mullins(params: dict, effects: dict, v: Mapping[str, float]) -> tuple[dict, dict]:
@@ -181,17 +182,20 @@ CAUSES: dict[str, Cause] = {c.id: c for c in (
     # a family (issue 29): an elastomer stiffens progressively as it is compressed, a part with a stop
     # met gradually as a power of its deflection (bump stops' force laws grow as its square to its
     # fourth power), and a part with a void or a rate-limiting sleeve takes its extra stiffness at
-    # once from zero deflection (a kink in its law; e.g. voided bushings, Kadlowec et al. 2003)
+    # once from zero deflection (a kink in its law; e.g. voided bushings, Kadlowec et al. 2003), or
+    # over the fraction of a millimetre in which its void's faces come into contact (the kink's width)
     Cause("asymmetry",
-          "tension/compression asymmetry beyond the elastic law: one side stiffer, at once from zero deflection "
-          "(a kink) and progressively, as a power of the deflection",
+          "tension/compression asymmetry beyond the elastic law: one side stiffer, from zero deflection "
+          "(a kink, or a step spread over a width) and progressively, as a power of the deflection",
           "loops not point-symmetric about their centre",
           (Parameter("asymmetry", "1/mm", (-1.0, 1.0), (0.05, 0.15), signed=True, sided=True,
                      description="extra tangent fraction of K0 per mm at 1 mm; > 0 stiffens compression"),
            Parameter("asymmetry_step", "-", (-1.0, 1.0), (0.03, 0.10), signed=True, sided=True, default=0.0,
                      description="extra tangent fraction of K0 from zero deflection; > 0 stiffens compression"),
            Parameter("asymmetry_power", "-", (1.0, 3.0), (1.0, 2.0), default=1.0,
-                     description="power n of the progressive part: the extra tangent grows as |x|^n")),
+                     description="power n of the progressive part: the extra tangent grows as |x|^n"),
+           Parameter("asymmetry_step_width", "mm", (0.0, 3.0), (0.2, 1.0), default=0.0,
+                     description="width over which the step's extra tangent rises, centred on zero (0: a kink)")),
           lambda b: b.values.get("K0", 0.0) > 0.0, _asymmetry,
           ({"asymmetry": 0.0, "asymmetry_power": 1.0},)),     # the kink alone
     # the recovery's shape (issue 29): a power of |x|/x_max, 1 the linear recovery, as the families of
