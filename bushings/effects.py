@@ -123,20 +123,28 @@ def with_friction(ch: ChannelParams, Ff: float, co_scale: float = 1.0) -> Channe
 BROAD_TAUS_S = np.logspace(-3, 4, 15)
 
 
-def broad_relaxation_branches(k1: float, alpha: float) -> tuple[np.ndarray, np.ndarray]:
+def broad_relaxation_branches(k1: float, alpha: float, tau_end_s: float = math.inf) -> tuple[np.ndarray, np.ndarray]:
     """Maxwell branches (stiffnesses [N/m], damper rates [N·s/m]) whose relaxation modulus follows
     ``k1·t^−α`` (a fractional element, ``k1`` its stiffness at t = 1 s) within 5 % from 10 ms to 100 s.
 
     From t^−α = (1/Γ(α))·∫ τ^−α e^{−t/τ} d ln τ, discretised on the log-spaced :data:`BROAD_TAUS_S`;
     the tail beyond the longest time, ∫ τ^−α d ln τ = τ_max^−α/α, is lumped into the longest branch.
+    A terminal time ``tau_end_s`` [s] cuts the spectrum off as e^{−τ/τ_end} (the spectrum of
+    Baumgaertel, Schausberger and Winter (1990), here with an exponential cut-off): well below τ_end
+    the modulus falls at the power law's rate, less the stiffness the cut branches held, and beyond it
+    relaxes fully; ∞, none. Branches cut to below 1e−12 of their stiffness are left out (a branch
+    without stiffness has no relaxation time).
     """
     taus = BROAD_TAUS_S
-    k = k1 / math.gamma(alpha) * taus ** (-alpha) * math.log(taus[1] / taus[0])
-    k[-1] += k1 / math.gamma(alpha) * taus[-1] ** (-alpha) / alpha
-    return k, k * taus
+    cut = np.exp(-taus / tau_end_s)
+    k = k1 / math.gamma(alpha) * taus ** (-alpha) * math.log(taus[1] / taus[0]) * cut
+    k[-1] += k1 / math.gamma(alpha) * taus[-1] ** (-alpha) / alpha * cut[-1]
+    kept = cut > 1e-12
+    return k[kept], (k * taus)[kept]
 
 
-def with_broad_relaxation(ch: ChannelParams, k1: float, alpha: float) -> ChannelParams:
-    """The law with a parallel fractional element of relaxation stiffness k1 [N/m] at 1 s and order α."""
-    k, c = broad_relaxation_branches(k1, alpha)
+def with_broad_relaxation(ch: ChannelParams, k1: float, alpha: float, tau_end_s: float = math.inf) -> ChannelParams:
+    """The law with a parallel fractional element of relaxation stiffness k1 [N/m] at 1 s and order α,
+    its spectrum cut off at the terminal time ``tau_end_s`` [s] (:func:`broad_relaxation_branches`)."""
+    k, c = broad_relaxation_branches(k1, alpha, tau_end_s)
     return ch.replace(maxwell_k=ch.maxwell_k + tuple(k), maxwell_c=ch.maxwell_c + tuple(c))

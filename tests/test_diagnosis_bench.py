@@ -135,6 +135,24 @@ def test_broad_relaxation_branches_follow_the_power_law():
         np.testing.assert_allclose(modulus, 100e3 * t ** -alpha, rtol=0.05)
 
 
+@pytest.mark.parametrize("tau_end_s", [10.0, 100.0, 1000.0])
+def test_a_terminal_time_keeps_the_power_laws_rate_well_below_it_and_relaxes_fully_beyond(tau_end_s):
+    """Cut off at τ_end: at τ_end/1000 the modulus falls at the power law's rate, −α·k1·t^(−α−1),
+    within 1 %; at 10 τ_end less than 1 % of the uncut spectrum's modulus is left; no branch without
+    stiffness; ∞ is the uncut spectrum, bit for bit."""
+    for alpha in (0.1, 0.25, 0.5):
+        k, c = broad_relaxation_branches(100e3, alpha, tau_end_s)
+        uncut_k, uncut_c = broad_relaxation_branches(100e3, alpha)
+        assert (k > 0.0).all() and len(k) <= len(uncut_k)
+        modulus = lambda t, k=k, c=c: float((k * np.exp(-t / (c / k))).sum())
+        t = tau_end_s / 1000.0
+        rate = -float((k / (c / k) * np.exp(-t / (c / k))).sum())
+        assert rate == pytest.approx(-alpha * 100e3 * t ** (-alpha - 1.0), rel=0.01)
+        assert modulus(10 * tau_end_s) < 0.01 * float((uncut_k * np.exp(-10 * tau_end_s / (uncut_c / uncut_k))).sum())
+        infinite = broad_relaxation_branches(100e3, alpha, math.inf)
+        assert all(np.array_equal(a, b) for a, b in zip(infinite, (uncut_k, uncut_c)))
+
+
 def test_mullins_first_loading_is_the_virgin_curve_and_reloading_is_softer():
     ch = load_parameter_set("fig5_9_progressive").channel("elastic")
     virgin = ExtendedBank([ch]).run(np.linspace(0, 2e-3, 50), 0.01)[:, 0]

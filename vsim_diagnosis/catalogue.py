@@ -110,7 +110,7 @@ def _friction(params: dict, effects: dict, v: Mapping[str, float]) -> tuple[dict
 
 
 def _broad(params: dict, effects: dict, v: Mapping[str, float]) -> tuple[dict, dict]:
-    k, c = broad_relaxation_branches(v["k1"], v["alpha"])
+    k, c = broad_relaxation_branches(v["k1"], v["alpha"], v.get("broad_tau_end_s", math.inf))
     return {**params, "maxwell_k": [*params.get("maxwell_k", ()), *map(float, k)],
             "maxwell_c": [*params.get("maxwell_c", ()), *map(float, c)]}, effects
 
@@ -218,11 +218,15 @@ CAUSES: dict[str, Cause] = {c.id: c for c in (
           lambda b: _ladder(b) or b.model == "tvs", _heating),
     Cause("broad_relaxation",
           f"relaxation over decades: a fractional element k1·t^-alpha in parallel (Prony series, "
-          f"{len(BROAD_TAUS_S)} branches from {BROAD_TAUS_S[0]:g} to {BROAD_TAUS_S[-1]:g} s)",
+          f"{len(BROAD_TAUS_S)} branches from {BROAD_TAUS_S[0]:g} to {BROAD_TAUS_S[-1]:g} s), its spectrum "
+          f"cut off at a terminal time (Baumgaertel-Schausberger-Winter)",
           "log-time relaxation slope that a finite ladder cannot follow; stiffness rising with frequency",
           (Parameter("k1", "N/mm", (0.5, 2000.0), (30.0, 100.0), log=True, description="relaxation stiffness at 1 s"),
-           Parameter("alpha", "-", (0.02, 0.9), (0.1, 0.25), description="order of the fractional element")),
-          lambda b: True, _broad),
+           Parameter("alpha", "-", (0.02, 0.9), (0.1, 0.25), description="order of the fractional element"),
+           Parameter("broad_tau_end_s", "s", (1.0, 1e7), (1e5, 1e7), log=True, default=math.inf,
+                     description="terminal relaxation time: the spectrum cut off beyond it")),
+          lambda b: True, _broad,
+          ({"broad_tau_end_s": 60.0},)),     # a spectrum that ends within the minute of a bench test
 )}
 
 
