@@ -11,7 +11,7 @@ from typing import Any, Iterable, Sequence
 from matplotlib.figure import Figure
 
 from vsim_core.files import atomic_output
-from vsim_diagnosis.verdict import Separation
+from vsim_diagnosis.verdict import MAX_EXCESS_LEFT, Separation
 from vsim_presentation.figures import save_figure
 
 
@@ -76,8 +76,8 @@ def partly_explained(share: float, left: str = "") -> str:
     """The sentence that follows a cause that explains the mismatch only partly (``share`` of its
     excess over the noise); ``left`` names what it still does not fit."""
     still = f"; still not fitted: {left}" if left else ""
-    return (f" Partly explained: it removes {share:.0%} of the mismatch beyond the noise, and what it leaves is "
-            f"still significant{still}.")
+    return (f" Partly explained: it removes {share:.0%} of the mismatch beyond the noise, short of a full "
+            f"explanation (at least {1.0 - MAX_EXCESS_LEFT ** 2:.0%} removed, nothing significant left){still}.")
 
 
 def separation_clause(sep: Separation, what: str) -> str:
