@@ -16,7 +16,8 @@ from vsim_diagnosis.kc_layout import Job, Layout, Test
 from vsim_diagnosis.kc_fits import Scorer
 from scipy.special import gammaincc
 
-from vsim_diagnosis.verdict import MISFIT_CHANCE, decide, explained, misfit, misfit_stretch, single_verdict, split
+from vsim_diagnosis.verdict import (MIN_GAIN, MISFIT_CHANCE, decide, explained, misfit, misfit_stretch, single_verdict,
+                                    split)
 
 CHANNELS = [f"camber_{t}" for t in ("fl", "fr", "rl", "rr")] + [f"toe_{t}" for t in ("fl", "fr", "rl", "rr")]
 
@@ -133,4 +134,6 @@ def test_a_cause_that_removes_most_of_a_significant_mismatch_is_named_in_part(le
         assert how == ("full" if left <= 0.35 else "partial") and share == pytest.approx(1.0 - left ** 2)
     assert single_verdict(1.45, 1.2, 1.0) == "none"
     assert single_verdict(1.45, 1.2, 1.0, misfit_seen=True) == "unexplained"
-    assert single_verdict(2.0, 1.9, 1.0) == "unexplained"    # a gain below MIN_GAIN explains nothing
+    # beyond NOISE_FACTOR, leaving half the excess is a gain beyond MIN_GAIN: 1.5 → √(1 + 1.25/4) gains 24 %
+    assert single_verdict(1.5 + 1e-9, math.sqrt(1.0 + 1.25 / 4.0) - 1e-9, 1.0) == "named"
+    assert 1.0 - math.sqrt(1.0 + 1.25 / 4.0) / 1.5 > MIN_GAIN

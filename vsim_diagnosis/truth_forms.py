@@ -22,7 +22,8 @@ viscous family's dashpot (the family keeps a little ladder damping, Co ≥ 0.1).
   two-node thermal network, two time constants where the family has one), and the force softens
   exponentially with the core's heat, η = exp(−κ·Q_core);
 * ``relaxation_box``: relaxation with a box spectrum, moduli spread evenly over log τ from 10 ms to
-  τ_max (Tobolsky's box: a force falling linearly with log t, where the family's is a power of t).
+  τ_max (Tobolsky's box: a force falling linearly with log t, where the family's is a power of t cut off
+  exponentially at its terminal time).
 
 Signs as the catalogue's: a positive c or s stiffens compression (x < 0).
 """

@@ -127,11 +127,11 @@ def decide(before: float, after: float, floor: float, misfit_seen: bool = False)
 def single_verdict(before: float, after: float, floor: float, misfit_seen: bool = False) -> str:
     """The verdict on the best single cause: :func:`decide`'s, or ``named`` in part where decide
     finds it unexplained but the baseline's mismatch is significant (``before`` beyond NOISE_FACTOR
-    × the ``floor``) and the cause removes most of it (gains MIN_GAIN and leaves at most
-    MAX_EXCESS_LEFT_IN_PART of its excess; :func:`explained` then says ``partial``). Comparisons of
-    causes (rivals, pairs) keep decide's stricter test."""
+    × the ``floor``) and the cause removes most of it (leaves at most MAX_EXCESS_LEFT_IN_PART of its
+    excess, which from there is a gain beyond MIN_GAIN; :func:`explained` then says ``partial``).
+    Comparisons of causes (rivals, pairs) keep decide's stricter test."""
     verdict = decide(before, after, floor, misfit_seen)
-    if (verdict == "unexplained" and before > NOISE_FACTOR * floor and after <= before * (1.0 - MIN_GAIN)
+    if (verdict == "unexplained" and before > NOISE_FACTOR * floor
             and _excess(after, floor) <= MAX_EXCESS_LEFT_IN_PART * _excess(before, floor)):
         return "named"
     return verdict
