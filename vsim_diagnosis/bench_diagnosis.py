@@ -33,6 +33,7 @@ from bushings.parameter_sets import ParameterSet
 from vsim_diagnosis.catalogue import PAIR_SEPARATOR, Cause, applicable, combined, parts
 from vsim_diagnosis.bench_alike import extra_programmes, load_cell_noise_n, separations
 from vsim_diagnosis.fit_starts import corner_starts, side_starts, sides_apart, to_fit
+from vsim_diagnosis.fit_uncertainty import standard_errors
 from vsim_diagnosis.verdict import (Outcome, Separation, alike, explained, pair_named, pair_shares, second_cause_wanted,
                                     single_verdict, split)
 from vsim_recordings.bench_dataset import BenchDataset
@@ -149,7 +150,7 @@ class Candidate:
     record_errors: np.ndarray          #: per record, with the training-fit values
     score: float = 0.0                 #: held-out error with the parameter penalty (lower is better)
     final: dict[str, float] = field(default_factory=dict)   #: refitted on every test
-    #: uncertainty of ``final``: the larger of the linearised standard error and the shift from ``values``
+    #: uncertainty of ``final``: the larger of its standard error (fit_uncertainty) and the shift from ``values``
     std: dict[str, float] = field(default_factory=dict)
     model: ParameterSet | None = None                       #: the extended baseline with ``final``
     fit_s: float = 0.0                 #: wall time of its fit and score [s] (to schedule the longest first)
@@ -253,8 +254,8 @@ def fit_cause(replay: Replay, base: ParameterSet, cause: Cause, train: np.ndarra
     ``corners``, those and ``start`` with each family's sided parameters on either side; each side
     fitted from its best point within its bounds (:mod:`vsim_diagnosis.fit_starts`), the best kept
     (from a ``start``, only its side and the best point's: a pair's causes fitted alone chose theirs);
-    returns the values and their standard uncertainties (linearised, from the Jacobian and the
-    residual variance)."""
+    returns the values and their standard uncertainties (:func:`vsim_diagnosis.fit_uncertainty.standard_errors`,
+    the tests the independent units)."""
     obj = _Objective(replay, base, cause, train)
     if start is None:
         grid = corner_starts(cause)
@@ -270,21 +271,8 @@ def fit_cause(replay: Replay, base: ParameterSet, cause: Cause, train: np.ndarra
         side = least_squares(obj.fun, np.clip(z0, lo + 1e-9, hi - 1e-9), jac=lambda z, hi=hi: obj.jac(z, hi),
                              bounds=(lo, hi), x_scale=1.0, max_nfev=max_nfev, method="trf", ftol=1e-6, xtol=1e-6)
         sol = side if sol is None or side.cost < sol.cost else sol
-    J = sol.jac
-    dof = max(int((obj.w > 0).sum()) - len(sol.x), 1)
-    # Residual variance, inflated for the residuals' correlation from sample to sample (a smooth
-    # model error is not white noise): n independent samples are worth n(1 − ρ)/(1 + ρ).
-    r = sol.fun[obj.w > 0]
-    rho = float(np.clip(np.dot(r[1:], r[:-1]) / max(np.dot(r, r), 1e-300), 0.0, 0.999))
-    s2 = 2.0 * sol.cost / dof * (1.0 + rho) / (1.0 - rho)
-    # A parameter the training tests cannot see (a slip stiffness with no slip force) has no column
-    # in J: its uncertainty is unbounded, the others' taken from the rest of J.
-    seen = np.linalg.norm(J, axis=0) > 1e-9 * max(float(np.linalg.norm(J)), 1e-300)
-    std_z = np.full(len(sol.x), np.inf)
-    try:
-        std_z[seen] = np.sqrt(np.clip(np.diag(np.linalg.inv(J[:, seen].T @ J[:, seen])) * s2, 0.0, None))
-    except np.linalg.LinAlgError:
-        pass
+    on = obj.w > 0
+    std_z = standard_errors(sol.jac[on], sol.fun[on], obj.replay.record[on], int(on.sum()) - len(sol.x))
     values = obj.values(sol.x)
     std = {p.name: float(values[p.name] * s if p.log else s) for p, s in zip(cause.parameters, std_z)}
     return values, std
@@ -363,9 +351,9 @@ def diagnose_bench(data: BenchDataset, baseline: ParameterSet,
                             load_cell_noise_n(noise, replay.scale), extra_programmes())
     if verdict == "named":
         say(f"refitting {best.cause.id} on every test")
-        best.final, linearised = fit_cause(replay, baseline, best.cause, everything, start=best.values, max_nfev=6)
-        # The linearised error ignores model error; the shift from the half-data fit shows it.
-        best.std = {k: max(s, abs(best.final[k] - best.values[k])) for k, s in linearised.items()}
+        best.final, standard = fit_cause(replay, baseline, best.cause, everything, start=best.values, max_nfev=6)
+        # the shift from the half-data fit: what half the tests alone would have said
+        best.std = {k: max(s, abs(best.final[k] - best.values[k])) for k, s in standard.items()}
         best.model = best.cause.apply(baseline, best.final,
                                       source=f"{baseline.name} extended by {best.cause.id}, fitted by vsim diagnose "
                                              f"on {data.path.name} ({len(replay.names)} bench tests)")
