@@ -16,8 +16,8 @@ from vsim_diagnosis.kc_layout import Job, Layout, Test
 from vsim_diagnosis.kc_fits import Scorer
 from scipy.special import gammaincc
 
-from vsim_diagnosis.verdict import (MIN_GAIN, MISFIT_CHANCE, decide, explained, misfit, misfit_stretch, single_verdict,
-                                    split)
+from vsim_diagnosis.verdict import (MIN_GAIN, MISFIT_CHANCE, alike, decide, explained, misfit, misfit_stretch,
+                                    single_verdict, split)
 
 CHANNELS = [f"camber_{t}" for t in ("fl", "fr", "rl", "rr")] + [f"toe_{t}" for t in ("fl", "fr", "rl", "rr")]
 
@@ -137,3 +137,15 @@ def test_a_cause_that_removes_most_of_a_significant_mismatch_is_named_in_part(le
     # beyond NOISE_FACTOR, leaving half the excess is a gain beyond MIN_GAIN: 1.5 → √(1 + 1.25/4) gains 24 %
     assert single_verdict(1.5 + 1e-9, math.sqrt(1.0 + 1.25 / 4.0) - 1e-9, 1.0) == "named"
     assert 1.0 - math.sqrt(1.0 + 1.25 / 4.0) / 1.5 > MIN_GAIN
+
+
+def test_a_rival_of_a_cause_named_in_part_is_alike_when_named_in_part_too() -> None:
+    """From 2 × the noise (excess √3), a best cause leaving 0.45 of the excess is named in part: a
+    rival leaving 0.48 would be named in part too and the best does not beat it as a cause must
+    (alike); one leaving 0.6 would not be named at all. A best named fully keeps decide's test: a
+    rival that would be named only in part is no rival of it."""
+    left = lambda fraction: math.sqrt(1.0 + 3.0 * fraction ** 2)
+    assert alike(2.0, left(0.48), left(0.45), 1.0)
+    assert not alike(2.0, left(0.6), left(0.45), 1.0)
+    assert not alike(2.0, left(0.45), left(0.3), 1.0)
+    assert alike(2.0, left(0.33), left(0.3), 1.0)

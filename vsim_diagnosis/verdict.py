@@ -146,9 +146,11 @@ def told_apart(rival: float, best: float, floor: float) -> bool:
 
 def alike(before: float, rival: float, best: float, floor: float) -> bool:
     """Whether a rival cause (held-out error ``rival``) is one the tests cannot tell from the best
-    (``best``): it would be named on its own against the baseline's ``before``, and the best does not
-    beat it as a cause must (:func:`told_apart`)."""
-    return decide(before, rival, floor) == "named" and not told_apart(rival, best, floor)
+    (``best``): it would be named on its own against the baseline's ``before`` as the best is (fully
+    by :func:`decide`, or in part by :func:`single_verdict` where the best explains only part), and
+    the best does not beat it as a cause must (:func:`told_apart`)."""
+    named = decide if decide(before, best, floor) == "named" else single_verdict
+    return named(before, rival, floor) == "named" and not told_apart(rival, best, floor)
 
 
 @dataclass(frozen=True)
