@@ -34,7 +34,7 @@ from vsim_core.shipped import DEFAULT_VEHICLE
 from vsim_diagnosis.catalogue import PAIR_SEPARATOR
 from vsim_diagnosis.kc_alike import alike, separations
 from vsim_diagnosis.kc_diagnosis import _second_stage, diagnose_kc
-from vsim_diagnosis.kc_fits import Candidate, Scorer, fit, nominal, verify
+from vsim_diagnosis.kc_fits import Candidate, Scorer, fit, nominal, significant, verify
 from vsim_diagnosis.kc_layout import Layout, Test
 from vsim_diagnosis.verdict import Separation, pair_named, split, told_apart
 from vsim_diagnosis.virtual_kc_rig import DEFAULT_SCENARIOS, measure_kc, parse_kc_truth
@@ -296,6 +296,26 @@ def test_the_second_stage_fits_the_second_cause_beside_the_first():
         assert c.hypothesis.values[p] == pytest.approx(truth * mid, rel=0.05)   # the first was 35 % off
     assert pairs[0].heldout_error == pytest.approx(1.0, abs=0.1) and best.heldout_error > 2.0
     assert pair_named(scorer.heldout_error(base), best.heldout_error, pairs[0].heldout_error, 1.0)
+    assert significant(pairs[0])
+    # with no second effect in the data, the pair's gain is the first's joint refit: the second's
+    # magnitude is not told from none
+    layout.measured[:] = 1.3 * first + 0.2 * rng.standard_normal(first.shape)
+    scorer = Scorer(layout, base, split(4))
+    verify([best], [effect(best.hypothesis)], scorer)
+    nulls = _second_stage(best, [(h, base + effect(h)) for h in hs], base, scorer,
+                          lambda hss, tests: [sum(effect(h) for h in hs) for hs in hss], range(4))
+    assert not any(significant(c) for c in nulls)
+
+
+def test_a_magnitude_is_significant_off_no_effect_on_its_effects_scale():
+    """Two standard uncertainties off no effect: 0 for an offset, 1 for a factor (on its logarithm)."""
+    def fitted(cause: str, name: str, value: float, std: float) -> Candidate:
+        return Candidate(Hypothesis(cause, ("front",), {name: value}), math.nan, {name: std})
+
+    assert significant(fitted("hardpoint", "offset", -2.1, 1.0))
+    assert not significant(fitted("hardpoint", "offset", 0.17, 5.1))
+    assert significant(fitted("spring_rate", "spring_rate_scale", 1.05, 0.02))        # log 1.05 = 0.049 ≥ 2 × 0.019
+    assert not significant(fitted("spring_rate", "spring_rate_scale", 1.03, 0.02))    # 0.030 < 0.039
 
 
 def test_the_verdict_says_which_parameters_the_kc_fit_held():

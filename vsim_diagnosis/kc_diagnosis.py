@@ -50,7 +50,8 @@ from vsim_diagnosis.catalogue import PAIR_SEPARATOR
 from vsim_diagnosis.kc_alike import alike, extra_scenarios, run_unless_diverged, separations
 from vsim_diagnosis.kc_catalogue import (BUSHING_CAUSES, VEHICLE_CAUSES, Hypothesis, extended_vehicle, locations,
                                          parameters)
-from vsim_diagnosis.kc_fits import Candidate, Scorer, fit, fit_pair, kept, nominal, nudged, verify
+from vsim_diagnosis.kc_fits import (Candidate, Scorer, fit, fit_pair, kept, nominal, nudged, significant,
+                                    verify)
 from vsim_diagnosis.kc_layout import Layout, run_job
 from vsim_diagnosis.verdict import (Outcome, Separation, decide, explained, misfit, misfit_stretch, pair_named,
                                     pair_shares, second_cause_wanted, single_verdict, split)
@@ -217,7 +218,8 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, executor: Execut
                       if (h.cause, h.location) != (best.hypothesis.cause, best.hypothesis.location)]
             pairs = _second_stage(best, others, base, scorer,
                                   lambda hs, tests: rows([extended_vehicle(vehicle, h) for h in hs], tests), every)
-            if pairs and pair_named(before, best.heldout_error, pairs[0].heldout_error, 1.0):
+            # a second cause whose magnitude is not told from none is the first's joint refit, not a cause
+            if pairs and pair_named(before, best.heldout_error, pairs[0].heldout_error, 1.0) and significant(pairs[0]):
                 second = pairs[0]
                 single = _alone(second.hypothesis, top + screened[VERIFIED:])
                 if not single.verified:   # its single fit, run on every test as the first cause's was

@@ -17,6 +17,8 @@ from vsim_diagnosis.kc_layout import Layout
 
 #: Relative increase of the held-out score per fitted parameter.
 PARAMETER_PENALTY = 0.02
+#: Standard uncertainties by which a fitted magnitude must stand off no effect to be a cause found.
+SIGNIFICANT = 2.0
 
 
 @dataclass
@@ -206,6 +208,14 @@ def _magnitude(p: Parameter, at: float, coef: float, sd: float) -> tuple[float, 
     value = float(np.clip(p.from_effect(min(coef * x0, p.effect(hi))), lo, hi))
     scale = p.effect(value) / x0 if x0 != 0.0 else 0.0   # at no effect (clipped to it): none from here
     return value, (abs(value * x0) if p.factor else abs(x0)) * sd, scale
+
+
+def significant(c: Candidate) -> bool:
+    """Whether a candidate's magnitude (its first parameter) stands SIGNIFICANT standard uncertainties
+    off no effect, on the scale its effect grows with (a factor's logarithm)."""
+    p = parameters(c.hypothesis.cause)[0]
+    value, std = c.hypothesis.values[p.name], c.std.get(p.name, math.inf)
+    return abs(p.effect(value)) >= SIGNIFICANT * (std / value if p.factor else std)
 
 
 def nudged(h: Hypothesis) -> tuple[Hypothesis, float]:
