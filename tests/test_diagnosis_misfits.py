@@ -145,7 +145,9 @@ def test_a_rival_of_a_cause_named_in_part_is_alike_when_named_in_part_too() -> N
     (alike); one leaving 0.6 would not be named at all. A best named fully keeps decide's test: a
     rival that would be named only in part is no rival of it."""
     left = lambda fraction: math.sqrt(1.0 + 3.0 * fraction ** 2)
-    assert alike(2.0, left(0.48), left(0.45), 1.0)
-    assert not alike(2.0, left(0.6), left(0.45), 1.0)
+    assert decide(2.0, left(0.45), 1.0) != "named" and single_verdict(2.0, left(0.45), 1.0) == "named"
+    assert alike(2.0, left(0.48), left(0.45), 1.0, in_part=True)
+    assert not alike(2.0, left(0.48), left(0.45), 1.0)
+    assert not alike(2.0, left(0.6), left(0.45), 1.0, in_part=True)
     assert not alike(2.0, left(0.45), left(0.3), 1.0)
     assert alike(2.0, left(0.33), left(0.3), 1.0)

@@ -34,8 +34,8 @@ from vsim_diagnosis.catalogue import PAIR_SEPARATOR, Cause, applicable, combined
 from vsim_diagnosis.bench_alike import extra_programmes, load_cell_noise_n, separations
 from vsim_diagnosis.fit_starts import corner_starts, side_starts, sides_apart, to_fit
 from vsim_diagnosis.fit_uncertainty import standard_errors
-from vsim_diagnosis.verdict import (Outcome, Separation, alike, explained, pair_named, pair_shares, second_cause_wanted,
-                                    single_verdict, split)
+from vsim_diagnosis.verdict import (Outcome, Separation, alike, decide, explained, pair_named, pair_shares,
+                                    second_cause_wanted, single_verdict, split)
 from vsim_recordings.bench_dataset import BenchDataset
 
 #: Penalty per fitted parameter on the held-out error used for ranking.
@@ -332,7 +332,8 @@ def diagnose_bench(data: BenchDataset, baseline: ParameterSet,
                            key=lambda c: (c.score, c.cause.id))
             if pairs and pair_named(before, best.heldout_error, pairs[0].heldout_error, floor):
                 best, verdict = pairs[0], "named"
-        rivals = ([c for c in ranking[1:] if alike(before, c.heldout_error, best.heldout_error, floor)]
+        in_part = decide(before, best.heldout_error, floor) != "named" if best is not None else False
+        rivals = ([c for c in ranking[1:] if alike(before, c.heldout_error, best.heldout_error, floor, in_part)]
                   if verdict == "named" and best is ranking[0] else [])
         if rivals:
             # the held-out half cannot tell them apart: the other half is asked too (two-fold cross-validation)
@@ -342,7 +343,8 @@ def diagnose_bench(data: BenchDataset, baseline: ParameterSet,
                                 key=lambda c: c.two_fold_error * (1.0 + PARAMETER_PENALTY * len(c.cause.parameters)))
             both, floor_both = aggregate(base_errors, everything), aggregate(noise, everything)
             best = contenders[0]
-            rivals = [c for c in contenders[1:] if alike(both, c.two_fold_error, best.two_fold_error, floor_both)]
+            rivals = [c for c in contenders[1:]
+                      if alike(both, c.two_fold_error, best.two_fold_error, floor_both, in_part)]
     apart = []
     if rivals:
         say(f"{', '.join(c.cause.id for c in rivals)}: not told from {best.cause.id} by these tests; playing the "

@@ -21,7 +21,7 @@ def standard_errors(J: np.ndarray, r: np.ndarray, groups: np.ndarray, dof: int) 
     (its residual variance inflated for the residuals' sample-to-sample correlation ρ: n samples are
     worth n(1 − ρ)/(1 + ρ)) and the cluster-robust one (module docstring). A parameter the residuals
     do not depend on (a null column of J) has an unbounded uncertainty, the others taken from the
-    rest of J; all are unbounded when the rest is singular."""
+    rest of J; all are unbounded when the rest cannot be inverted."""
     rho = float(np.clip(np.dot(r[1:], r[:-1]) / max(np.dot(r, r), 1e-300), 0.0, 0.999))
     s2 = float(np.dot(r, r)) / max(dof, 1) * (1.0 + rho) / (1.0 - rho)
     seen = np.linalg.norm(J, axis=0) > 1e-9 * max(float(np.linalg.norm(J)), 1e-300)
@@ -32,6 +32,9 @@ def standard_errors(J: np.ndarray, r: np.ndarray, groups: np.ndarray, dof: int) 
         return std
     units = np.unique(groups)
     scores = np.array([J[groups == g][:, seen].T @ r[groups == g] for g in units])
+    # centred: at a bound, or where the fit stopped short, the scores do not sum to zero, and what
+    # they share is no disagreement between the tests
+    scores -= scores.mean(axis=0)
     factor = len(units) / (len(units) - 1) if len(units) > 1 else 1.0
     robust = np.diag(bread @ (scores.T @ scores) @ bread) * factor
     std[seen] = np.sqrt(np.clip(np.maximum(np.diag(bread) * s2, robust), 0.0, None))

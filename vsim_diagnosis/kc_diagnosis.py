@@ -20,7 +20,9 @@
 5. When the best leaves a mismatch beyond the noise, or a test it does not fit: every other
    hypothesis beside it, its magnitude fitted on what the best's run leaves from its own screening
    run; the best few run beside it on every test, both magnitudes refitted together, run again and
-   scored (:func:`vsim_diagnosis.verdict.pair_named` decides whether two causes are named).
+   scored; the best pair whose second magnitude stands off no effect
+   (:func:`vsim_diagnosis.kc_fits.significant`) is named when :func:`vsim_diagnosis.verdict.pair_named`
+   says so.
 
 Why not the cheaper screen of replaying each bushing's recorded deflections through the extended
 law and mapping the force change through the response to a probe force: in a hysteretic direction
@@ -219,8 +221,11 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, executor: Execut
             pairs = _second_stage(best, others, base, scorer,
                                   lambda hs, tests: rows([extended_vehicle(vehicle, h) for h in hs], tests), every)
             # a second cause whose magnitude is not told from none is the first's joint refit, not a cause
-            if pairs and pair_named(before, best.heldout_error, pairs[0].heldout_error, 1.0) and significant(pairs[0]):
-                second = pairs[0]
+            k = next((i for i, c in enumerate(pairs) if significant(c)), len(pairs))
+            for c in pairs[:k]:
+                say(f"  beside it, {c.hypothesis.label} is not told from no effect: {_fmt(c.hypothesis.values)}")
+            if k < len(pairs) and pair_named(before, best.heldout_error, pairs[k].heldout_error, 1.0):
+                second = pairs[k]
                 single = _alone(second.hypothesis, top + screened[VERIFIED:])
                 if not single.verified:   # its single fit, run on every test as the first cause's was
                     single = replace(single)

@@ -211,11 +211,13 @@ def _magnitude(p: Parameter, at: float, coef: float, sd: float) -> tuple[float, 
 
 
 def significant(c: Candidate) -> bool:
-    """Whether a candidate's magnitude (its first parameter) stands SIGNIFICANT standard uncertainties
-    off no effect, on the scale its effect grows with (a factor's logarithm)."""
+    """Whether a candidate's magnitude (its first parameter) stands over SIGNIFICANT standard
+    uncertainties off no effect, on the scale its effect grows with (a factor's logarithm); a null
+    or unbounded uncertainty (a hypothesis fitted from no effect at all) does not tell."""
     p = parameters(c.hypothesis.cause)[0]
     value, std = c.hypothesis.values[p.name], c.std.get(p.name, math.inf)
-    return abs(p.effect(value)) >= SIGNIFICANT * (std / value if p.factor else std)
+    std = std / value if p.factor else std
+    return 0.0 < std < math.inf and abs(p.effect(value)) > SIGNIFICANT * std
 
 
 def nudged(h: Hypothesis) -> tuple[Hypothesis, float]:

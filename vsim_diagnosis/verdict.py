@@ -129,7 +129,8 @@ def single_verdict(before: float, after: float, floor: float, misfit_seen: bool 
     finds it unexplained but the baseline's mismatch is significant (``before`` beyond NOISE_FACTOR
     × the ``floor``) and the cause removes most of it (leaves at most MAX_EXCESS_LEFT_IN_PART of its
     excess, which from there is a gain beyond MIN_GAIN; :func:`explained` then says ``partial``).
-    Comparisons of causes (rivals, pairs) keep decide's stricter test."""
+    Pairs keep decide's stricter test; rivals of a cause named in part are judged by this one
+    (:func:`alike`)."""
     verdict = decide(before, after, floor, misfit_seen)
     if (verdict == "unexplained" and before > NOISE_FACTOR * floor
             and _excess(after, floor) <= MAX_EXCESS_LEFT_IN_PART * _excess(before, floor)):
@@ -144,12 +145,12 @@ def told_apart(rival: float, best: float, floor: float) -> bool:
     return decide(rival, best, floor) == "named"
 
 
-def alike(before: float, rival: float, best: float, floor: float) -> bool:
+def alike(before: float, rival: float, best: float, floor: float, in_part: bool = False) -> bool:
     """Whether a rival cause (held-out error ``rival``) is one the tests cannot tell from the best
-    (``best``): it would be named on its own against the baseline's ``before`` as the best is (fully
-    by :func:`decide`, or in part by :func:`single_verdict` where the best explains only part), and
-    the best does not beat it as a cause must (:func:`told_apart`)."""
-    named = decide if decide(before, best, floor) == "named" else single_verdict
+    (``best``): it would be named on its own against the baseline's ``before`` as the best was (fully
+    by :func:`decide`; ``in_part``, a best named only by :func:`single_verdict`: in part by it too),
+    and the best does not beat it as a cause must (:func:`told_apart`)."""
+    named = single_verdict if in_part else decide
     return named(before, rival, floor) == "named" and not told_apart(rival, best, floor)
 
 
