@@ -34,7 +34,7 @@ from vsim_core.shipped import DEFAULT_VEHICLE
 from vsim_diagnosis.catalogue import PAIR_SEPARATOR
 from vsim_diagnosis.kc_alike import alike, separations
 from vsim_diagnosis.kc_diagnosis import _second_stage, diagnose_kc
-from vsim_diagnosis.kc_fits import Candidate, Scorer, fit, nominal, significant, verify
+from vsim_diagnosis.kc_fits import Candidate, Scorer, fit, fit_pair, nominal, significant, verify
 from vsim_diagnosis.kc_layout import Layout, Test
 from vsim_diagnosis.verdict import Separation, pair_named, split, told_apart
 from vsim_diagnosis.virtual_kc_rig import DEFAULT_SCENARIOS, measure_kc, parse_kc_truth
@@ -258,6 +258,33 @@ def test_the_refit_fits_a_second_parameter_along_its_slope_and_keeps_it_in_bound
     # a slope that changes nothing the signature does not: the second parameter is left alone
     flat = fit(h, shape, np.zeros_like(shape), scorer, 0.5 * shape)
     assert flat.hypothesis.values["alpha"] == alpha and "alpha" not in flat.std
+
+
+def test_the_pair_refit_fits_the_second_causes_second_parameter_along_its_slope():
+    """What the first cause leaves is 0.9 × a second cause's effect plus its second parameter moved by
+    0.05 (its rows' slope along it): the pair refit finds both, each within 3 of its uncertainties,
+    and the first's magnitude; without the slope the held second parameter is absorbed elsewhere."""
+    rng = np.random.default_rng(8)
+    t = np.linspace(0.0, 1.0, 4000)
+    first, second, slope = (np.column_stack([np.sin(k * np.pi * t), np.cos((k + 1) * np.pi * t)]) for k in (2, 5, 9))
+    slope = 8.0 * slope
+    measured = 1.2 * first + 0.9 * second + 0.05 * slope + 0.2 * rng.standard_normal(first.shape)
+    tests = [Test(str(i), None, np.arange(1000 * i, 1000 * (i + 1))) for i in range(4)]
+    layout = Layout(["c_x", "c_y"], measured, np.zeros(4000), np.zeros(4000, dtype=int), np.repeat(np.arange(4), 1000),
+                    tests)
+    base = np.zeros_like(first)
+    scorer = Scorer(layout, base, split(4))
+    h1 = Hypothesis("coupling", ("e1_rear", "x", "z"), nominal("coupling"))
+    h2 = Hypothesis("broad_relaxation", ("e1_front", "y"), nominal("broad_relaxation"))
+    one, two = Candidate(h1, math.nan, simulated=first), Candidate(h2, math.nan, simulated=first + second)
+    pair = fit_pair(one, two, base, scorer, slope)
+    assert pair.hypothesis.values["alpha"] == pytest.approx(h2.values["alpha"] + 0.05, abs=3 * pair.std["alpha"])
+    assert pair.hypothesis.values["k1"] == pytest.approx(0.9 * h2.values["k1"], abs=3 * pair.std["k1"])
+    assert pair.beside.hypothesis.values["stiffness"] == pytest.approx(1.2 * h1.values["stiffness"],
+                                                                       abs=3 * pair.beside.std["stiffness"])
+    assert 0.0 < pair.std["alpha"] < 0.01 and pair.screened_error == pytest.approx(1.0, abs=0.1)
+    held = fit_pair(one, two, base, scorer)
+    assert "alpha" not in held.std and held.screened_error > 1.5
 
 
 def test_the_second_stage_fits_the_second_cause_beside_the_first():

@@ -281,7 +281,12 @@ def _second_stage(best: Candidate, others: list[tuple[Hypothesis, np.ndarray]], 
     screened = sorted((fit(h, sig - base, best.simulated, scorer) for h, sig in others), key=lambda c: c.score)
     top = screened[:VERIFIED]
     verify(top, rows([[best.hypothesis, c.hypothesis] for c in top], every), scorer)
-    refits = [(c, fit_pair(best, c, base, scorer)) for c in top]
+    # a second cause with a second parameter: one more run beside the first with it moved, for its slope
+    moves = [nudged(c.hypothesis) if len(parameters(c.hypothesis.cause)) > 1 else None for c in top]
+    training = [i for i, held in enumerate(scorer.heldout) if not held]
+    moved_rows = iter(rows([[best.hypothesis, m[0]] for m in moves if m], training) if any(moves) else [])
+    refits = [(c, fit_pair(best, c, base, scorer, None if m is None else (next(moved_rows) - c.simulated) / m[1]))
+              for c, m in zip(top, moves)]
     moved = [(c, r) for c, r in refits if r is not None]
     better = kept([c for c, _ in moved], [r for _, r in moved],
                   rows([[r.beside.hypothesis, r.hypothesis] for _, r in moved], every), scorer) if moved else []

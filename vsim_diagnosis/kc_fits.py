@@ -135,11 +135,13 @@ def fit(h: Hypothesis, signature: np.ndarray, base: np.ndarray, scorer: Scorer,
     return Candidate(replace(h, values={**at, first.name: value}), math.nan, std, screened_error=trained)
 
 
-def fit_pair(first: Candidate, second: Candidate, base: np.ndarray, scorer: Scorer) -> Candidate | None:
+def fit_pair(first: Candidate, second: Candidate, base: np.ndarray, scorer: Scorer,
+             slope: np.ndarray | None = None) -> Candidate | None:
     """Both causes' magnitudes (first parameters) refitted together on the training tests, each effect
-    taken proportional to its magnitude from the runs (``first``'s alone, ``second``'s beside it):
-    the second cause with the first, as refitted, ``beside`` it; None when the two effects are alike
-    on the campaign (nothing to refit)."""
+    taken proportional to its magnitude from the runs (``first``'s alone, ``second``'s beside it);
+    given ``slope`` (the pair's rows' derivative with respect to the second cause's second parameter),
+    that parameter too, linearly along it, as :func:`fit` does: the second cause with the first, as
+    refitted, ``beside`` it; None when the two effects are alike on the campaign (nothing to refit)."""
     train = ~scorer.held_rows
     mismatch = scorer.residual(base, train).ravel()
     columns = [mismatch - scorer.residual(rows, train).ravel() for rows in (first.simulated, second.simulated)]
@@ -147,16 +149,29 @@ def fit_pair(first: Candidate, second: Candidate, base: np.ndarray, scorer: Scor
     gram = _gram(columns)
     if _alike(gram):
         return None                          # the two act alike on the campaign: nothing to refit
+    at = dict(second.hypothesis.values)
+    extra = {}
+    if slope is not None:
+        shape = mismatch - scorer.residual(base + slope, train).ravel()
+        wide = _gram([*columns, shape])
+        if np.linalg.det(wide) > 1e-9 * np.prod(np.diag(wide)):   # else it changes nothing the two do not
+            coef = np.linalg.solve(wide, [float(np.dot(c, mismatch)) for c in (*columns, shape)])
+            magnitude, shape_p = parameters(second.hypothesis.cause)[:2]
+            moved = float(np.clip(at[shape_p.name] + coef[2], *_side_bounds(shape_p, at[magnitude.name])))
+            mismatch = mismatch - (moved - at[shape_p.name]) * shape   # the magnitudes refitted given it
+            extra = {shape_p.name: math.sqrt(_variances(mismatch - coef[:2] @ np.array(columns), wide)[2])}
+            at[shape_p.name] = moved
     coef = np.linalg.solve(gram, [float(np.dot(c, mismatch)) for c in columns])
     sd = np.sqrt(_variances(mismatch - coef @ np.array(columns), gram))
     out, scales = [], []
     for c, k, s in zip((first, second), coef, sd):
         p = parameters(c.hypothesis.cause)[0]
-        at = c.hypothesis.values[p.name]
-        value, std, scale = _magnitude(p, at, float(k), float(s))
+        values = at if c is second else c.hypothesis.values
+        value, std, scale = _magnitude(p, values[p.name], float(k), float(s))
         # the first's uncertainty at least its shift (the second's: :func:`kept`)
-        out.append(Candidate(replace(c.hypothesis, values={**c.hypothesis.values, p.name: value}), math.nan,
-                             {**c.std, p.name: max(std, abs(value - at)) if c is first else std}))
+        out.append(Candidate(replace(c.hypothesis, values={**values, p.name: value}), math.nan,
+                             {**c.std, **(extra if c is second else {}),
+                              p.name: max(std, abs(value - values[p.name])) if c is first else std}))
         scales.append(scale)
     left = mismatch - scales[0] * columns[0] - scales[1] * columns[1]
     out[1].screened_error = float(math.sqrt(np.mean(left ** 2)))
