@@ -34,7 +34,7 @@ from vsim_core.shipped import DEFAULT_VEHICLE
 from vsim_diagnosis.catalogue import PAIR_SEPARATOR
 from vsim_diagnosis.kc_alike import alike, separations
 from vsim_diagnosis.kc_diagnosis import _second_stage, diagnose_kc
-from vsim_diagnosis.kc_fits import Candidate, Scorer, fit, fit_pair, nominal, significant, verify
+from vsim_diagnosis.kc_fits import Candidate, Scorer, fit, fit_pair, nominal, separation, significant, verify
 from vsim_diagnosis.kc_layout import Layout, Test
 from vsim_diagnosis.verdict import Separation, pair_named, split, told_apart
 from vsim_diagnosis.virtual_kc_rig import DEFAULT_SCENARIOS, measure_kc, parse_kc_truth
@@ -335,14 +335,14 @@ def test_the_second_stage_fits_the_second_cause_beside_the_first():
 
 
 def test_a_magnitude_is_significant_off_no_effect_on_its_effects_scale():
-    """Two standard uncertainties off no effect: 0 for an offset, 1 for a factor (on its logarithm)."""
-    def fitted(cause: str, name: str, value: float, std: float) -> Candidate:
-        return Candidate(Hypothesis(cause, ("front",), {name: value}), math.nan, {name: std})
-
-    assert significant(fitted("hardpoint", "offset", -2.1, 1.0))
-    assert not significant(fitted("hardpoint", "offset", 0.17, 5.1))
-    assert significant(fitted("spring_rate", "spring_rate_scale", 1.05, 0.02))        # log 1.05 = 0.049 ≥ 2 × 0.019
-    assert not significant(fitted("spring_rate", "spring_rate_scale", 1.03, 0.02))    # 0.030 < 0.039
+    """Two standard uncertainties off no effect: 0 for an offset, 1 for a factor (on its logarithm);
+    a null or unbounded uncertainty does not tell."""
+    offset, factor = parameters("hardpoint")[0], parameters("spring_rate")[0]
+    assert separation(offset, -2.1, 1.0) == pytest.approx(2.1) and separation(offset, 0.17, 5.1) < 0.1
+    assert separation(factor, 1.05, 0.02) == pytest.approx(math.log(1.05) / (0.02 / 1.05))   # 2.56
+    assert separation(factor, 1.03, 0.02) < 2.0                                                # 1.55
+    assert math.isnan(separation(offset, 1.0, 0.0)) and math.isnan(separation(offset, 1.0, math.inf))
+    assert not significant(Candidate(Hypothesis("hardpoint", ("front",), {"offset": 1.0}), math.nan))
 
 
 def test_the_verdict_says_which_parameters_the_kc_fit_held():

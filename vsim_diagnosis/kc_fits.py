@@ -34,6 +34,9 @@ class Candidate:
     #: a second cause's: the first cause as refitted together with it (:func:`fit_pair`); the run
     #: and errors above are then the pair's
     beside: "Candidate | None" = None
+    #: its magnitude's distance from no effect in the fit's own standard uncertainty (:func:`separation`),
+    #: before :func:`kept` widens the uncertainty to the refit's shift
+    z: float = math.nan
 
     @property
     def verified(self) -> bool:
@@ -132,7 +135,8 @@ def fit(h: Hypothesis, signature: np.ndarray, base: np.ndarray, scorer: Scorer,
     value, std[first.name], scale = _magnitude(first, at[first.name], coef[0], math.sqrt(var[0]))
     rest = sum(c * x for c, x in zip(coef[1:], columns[1:]))
     trained = float(math.sqrt(np.mean((mismatch - scale * columns[0] - rest) ** 2)))
-    return Candidate(replace(h, values={**at, first.name: value}), math.nan, std, screened_error=trained)
+    return Candidate(replace(h, values={**at, first.name: value}), math.nan, std, screened_error=trained,
+                     z=separation(first, value, std[first.name]))
 
 
 def fit_pair(first: Candidate, second: Candidate, base: np.ndarray, scorer: Scorer,
@@ -171,7 +175,8 @@ def fit_pair(first: Candidate, second: Candidate, base: np.ndarray, scorer: Scor
         # the first's uncertainty at least its shift (the second's: :func:`kept`)
         out.append(Candidate(replace(c.hypothesis, values={**values, p.name: value}), math.nan,
                              {**c.std, **(extra if c is second else {}),
-                              p.name: max(std, abs(value - values[p.name])) if c is first else std}))
+                              p.name: max(std, abs(value - values[p.name])) if c is first else std},
+                             z=separation(p, value, std)))
         scales.append(scale)
     left = mismatch - scales[0] * columns[0] - scales[1] * columns[1]
     out[1].screened_error = float(math.sqrt(np.mean(left ** 2)))
@@ -225,14 +230,20 @@ def _magnitude(p: Parameter, at: float, coef: float, sd: float) -> tuple[float, 
     return value, (abs(value * x0) if p.factor else abs(x0)) * sd, scale
 
 
-def significant(c: Candidate) -> bool:
-    """Whether a candidate's magnitude (its first parameter) stands over SIGNIFICANT standard
-    uncertainties off no effect, on the scale its effect grows with (a factor's logarithm); a null
-    or unbounded uncertainty (a hypothesis fitted from no effect at all) does not tell."""
-    p = parameters(c.hypothesis.cause)[0]
-    value, std = c.hypothesis.values[p.name], c.std.get(p.name, math.inf)
+def separation(p: Parameter, value: float, std: float) -> float:
+    """How many standard uncertainties ``std`` a magnitude ``value`` of ``p`` stands off no effect, on
+    the scale its effect grows with (a factor's logarithm); NaN for a null or unbounded uncertainty
+    (a hypothesis fitted from no effect at all), which does not tell."""
     std = std / value if p.factor else std
-    return 0.0 < std < math.inf and abs(p.effect(value)) > SIGNIFICANT * std
+    return abs(p.effect(value)) / std if 0.0 < std < math.inf else math.nan
+
+
+def significant(c: Candidate) -> bool:
+    """Whether a candidate's magnitude (its first parameter) stands over SIGNIFICANT of its fit's
+    standard uncertainties off no effect (``c.z``). Not the uncertainty :func:`kept` reports: the
+    shift from a screening value that a second parameter, fitted since, has moved says nothing of
+    whether the effect is there."""
+    return c.z > SIGNIFICANT
 
 
 def nudged(h: Hypothesis) -> tuple[Hypothesis, float]:
