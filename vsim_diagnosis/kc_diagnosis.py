@@ -19,10 +19,10 @@
    with the shipped test that would separate them.
 5. When the best leaves a mismatch beyond the noise, or a test it does not fit: every other
    hypothesis beside it, its magnitude fitted on what the best's run leaves from its own screening
-   run; the best few run beside it on every test, both magnitudes refitted together, run again and
-   scored; the best pair whose second magnitude stands off no effect
-   (:func:`vsim_diagnosis.kc_fits.significant`) is named when :func:`vsim_diagnosis.verdict.pair_named`
-   says so.
+   run; the best few run beside it on every test (a second cause with a shape parameter once more,
+   with it moved), both magnitudes and that shape refitted together, run again and scored; the best
+   pair whose second magnitude stands off no effect (:func:`vsim_diagnosis.kc_fits.significant`) is
+   named when :func:`vsim_diagnosis.verdict.pair_named` says so.
 
 Why not the cheaper screen of replaying each bushing's recorded deflections through the extended
 law and mapping the force change through the response to a probe force: in a hysteretic direction
