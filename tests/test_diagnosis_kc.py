@@ -315,7 +315,8 @@ def test_the_second_stage_fits_the_second_cause_beside_the_first():
 
     verify([best], [effect(best.hypothesis)], scorer)
     pairs = _second_stage(best, [(h, base + effect(h)) for h in hs], base, scorer,
-                          lambda hss, tests: [sum(effect(h) for h in hs) for hs in hss], range(4))
+                          lambda hss, tests: [sum(effect(h) for h in hs) for hs in hss], range(4),
+                          [0, 2])
     assert pairs[0].hypothesis.cause == "coupling" and pairs[0].beside.hypothesis.cause == "mullins"
     for c, truth in ((pairs[0], 0.8), (pairs[0].beside, 1.3 - 0.3 * 0.8)):
         p = parameters(c.hypothesis.cause)[0].name
@@ -330,7 +331,8 @@ def test_the_second_stage_fits_the_second_cause_beside_the_first():
     scorer = Scorer(layout, base, split(4))
     verify([best], [effect(best.hypothesis)], scorer)
     nulls = _second_stage(best, [(h, base + effect(h)) for h in hs], base, scorer,
-                          lambda hss, tests: [sum(effect(h) for h in hs) for hs in hss], range(4))
+                          lambda hss, tests: [sum(effect(h) for h in hs) for hs in hss], range(4),
+                          [0, 2])
     assert not any(significant(c) for c in nulls)
 
 

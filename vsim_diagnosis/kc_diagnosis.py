@@ -197,14 +197,11 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, executor: Execut
         top = screened[:VERIFIED]
         say(f"the best {len(top)} on every test with their fitted magnitudes, then refitted along the effect they gave")
         verify(top, rows([extended_vehicle(vehicle, [c.hypothesis]) for c in top], every), scorer)
-        # a cause with a second parameter: one more run with it moved, on the training tests, for its slope
-        moves = [nudged(c.hypothesis) if len(parameters(c.hypothesis.cause)) > 1 else None for c in top]
-        if any(moves):
-            say(f"  {sum(map(bool, moves))} with a second parameter: run with it moved, to fit it too")
-        moved = iter(rows([extended_vehicle(vehicle, [m[0]]) for m in moves if m], training))
-        refit = [fit(c.hypothesis, c.simulated - base, base, scorer,
-                     None if m is None else (next(moved) - c.simulated) / m[1])
-                 for c, m in zip(top, moves)]
+        shaped = sum(len(parameters(c.hypothesis.cause)) > 1 for c in top)
+        if shaped:
+            say(f"  {shaped} with a second parameter: run with it moved, to fit it too")
+        slopes = _slopes(top, lambda hs: rows([extended_vehicle(vehicle, [h]) for h in hs], training))
+        refit = [fit(c.hypothesis, c.simulated - base, base, scorer, s) for c, s in zip(top, slopes)]
         top = kept(top, refit, rows([extended_vehicle(vehicle, [c.hypothesis]) for c in refit], every), scorer)
         best = top[0]
         found = located_misfits(layout, scorer, base)
@@ -219,7 +216,8 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, executor: Execut
             others = [(h, sig) for h, sig in zip(candidates, signatures)
                       if (h.cause, h.location) != (best.hypothesis.cause, best.hypothesis.location)]
             pairs = _second_stage(best, others, base, scorer,
-                                  lambda hs, tests: rows([extended_vehicle(vehicle, h) for h in hs], tests), every)
+                                  lambda hs, tests: rows([extended_vehicle(vehicle, h) for h in hs], tests), every,
+                                  training)
             # a second cause whose magnitude is not told from none is the first's joint refit, not a cause
             k = next((i for i, c in enumerate(pairs) if significant(c)), len(pairs))
             for c in pairs[:k]:
@@ -272,7 +270,7 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, executor: Execut
 
 def _second_stage(best: Candidate, others: list[tuple[Hypothesis, np.ndarray]], base: np.ndarray, scorer: Scorer,
                   rows: Callable[[list[list[Hypothesis]], Sequence[int]], list[np.ndarray]],
-                  every: Sequence[int]) -> list[Candidate]:
+                  every: Sequence[int], training: Sequence[int]) -> list[Candidate]:
     """Every other hypothesis beside ``best``: its magnitude fitted on what ``best``'s run leaves, its
     effect taken from its own screening run (``others``: hypothesis, rows); the best VERIFIED run
     beside ``best`` on every test (``rows`` of the vehicles with the hypotheses listed), both
@@ -281,16 +279,22 @@ def _second_stage(best: Candidate, others: list[tuple[Hypothesis, np.ndarray]], 
     screened = sorted((fit(h, sig - base, best.simulated, scorer) for h, sig in others), key=lambda c: c.score)
     top = screened[:VERIFIED]
     verify(top, rows([[best.hypothesis, c.hypothesis] for c in top], every), scorer)
-    # a second cause with a second parameter: one more run beside the first with it moved, for its slope
-    moves = [nudged(c.hypothesis) if len(parameters(c.hypothesis.cause)) > 1 else None for c in top]
-    training = [i for i, held in enumerate(scorer.heldout) if not held]
-    moved_rows = iter(rows([[best.hypothesis, m[0]] for m in moves if m], training) if any(moves) else [])
-    refits = [(c, fit_pair(best, c, base, scorer, None if m is None else (next(moved_rows) - c.simulated) / m[1]))
-              for c, m in zip(top, moves)]
+    slopes = _slopes(top, lambda hs: rows([[best.hypothesis, h] for h in hs], training))   # beside the first
+    refits = [(c, fit_pair(best, c, base, scorer, s)) for c, s in zip(top, slopes)]
     moved = [(c, r) for c, r in refits if r is not None]
     better = kept([c for c, _ in moved], [r for _, r in moved],
                   rows([[r.beside.hypothesis, r.hypothesis] for _, r in moved], every), scorer) if moved else []
     return sorted(better + [c for c, r in refits if r is None], key=lambda c: c.score)
+
+
+def _slopes(top: list[Candidate], run_moved: Callable[[list[Hypothesis]], list[np.ndarray]]
+            ) -> list[np.ndarray | None]:
+    """Per candidate, its rows' slope along its cause's second parameter, from one more run on the
+    training tests with that parameter moved (:func:`vsim_diagnosis.kc_fits.nudged`; ``run_moved``
+    gives the rows of those hypotheses' runs); None for a cause with one parameter."""
+    moves = [nudged(c.hypothesis) if len(parameters(c.hypothesis.cause)) > 1 else None for c in top]
+    moved = iter(run_moved([m[0] for m in moves if m]) if any(moves) else [])
+    return [None if m is None else (next(moved) - c.simulated) / m[1] for c, m in zip(top, moves)]
 
 
 def _alone(h: Hypothesis, ranking: list[Candidate]) -> Candidate:

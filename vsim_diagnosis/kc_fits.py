@@ -158,7 +158,7 @@ def fit_pair(first: Candidate, second: Candidate, base: np.ndarray, scorer: Scor
     if slope is not None:
         shape = mismatch - scorer.residual(base + slope, train).ravel()
         wide = _gram([*columns, shape])
-        if np.linalg.det(wide) > 1e-9 * np.prod(np.diag(wide)):   # else it changes nothing the two do not
+        if not _alike(wide):   # else it changes nothing the two do not
             coef = np.linalg.solve(wide, [float(np.dot(c, mismatch)) for c in (*columns, shape)])
             magnitude, shape_p = parameters(second.hypothesis.cause)[:2]
             moved = float(np.clip(at[shape_p.name] + coef[2], *_side_bounds(shape_p, at[magnitude.name])))
@@ -190,9 +190,9 @@ def _gram(columns: list[np.ndarray]) -> np.ndarray:
 
 
 def _alike(gram: np.ndarray) -> bool:
-    """Whether two columns (their ``gram`` matrix) are parallel to within round-off: the second
-    changes nothing the first does not, and the two cannot be fitted apart."""
-    return bool(np.linalg.det(gram) <= 1e-9 * gram[0, 0] * gram[1, 1])
+    """Whether columns (their ``gram`` matrix) are dependent to within round-off: the last changes
+    nothing the others do not, and they cannot be fitted apart."""
+    return bool(np.linalg.det(gram) <= 1e-9 * np.prod(np.diag(gram)))
 
 
 def _variances(residual: np.ndarray, gram: np.ndarray) -> np.ndarray:
