@@ -33,7 +33,7 @@ from vsim_cluster.executor import SerialExecutor
 from vsim_core.shipped import DEFAULT_VEHICLE
 from vsim_diagnosis.catalogue import PAIR_SEPARATOR
 from vsim_diagnosis.kc_alike import alike, separations
-from vsim_diagnosis.kc_diagnosis import _second_stage, diagnose_kc
+from vsim_diagnosis.kc_diagnosis import _best_per_place, _second_stage, diagnose_kc, hypotheses
 from vsim_diagnosis.kc_fits import Candidate, Scorer, fit, fit_pair, nominal, separation, significant, verify
 from vsim_diagnosis.kc_layout import Layout, Test
 from vsim_diagnosis.verdict import Separation, pair_named, split, told_apart
@@ -112,6 +112,27 @@ def test_places_and_draws():
     assert {h.values["spring_rate_scale"] > 1.0 for h in rates} == {True, False}
     assert {h.location for h in rates} == {("front",), ("rear",)} == set(locations(v, "spring_rate"))
     assert locations(v, "anti_roll_bar") == [("front",)] and locations(v, "beam_torsion") == [()]
+
+
+def test_the_screening_tries_a_cause_on_each_sign_whose_effect_is_not_odd_in_it():
+    v = load_vehicle()
+    signs: dict[tuple, set[float]] = {}
+    for h in hypotheses(v):
+        first = parameters(h.cause)[0]
+        signs.setdefault((h.cause, h.location), set()).add(math.copysign(1.0, first.effect(h.values[first.name])))
+    for (cause, location), seen in signs.items():
+        # a cross stiffness softens both directions it couples (even part), an asymmetry picks its side
+        both = cause in ("coupling", "asymmetry")
+        assert seen == ({1.0, -1.0} if both else {1.0}), (cause, location, seen)
+    assert {loc for c, loc in signs if c == "coupling"} == set(locations(v, "coupling"))
+    # the ranking names each thing once: a coupling's better fit of its two, both sides of an asymmetry
+    hs = [h for h in hypotheses(v) if h.location in (("e1_rear", "x", "z"), ("e1_rear", "x"))
+          and h.cause in ("coupling", "asymmetry")]   # asymmetry +, -, coupling +, -
+    fitted = [Candidate(h, math.nan, screened_error=e) for h, e in zip(hs, [3.0, 2.0, 2.5, 1.5])]
+    kept = _best_per_place(fitted)
+    assert sorted(c.screened_error for c in kept) == [c.screened_error for c in kept]
+    assert {(c.hypothesis.cause, c.hypothesis.values[parameters(c.hypothesis.cause)[0].name] > 0) for c in kept} \
+        == {("coupling", False), ("asymmetry", True), ("asymmetry", False)}, hs
 
 
 def test_an_axle_factor_scales_its_design_value_in_the_vehicle_and_its_file(tmp_path):

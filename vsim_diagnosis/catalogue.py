@@ -29,6 +29,8 @@ class Parameter:
     signed: bool = False               #: the virtual rig draws either sign
     sided: bool = False                #: a signed parameter whose sign picks another effect, not the
     #: opposite one (asymmetry: which side stiffens): a linear fit cannot cross zero
+    even: bool = False                 #: a signed parameter whose effect is not odd in it (a cross stiffness
+    #: softens both directions it couples, whatever its sign): a fit scaled from one sign's run misses the other's
     log: bool = False                  #: fitted on a log scale (positive, spans decades)
     factor: bool = False               #: a factor on a design value (1: no effect), whose effect grows
     #: with its logarithm (a log parameter otherwise has no effect at 0 and an effect growing with it)
@@ -38,8 +40,9 @@ class Parameter:
 
     @property
     def signs(self) -> tuple[float, ...]:
-        """The signs a hypothesis must be tried with: both for a sided parameter, else +1."""
-        return (1.0, -1.0) if self.sided else (1.0,)
+        """The signs a hypothesis must be tried with: both for a sided parameter or one with an even
+        part in its effect, else +1."""
+        return (1.0, -1.0) if self.sided or self.even else (1.0,)
 
     def effect(self, value: float) -> float:
         """The coordinate the parameter's effect is taken proportional to: its logarithm for a factor,

@@ -8,7 +8,8 @@
    error in each recording is a nuisance, removed.
 2. Screening: every catalogue cause at every place it can sit (:mod:`vsim_diagnosis.kc_catalogue`)
    is run once on the training tests (every other one) at mid-range magnitude (a sided cause, whose
-   sign picks another effect, once per sign); its magnitude is fitted by taking the effect
+   sign picks another effect, or one whose effect is not odd in its magnitude, such as a cross
+   stiffness, once per sign); its magnitude is fitted by taking the effect
    proportional to it (to its logarithm for a factor on a design value).
 3. The best few are run on every test with their fitted magnitudes, refitted once along the effect
    that run gave (a cause with a second parameter, such as a damper's exponent, also along the
@@ -42,7 +43,7 @@ import math
 import time
 from contextlib import closing, nullcontext
 from dataclasses import dataclass, field, replace
-from typing import Callable, Mapping, Sequence
+from typing import Callable, Iterable, Sequence
 
 import numpy as np
 
@@ -144,11 +145,13 @@ class KCDiagnosis(Outcome):
 
 def hypotheses(vehicle: VehicleDefinition) -> list[Hypothesis]:
     """Every catalogue cause at every place it can sit in ``vehicle``, at mid-range values; a sided
-    cause once per side (all its sided parameters on it)."""
+    cause once per side (all its sided parameters on it), a cause whose effect has an even part
+    once per sign of its magnitude (:attr:`vsim_diagnosis.catalogue.Parameter.signs`)."""
     out = []
     for c in (*BUSHING_CAUSES, *VEHICLE_CAUSES):
         params, values = parameters(c), nominal(c)
-        out += [Hypothesis(c, loc, {**values, **{p.name: sign * values[p.name] for p in params if p.sided}})
+        signed = [p.name for p in params if p.sided or p is params[0]]
+        out += [Hypothesis(c, loc, {**values, **{k: sign * values[k] for k in signed}})
                 for loc in locations(vehicle, c) for sign in params[0].signs]
     return out
 
@@ -190,8 +193,7 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, executor: Execut
         say(f"held-out error of the baseline: {before:.3f} (1 = the measurement noise); one run of each of "
             f"{len(candidates)} hypotheses at mid-range magnitude on the {len(training)} training tests")
         signatures = rows([extended_vehicle(vehicle, [h]) for h in candidates], training)
-        screened = sorted((fit(h, sig - base, base, scorer) for h, sig in zip(candidates, signatures)),
-                          key=lambda c: c.score)
+        screened = _best_per_place(fit(h, sig - base, base, scorer) for h, sig in zip(candidates, signatures))
         for c in screened[:VERIFIED]:
             say(f"  {c.hypothesis.label}: training error {c.screened_error:.3f} with {_fmt(c.hypothesis.values)}")
         top = screened[:VERIFIED]
@@ -276,7 +278,7 @@ def _second_stage(best: Candidate, others: list[tuple[Hypothesis, np.ndarray]], 
     beside ``best`` on every test (``rows`` of the vehicles with the hypotheses listed), both
     magnitudes refitted together along the effects those runs gave (:func:`fit_pair`), run again and
     scored on the held-out tests; the candidates carry the pair's errors and rows, best first."""
-    screened = sorted((fit(h, sig - base, best.simulated, scorer) for h, sig in others), key=lambda c: c.score)
+    screened = _best_per_place(fit(h, sig - base, best.simulated, scorer) for h, sig in others)
     top = screened[:VERIFIED]
     verify(top, rows([[best.hypothesis, c.hypothesis] for c in top], every), scorer)
     slopes = _slopes(top, lambda hs: rows([[best.hypothesis, h] for h in hs], training))   # beside the first
@@ -298,15 +300,26 @@ def _slopes(top: list[Candidate], run_moved: Callable[[list[Hypothesis]], list[n
 
 
 def _alone(h: Hypothesis, ranking: list[Candidate]) -> Candidate:
-    """The single stage's candidate of ``h``'s cause at its place (and on its side, for a sided
-    cause: the sign of its first parameter), fitted alone."""
+    """The single stage's candidate of ``h``'s cause at its place (:func:`_place`), fitted alone."""
+    return next(c for c in ranking if _place(c.hypothesis) == _place(h))
+
+
+def _place(h: Hypothesis) -> tuple:
+    """What a hypothesis names: its cause, its place and, for a sided cause, its side (the sign of its
+    first parameter); not the screening sign of a cause whose effect is not odd, fitted either way."""
     first = parameters(h.cause)[0]
+    return h.cause, h.location, math.copysign(1.0, h.values[first.name]) if first.sided else 1.0
 
-    def side(values: Mapping[str, float]) -> float:
-        return math.copysign(1.0, values[first.name]) if first.sided else 1.0
 
-    return next(c for c in ranking if (c.hypothesis.cause, c.hypothesis.location) == (h.cause, h.location)
-                and side(c.hypothesis.values) == side(h.values))
+def _best_per_place(candidates: Iterable[Candidate]) -> list[Candidate]:
+    """The candidates best first, only the best of those naming one thing (:func:`_place`: a cause
+    screened on both signs is fitted from each)."""
+    out, seen = [], set()
+    for c in sorted(candidates, key=lambda c: c.score):
+        if _place(c.hypothesis) not in seen:
+            seen.add(_place(c.hypothesis))
+            out.append(c)
+    return out
 
 
 def located_misfits(layout: Layout, scorer: Scorer, predicted: np.ndarray) -> list[Misfit]:
