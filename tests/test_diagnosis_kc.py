@@ -34,7 +34,8 @@ from vsim_core.shipped import DEFAULT_VEHICLE
 from vsim_diagnosis.catalogue import PAIR_SEPARATOR
 from vsim_diagnosis.kc_alike import alike, separations
 from vsim_diagnosis.kc_diagnosis import _best_per_place, _second_stage, diagnose_kc, hypotheses
-from vsim_diagnosis.kc_fits import Candidate, Scorer, fit, fit_pair, nominal, separation, significant, verify
+from vsim_diagnosis.kc_fits import (Candidate, Scorer, fit, fit_pair, halfway, nominal, separation, significant,
+                                    verify)
 from vsim_diagnosis.kc_layout import Layout, Test
 from vsim_diagnosis.verdict import Separation, pair_named, split, told_apart
 from vsim_diagnosis.virtual_kc_rig import DEFAULT_SCENARIOS, measure_kc, parse_kc_truth
@@ -355,6 +356,57 @@ def test_the_second_stage_fits_the_second_cause_beside_the_first():
                           lambda hss, tests: [sum(effect(h) for h in hs) for hs in hss], range(4),
                           [0, 2])
     assert not any(significant(c) for c in nulls)
+
+
+def test_a_pair_refit_that_overshoots_is_tried_at_half_its_step():
+    """The second cause's effect steepens along its shape beyond a knee its slope run (shape 1.25)
+    does not reach: the linearised refit overshoots the hidden shape 1.32 (to about 1.5) and its
+    run is worse than its start; half its step is run, kept, and significant. The halfway point
+    lies on the effect's scale (a factor's geometric mean), with the refit's own uncertainties."""
+    rng = np.random.default_rng(11)
+    t = np.linspace(0.0, 1.0, 4000)
+    first, a, b = (np.column_stack([np.sin(k * np.pi * t), np.cos((k + 1) * np.pi * t)]) for k in (2, 5, 9))
+    m0, beam0 = nominal("mullins")["mullins"], nominal("beam_torsion")["beam_torsion_scale"]
+
+    def effect(h: Hypothesis) -> np.ndarray:   # the beam log-linear; the softening linear in its magnitude
+        if h.cause == "beam_torsion":
+            return math.log(h.values["beam_torsion_scale"]) / math.log(beam0) * first
+        d = h.values["mullins_shape"] - 1.0
+        return h.values["mullins"] / m0 * (a + (d if d <= 0.3 else 0.3 + 10.0 * (d - 0.3)) * b)
+
+    mullins = Hypothesis("mullins", ("e1_rear", "x"), nominal("mullins"))
+    truth = replace(mullins, values={"mullins": 1.2 * m0, "mullins_shape": 1.32})
+    tests = [Test(str(i), None, np.arange(1000 * i, 1000 * (i + 1))) for i in range(4)]
+    layout = Layout(["c_x", "c_y"], first + effect(truth) + 0.2 * rng.standard_normal(first.shape), np.zeros(4000),
+                    np.zeros(4000, dtype=int), np.repeat(np.arange(4), 1000), tests)
+    base = np.zeros_like(first)
+    scorer = Scorer(layout, base, split(4))
+    best = Candidate(Hypothesis("beam_torsion", (), nominal("beam_torsion")), math.nan)
+    verify([best], [effect(best.hypothesis)], scorer)
+    runs = []
+
+    def rows(hss: list[list[Hypothesis]], tests) -> list[np.ndarray]:
+        runs.extend(hs[1].values["mullins_shape"] for hs in hss)
+        return [sum(effect(h) for h in hs) for hs in hss]
+
+    (pair,) = _second_stage(best, [(mullins, base + effect(mullins))], base, scorer, rows, range(4), [0, 2])
+    start, slope, full, half = runs   # the screening fit, its slope run, the refit, its half step
+    assert (start, slope) == (1.0, 1.25) and full > 1.45
+    shape = pair.hypothesis.values["mullins_shape"]
+    assert shape == pytest.approx(0.5 * (start + full), rel=1e-12) == pytest.approx(half, rel=1e-12)
+    assert pair.heldout_error < 1.6 and significant(pair)
+    assert pair.hypothesis.values["mullins"] == pytest.approx(1.2 * m0, rel=0.1)
+    # the halfway of two candidates, on each parameter's effect scale
+    one = Candidate(Hypothesis("beam_torsion", (), {"beam_torsion_scale": 1.3}), math.nan)
+    two = Candidate(Hypothesis("beam_torsion", (), {"beam_torsion_scale": 1.9}), math.nan,
+                    {"beam_torsion_scale": 0.01})
+    near, far = (Candidate(replace(mullins, values=v), math.nan, {"mullins": 0.004}) for v in
+                 ({"mullins": 0.1, "mullins_shape": 1.0}, {"mullins": 0.2, "mullins_shape": 1.5}))
+    far.beside = two
+    mid = halfway(one, near, far)
+    assert mid.hypothesis.values == pytest.approx({"mullins": 0.15, "mullins_shape": 1.25}, rel=1e-12)
+    assert mid.beside.hypothesis.values["beam_torsion_scale"] == pytest.approx(math.sqrt(1.3 * 1.9), rel=1e-12)
+    assert mid.std == far.std and mid.std is not far.std and mid.z == pytest.approx(0.15 / 0.004)
 
 
 def test_a_magnitude_is_significant_off_no_effect_on_its_effects_scale():

@@ -21,7 +21,8 @@
 5. When the best leaves a mismatch beyond the noise, or a test it does not fit: every other
    hypothesis beside it, its magnitude fitted on what the best's run leaves from its own screening
    run; the best few run beside it on every test (a second cause with a shape parameter once more,
-   with it moved), both magnitudes and that shape refitted together, run again and scored; the best
+   with it moved), both magnitudes and that shape refitted together, run again and scored (a refit
+   worse than where it started once more at half its step: the linearised step can overshoot); the best
    pair whose second magnitude stands off no effect (:func:`vsim_diagnosis.kc_fits.significant`) is
    named when :func:`vsim_diagnosis.verdict.pair_named` says so.
 
@@ -53,7 +54,7 @@ from vsim_diagnosis.catalogue import PAIR_SEPARATOR
 from vsim_diagnosis.kc_alike import alike, extra_scenarios, run_unless_diverged, separations
 from vsim_diagnosis.kc_catalogue import (BUSHING_CAUSES, VEHICLE_CAUSES, Hypothesis, extended_vehicle, locations,
                                          parameters)
-from vsim_diagnosis.kc_fits import (Candidate, Scorer, fit, fit_pair, kept, nominal, nudged, significant,
+from vsim_diagnosis.kc_fits import (Candidate, Scorer, fit, fit_pair, halfway, kept, nominal, nudged, significant,
                                     verify)
 from vsim_diagnosis.kc_layout import Layout, run_job
 from vsim_diagnosis.verdict import (Outcome, Separation, decide, explained, misfit, misfit_stretch, pair_named,
@@ -284,8 +285,18 @@ def _second_stage(best: Candidate, others: list[tuple[Hypothesis, np.ndarray]], 
     slopes = _slopes(top, lambda hs: rows([[best.hypothesis, h] for h in hs], training))   # beside the first
     refits = [(c, fit_pair(best, c, base, scorer, s)) for c, s in zip(top, slopes)]
     moved = [(c, r) for c, r in refits if r is not None]
-    better = kept([c for c, _ in moved], [r for _, r in moved],
-                  rows([[r.beside.hypothesis, r.hypothesis] for _, r in moved], every), scorer) if moved else []
+
+    def run(pairs: list[Candidate]) -> list[np.ndarray]:
+        return rows([[r.beside.hypothesis, r.hypothesis] for r in pairs], every)
+
+    # two magnitudes and a shape moved at once along their linearised effects can overshoot (a Mullins
+    # softening's magnitude and shape trade): a refit worse than its start is tried at half its step
+    halves = [halfway(best, c, r) for c, r in moved]   # with the fit's own uncertainties, before kept widens them
+    better = kept([c for c, _ in moved], [r for _, r in moved], run([r for _, r in moved]), scorer) if moved else []
+    over = [(c, half) for (c, r), half in zip(moved, halves) if r.score > c.score]
+    if over:
+        tried = kept([c for c, _ in over], [h for _, h in over], run([h for _, h in over]), scorer)
+        better = [b for b in better if all(b is not c for c, _ in over)] + tried
     return sorted(better + [c for c, r in refits if r is None], key=lambda c: c.score)
 
 

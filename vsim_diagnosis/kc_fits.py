@@ -184,6 +184,24 @@ def fit_pair(first: Candidate, second: Candidate, base: np.ndarray, scorer: Scor
     return out[1]
 
 
+def halfway(first: Candidate, start: Candidate, refit: Candidate) -> Candidate:
+    """A pair refit's step halved: every parameter of the second cause halfway from ``start`` (its
+    screening fit, beside ``first`` as fitted alone) to ``refit`` (:func:`fit_pair`), and the first
+    cause's halfway from ``first`` to ``refit.beside``, on the scale the fit is linear in (a factor's
+    logarithm); the refit's uncertainties."""
+    def mid(a: Candidate, b: Candidate) -> Candidate:
+        params = {p.name: p for p in parameters(a.hypothesis.cause)}
+        x, y = a.hypothesis.values, b.hypothesis.values
+        values = {k: params[k].from_effect(0.5 * (params[k].effect(x[k]) + params[k].effect(y[k]))) for k in y}
+        magnitude = parameters(a.hypothesis.cause)[0]
+        return Candidate(replace(b.hypothesis, values=values), math.nan, dict(b.std),
+                         z=separation(magnitude, values[magnitude.name], b.std[magnitude.name]))
+
+    out = mid(start, refit)
+    out.beside = mid(first, refit.beside)
+    return out
+
+
 def _gram(columns: list[np.ndarray]) -> np.ndarray:
     """The columns' dot products with each other (the normal equations' matrix)."""
     return np.array([[float(np.dot(a, b)) for b in columns] for a in columns])

@@ -38,9 +38,15 @@ def _parameters(d: KCDiagnosis, c: Candidate | None = None) -> dict[str, Any]:
 
 def _candidate(c: Candidate) -> dict[str, Any]:
     return {"cause": c.hypothesis.cause, "location": c.hypothesis.location_json(),
-            "heldout_error": c.heldout_error if c.verified else None, "training_error": c.screened_error,
+            "heldout_error": c.heldout_error if c.verified else None, "training_error": _training_error(c),
             "score": c.score, "n_parameters": len(parameters(c.hypothesis.cause)),
             "parameters": dict(c.hypothesis.values)}
+
+
+def _training_error(c: Candidate) -> float | None:
+    """The linearised fit's RMS on the training tests; None for a candidate no such fit gave (a pair
+    refit's halved step, :func:`vsim_diagnosis.kc_fits.halfway`), which only its runs scored."""
+    return c.screened_error if math.isfinite(c.screened_error) else None
 
 
 def _run_with(d: KCDiagnosis, c: Candidate) -> list[Hypothesis]:
@@ -53,7 +59,7 @@ def _pair(d: KCDiagnosis, c: Candidate) -> dict[str, Any]:
     """A second-stage candidate: the pair run, both causes with the values it was run with."""
     both = _run_with(d, c)
     return {"cause": PAIR_SEPARATOR.join(h.cause for h in both), "heldout_error": c.heldout_error,
-            "training_error": c.screened_error, "score": c.score,
+            "training_error": _training_error(c), "score": c.score,
             "causes": [{"cause": h.cause, "location": h.location_json(), "parameters": dict(h.values)} for h in both]}
 
 
