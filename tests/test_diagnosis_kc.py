@@ -31,7 +31,7 @@ from vsim_diagnosis.kc_catalogue import (OBSERVABLE, Hypothesis, draw, extended_
                                          locations, parameters)
 from vsim_cluster.executor import SerialExecutor
 from vsim_core.shipped import DEFAULT_VEHICLE
-from vsim_diagnosis.catalogue import PAIR_SEPARATOR
+from vsim_diagnosis.catalogue import PAIR_SEPARATOR, Parameter
 from vsim_diagnosis.kc_alike import alike, separations
 from vsim_diagnosis.kc_diagnosis import _best_per_place, _second_stage, diagnose_kc, hypotheses
 from vsim_diagnosis.kc_fits import (Candidate, Scorer, fit, fit_pair, halfway, nominal, separation, significant,
@@ -39,7 +39,7 @@ from vsim_diagnosis.kc_fits import (Candidate, Scorer, fit, fit_pair, halfway, n
 from vsim_diagnosis.kc_layout import Layout, Test
 from vsim_diagnosis.verdict import Separation, pair_named, split, told_apart
 from vsim_diagnosis.virtual_kc_rig import DEFAULT_SCENARIOS, measure_kc, parse_kc_truth
-from vsim_presentation.kc_report import _parameters, summary
+from vsim_presentation.kc_report import _candidate, _parameters, summary
 from vsim_recordings.recorder import run_scenario, simulate
 from vsim_recordings.kc_dataset import read_kc_dataset
 from vsim_recordings.run_reader import load_run
@@ -123,9 +123,11 @@ def test_the_screening_tries_a_cause_on_each_sign_whose_effect_is_not_odd_in_it(
         signs.setdefault((h.cause, h.location), set()).add(math.copysign(1.0, first.effect(h.values[first.name])))
     for (cause, location), seen in signs.items():
         # a cross stiffness softens both directions it couples (even part), an asymmetry picks its side
-        both = cause in ("coupling", "asymmetry")
+        both = cause in ("coupling", "asymmetry", "preload")
         assert seen == ({1.0, -1.0} if both else {1.0}), (cause, location, seen)
     assert {loc for c, loc in signs if c == "coupling"} == set(locations(v, "coupling"))
+    with pytest.raises(ValueError, match="needs signed"):   # a fit on one sign's run must be free to take the other
+        Parameter("stiffness", "N/mm", (0.0, 500.0), (40.0, 120.0), even_part=True)
     # the ranking names each thing once: a coupling's better fit of its two, both sides of an asymmetry
     hs = [h for h in hypotheses(v) if h.location in (("e1_rear", "x", "z"), ("e1_rear", "x"))
           and h.cause in ("coupling", "asymmetry")]   # asymmetry +, -, coupling +, -
@@ -362,7 +364,8 @@ def test_a_pair_refit_that_overshoots_is_tried_at_half_its_step():
     """The second cause's effect steepens along its shape beyond a knee its slope run (shape 1.25)
     does not reach: the linearised refit overshoots the hidden shape 1.32 (to about 1.5) and its
     run is worse than its start; half its step is run, kept, and significant. The halfway point
-    lies on the effect's scale (a factor's geometric mean), with the refit's own uncertainties."""
+    lies on the scale the fit moved each parameter along (a factor's logarithm), with the refit's own
+    uncertainties."""
     rng = np.random.default_rng(11)
     t = np.linspace(0.0, 1.0, 4000)
     first, a, b = (np.column_stack([np.sin(k * np.pi * t), np.cos((k + 1) * np.pi * t)]) for k in (2, 5, 9))
@@ -393,9 +396,11 @@ def test_a_pair_refit_that_overshoots_is_tried_at_half_its_step():
     start, slope, full, half = runs   # the screening fit, its slope run, the refit, its half step
     assert (start, slope) == (1.0, 1.25) and full > 1.45
     shape = pair.hypothesis.values["mullins_shape"]
-    assert shape == pytest.approx(0.5 * (start + full), rel=1e-12) == pytest.approx(half, rel=1e-12)
+    assert shape == pytest.approx(0.5 * (start + full), rel=1e-12) and shape == pytest.approx(half, rel=1e-12)
     assert pair.heldout_error < 1.6 and significant(pair)
     assert pair.hypothesis.values["mullins"] == pytest.approx(1.2 * m0, rel=0.1)
+    # no linearised fit gave it: its training error is written as null, the JSON strict
+    assert json.loads(json.dumps(_candidate(pair), allow_nan=False))["training_error"] is None
     # the halfway of two candidates, on each parameter's effect scale
     one = Candidate(Hypothesis("beam_torsion", (), {"beam_torsion_scale": 1.3}), math.nan)
     two = Candidate(Hypothesis("beam_torsion", (), {"beam_torsion_scale": 1.9}), math.nan,

@@ -39,7 +39,8 @@ from vsim_recordings.recorder import simulate
 
 def weak(cause: str) -> list[dict[str, float]]:
     """The cause's values at the weak end of its range: the first parameter at the low end of its
-    draw (of either sign, for a sided cause), the others mid-range."""
+    draw (of either sign, for a cause screened on both: :attr:`vsim_diagnosis.catalogue.Parameter.signs`),
+    the others mid-range."""
     first = parameters(cause)[0]
     return [{**nominal(cause), first.name: sign * first.draw[0]} for sign in first.signs]
 
@@ -96,7 +97,7 @@ def main() -> int:
             if not args.json:
                 print(f"{h.label:40s} {parameters(h.cause)[0].name} = {h.values[parameters(h.cause)[0].name]:<8.4g}"
                       f" excess {x:7.2f}", flush=True)
-            if x < out.get(h.label, {}).get("excess", math.inf):   # a sided cause: its weaker sign
+            if x < out.get(h.label, {}).get("excess", math.inf):   # a cause tried on both signs: its weaker
                 out[h.label] = {"excess": x, "floor": floor(h.cause, x)}
     out = {label: out[label] for label in dict.fromkeys(h.label for h in places)}   # in the places' order
     if args.json:

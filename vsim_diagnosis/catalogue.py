@@ -29,8 +29,9 @@ class Parameter:
     signed: bool = False               #: the virtual rig draws either sign
     sided: bool = False                #: a signed parameter whose sign picks another effect, not the
     #: opposite one (asymmetry: which side stiffens): a linear fit cannot cross zero
-    even: bool = False                 #: a signed parameter whose effect is not odd in it (a cross stiffness
-    #: softens both directions it couples, whatever its sign): a fit scaled from one sign's run misses the other's
+    even_part: bool = False            #: a signed parameter whose effect has a part even in it (a cross
+    #: stiffness softens both directions it couples, whatever its sign): a fit scaled from one sign's run
+    #: misses the other's
     log: bool = False                  #: fitted on a log scale (positive, spans decades)
     factor: bool = False               #: a factor on a design value (1: no effect), whose effect grows
     #: with its logarithm (a log parameter otherwise has no effect at 0 and an effect growing with it)
@@ -38,11 +39,16 @@ class Parameter:
     default: float | None = None       #: a family's shape parameter: its value in the family's first
     #: form, taken when a truth file leaves it out
 
+    def __post_init__(self) -> None:
+        if (self.sided or self.even_part) and not self.signed:
+            raise ValueError(f"parameter {self.name}: sided or even_part needs signed (a fit on one sign's run "
+                             f"must be free to take the other)")
+
     @property
     def signs(self) -> tuple[float, ...]:
         """The signs a hypothesis must be tried with: both for a sided parameter or one with an even
         part in its effect, else +1."""
-        return (1.0, -1.0) if self.sided or self.even else (1.0,)
+        return (1.0, -1.0) if self.sided or self.even_part else (1.0,)
 
     def effect(self, value: float) -> float:
         """The coordinate the parameter's effect is taken proportional to: its logarithm for a factor,

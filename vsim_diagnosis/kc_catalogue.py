@@ -57,7 +57,7 @@ VEHICLE_CAUSES: dict[str, VehicleCause] = {c.id: c for c in (
     VehicleCause("coupling", "a cross stiffness between two directions of one bushing (voids, inclined layers): "
                  "F_a += k·e_b, F_b += k·e_a",
                  "responses in a direction the input does not load in the baseline; mismatch in combined loading",
-                 (Parameter("stiffness", "N/mm", (-500.0, 500.0), (40.0, 120.0), signed=True, even=True,
+                 (Parameter("stiffness", "N/mm", (-500.0, 500.0), (40.0, 120.0), signed=True, even_part=True,
                             description="cross stiffness"),), located=True),
     VehicleCause("strut_friction", "Coulomb friction of the piston rod sliding in the strut tube",
                  "pad-force and camber loops wider than the bushings explain, width independent of speed",

@@ -151,7 +151,7 @@ def hypotheses(vehicle: VehicleDefinition) -> list[Hypothesis]:
     out = []
     for c in (*BUSHING_CAUSES, *VEHICLE_CAUSES):
         params, values = parameters(c), nominal(c)
-        signed = [p.name for p in params if p.sided or p is params[0]]
+        signed = [p.name for p in params if p.sided or p.even_part]
         out += [Hypothesis(c, loc, {**values, **{k: sign * values[k] for k in signed}})
                 for loc in locations(vehicle, c) for sign in params[0].signs]
     return out
@@ -278,7 +278,8 @@ def _second_stage(best: Candidate, others: list[tuple[Hypothesis, np.ndarray]], 
     effect taken from its own screening run (``others``: hypothesis, rows); the best VERIFIED run
     beside ``best`` on every test (``rows`` of the vehicles with the hypotheses listed), both
     magnitudes refitted together along the effects those runs gave (:func:`fit_pair`), run again and
-    scored on the held-out tests; the candidates carry the pair's errors and rows, best first."""
+    scored on the held-out tests (a refit worse than its start once more at half its step,
+    :func:`halfway`); the candidates carry the pair's errors and rows, best first."""
     screened = _best_per_place(fit(h, sig - base, best.simulated, scorer) for h, sig in others)
     top = screened[:VERIFIED]
     verify(top, rows([[best.hypothesis, c.hypothesis] for c in top], every), scorer)
@@ -293,7 +294,7 @@ def _second_stage(best: Candidate, others: list[tuple[Hypothesis, np.ndarray]], 
     # softening's magnitude and shape trade): a refit worse than its start is tried at half its step
     halves = [halfway(best, c, r) for c, r in moved]   # with the fit's own uncertainties, before kept widens them
     better = kept([c for c, _ in moved], [r for _, r in moved], run([r for _, r in moved]), scorer) if moved else []
-    over = [(c, half) for (c, r), half in zip(moved, halves) if r.score > c.score]
+    over = [(c, half) for (c, _), half in zip(moved, halves) if any(b is c for b in better)]   # its start kept
     if over:
         tried = kept([c for c, _ in over], [h for _, h in over], run([h for _, h in over]), scorer)
         better = [b for b in better if all(b is not c for c, _ in over)] + tried

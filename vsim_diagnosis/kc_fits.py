@@ -28,11 +28,12 @@ class Candidate:
     hypothesis: Hypothesis
     heldout_error: float                      #: noise-normalised RMS on held-out tests (1 = the noise)
     std: dict[str, float] = field(default_factory=dict)
-    screened_error: float = math.nan          #: RMS on the training tests after the screening's fit
+    screened_error: float = math.nan          #: RMS on the training tests after the screening's fit (NaN
+    #: for a candidate no linearised fit gave: :func:`halfway`)
     test_errors: np.ndarray | None = None     #: per test, from the full vehicle run
     simulated: np.ndarray | None = None       #: the full vehicle run's rows (verified candidates)
-    #: a second cause's: the first cause as refitted together with it (:func:`fit_pair`); the run
-    #: and errors above are then the pair's
+    #: a second cause's: the first cause as refitted together with it (:func:`fit_pair`, or halfway
+    #: there: :func:`halfway`); the run and errors above are then the pair's
     beside: "Candidate | None" = None
     #: its magnitude's distance from no effect in the fit's own standard uncertainty (:func:`separation`),
     #: before :func:`kept` widens the uncertainty to the refit's shift
@@ -187,13 +188,15 @@ def fit_pair(first: Candidate, second: Candidate, base: np.ndarray, scorer: Scor
 def halfway(first: Candidate, start: Candidate, refit: Candidate) -> Candidate:
     """A pair refit's step halved: every parameter of the second cause halfway from ``start`` (its
     screening fit, beside ``first`` as fitted alone) to ``refit`` (:func:`fit_pair`), and the first
-    cause's halfway from ``first`` to ``refit.beside``, on the scale the fit is linear in (a factor's
-    logarithm); the refit's uncertainties."""
+    cause's halfway from ``first`` to ``refit.beside``, each on the scale the fit moved it along (a
+    magnitude on its effect's, a factor's logarithm; a second parameter linearly); the refit's
+    uncertainties (taken before :func:`kept` widens them)."""
     def mid(a: Candidate, b: Candidate) -> Candidate:
-        params = {p.name: p for p in parameters(a.hypothesis.cause)}
+        magnitude, *rest = parameters(a.hypothesis.cause)
         x, y = a.hypothesis.values, b.hypothesis.values
-        values = {k: params[k].from_effect(0.5 * (params[k].effect(x[k]) + params[k].effect(y[k]))) for k in y}
-        magnitude = parameters(a.hypothesis.cause)[0]
+        values = {**y, **{p.name: 0.5 * (x[p.name] + y[p.name]) for p in rest if p.name in x and p.name in y},
+                  magnitude.name: magnitude.from_effect(0.5 * (magnitude.effect(x[magnitude.name])
+                                                               + magnitude.effect(y[magnitude.name])))}
         return Candidate(replace(b.hypothesis, values=values), math.nan, dict(b.std),
                          z=separation(magnitude, values[magnitude.name], b.std[magnitude.name]))
 
