@@ -116,6 +116,8 @@ def test_places_and_draws():
 
 
 def test_the_screening_tries_a_cause_on_each_sign_whose_effect_is_not_odd_in_it():
+    """A sided cause and a cross stiffness are screened on both signs at each place, every other cause
+    on one; the ranking keeps the better of a cross stiffness's two fits and both sides of a sided cause."""
     v = load_vehicle()
     signs: dict[tuple, set[float]] = {}
     for h in hypotheses(v):
@@ -401,7 +403,7 @@ def test_a_pair_refit_that_overshoots_is_tried_at_half_its_step():
     assert pair.hypothesis.values["mullins"] == pytest.approx(1.2 * m0, rel=0.1)
     # no linearised fit gave it: its training error is written as null, the JSON strict
     assert json.loads(json.dumps(_candidate(pair), allow_nan=False))["training_error"] is None
-    # the halfway of two candidates, on each parameter's effect scale
+    # the halfway of two candidates: a factor magnitude on its logarithm, a shape linearly
     one = Candidate(Hypothesis("beam_torsion", (), {"beam_torsion_scale": 1.3}), math.nan)
     two = Candidate(Hypothesis("beam_torsion", (), {"beam_torsion_scale": 1.9}), math.nan,
                     {"beam_torsion_scale": 0.01})
