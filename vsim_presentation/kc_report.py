@@ -245,7 +245,8 @@ def write_report(d: KCDiagnosis, baseline: VehicleDefinition, out_dir: Path, dat
     if d.pairs:
         report.paragraph(f"Second stage: {d.best.hypothesis.label} left a mismatch beyond the noise or a test it "
                          f"does not fit; every other hypothesis was fitted beside it, the best run with it on every "
-                         f"test, both magnitudes (and the second's shape) refitted together (two causes are named "
+                         f"test, both magnitudes (and the second's shape) refitted together, a refit that did worse "
+                         f"than where it started once more at half its step (two causes are named "
                          f"when the pair removes most of what the first left and the second's magnitude stands over "
                          f"two of its fit's standard uncertainties off no effect):")
         report.table(("pair", "held-out error", "fitted values"),
