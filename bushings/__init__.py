@@ -5,8 +5,8 @@ scheme and returns each channel's force and tangent stiffness. All quantities ar
 sets are written in the thesis's units (N, mm, s) and converted once, when loaded.
 """
 
-from bushings.bank import BushingBank
-from bushings.parameter_sets import ParameterSet, available_parameter_sets, load_parameter_set
-from bushings.parameters import ChannelParams, to_si
+from elastokin.bushings.bank import BushingBank
+from elastokin.bushings.parameter_sets import ParameterSet, available_parameter_sets, load_parameter_set
+from elastokin.bushings.parameters import ChannelParams, to_si
 
 __all__ = ["BushingBank", "ChannelParams", "ParameterSet", "available_parameter_sets", "load_parameter_set", "to_si"]

@@ -8,8 +8,8 @@ from typing import Sequence
 
 import numpy as np
 
-from bushings import kernel as kn
-from bushings.parameters import ChannelParams
+from elastokin.bushings import kernel as kn
+from elastokin.bushings.parameters import ChannelParams
 
 
 @dataclass
@@ -118,7 +118,7 @@ class BushingBank:
         return self.force, self.tangent
 
     def kernel_args(self) -> tuple[np.ndarray, ...]:
-        """The arrays :func:`bushings.kernel.step_bank` takes after (e, h), in its order, for
+        """The arrays :func:`elastokin.bushings.kernel.step_bank` takes after (e, h), in its order, for
         compiled callers (e.g. a vehicle step loop) that call the kernel themselves."""
         return tuple(getattr(self, name) for name, _, _ in kn.BANK_ARRAYS)
 

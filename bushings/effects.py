@@ -8,7 +8,7 @@ Two kinds, both switched on per channel and off by default:
   fitted to a fractional (power-law) relaxation modulus (:func:`with_broad_relaxation`);
 * state extensions (:class:`Effects`): preload (operating-point shift), tension/compression
   asymmetry, Mullins softening, self-heating, a slipping interface and a backlash dead band,
-  applied around the base law by the compiled wrapper of :mod:`bushings.extended_bank`.
+  applied around the base law by the compiled wrapper of :mod:`elastokin.bushings.extended_bank`.
 """
 
 from __future__ import annotations
@@ -19,8 +19,8 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from bushings.parameters import LENGTH_UNIT_SI, ChannelParams
-from vsim_core.errors import InputError
+from elastokin.bushings.parameters import LENGTH_UNIT_SI, ChannelParams
+from elastokin.core.errors import InputError
 
 
 @dataclass(frozen=True)

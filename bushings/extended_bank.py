@@ -1,4 +1,4 @@
-"""A bank of bushing channels with their state extensions (:class:`bushings.effects.Effects`), stepped
+"""A bank of bushing channels with their state extensions (:class:`elastokin.bushings.effects.Effects`), stepped
 by one compiled call around the base kernel; and whole deflection histories run in one compiled call
 (for fitting, where a history is replayed many times)."""
 
@@ -9,11 +9,11 @@ from typing import Sequence
 import numba as nb
 import numpy as np
 
-from bushings import kernel as kn
-from bushings.bank import DEFAULT_TOLERANCE, BushingBank
-from bushings.effects import NO_EFFECTS, Effects
-from bushings.parameters import LENGTH_UNIT_SI, ChannelParams
-from vsim_core.compiled_cache import follow
+from elastokin.bushings import kernel as kn
+from elastokin.bushings.bank import DEFAULT_TOLERANCE, BushingBank
+from elastokin.bushings.effects import NO_EFFECTS, Effects
+from elastokin.bushings.parameters import LENGTH_UNIT_SI, ChannelParams
+from elastokin.core.compiled_cache import follow
 
 # Columns of the effect parameter matrix (one row per channel) and of the effect state.
 (E_PRELOAD, E_ASYM, E_ASYM_POWER, E_ASYM_STEP, E_ASYM_STEP_WIDTH, E_MULLINS, E_MULLINS_SHAPE, E_HEAT, E_HEAT_TAU,
@@ -25,7 +25,7 @@ N_SCOLS = 5
 MOUNT_S, MOUNT_STEPS = 10.0, 200
 
 
-#: The files a function that steps the bank compiles into itself (see vsim_core.compiled_cache).
+#: The files a function that steps the bank compiles into itself (see elastokin.core.compiled_cache).
 KERNEL_FILES = (kn.__file__, __file__)
 follow(__file__, *KERNEL_FILES)
 

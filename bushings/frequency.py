@@ -17,9 +17,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from bushings.bank import BushingBank
-from bushings.parameters import ChannelParams
-from vsim_core.errors import InputError
+from elastokin.bushings.bank import BushingBank
+from elastokin.bushings.parameters import ChannelParams
+from elastokin.core.errors import InputError
 
 
 @dataclass(frozen=True)

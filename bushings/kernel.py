@@ -22,7 +22,7 @@ import math
 import numba as nb
 import numpy as np
 
-from bushings.parameters import MAX_CELLS
+from elastokin.bushings.parameters import MAX_CELLS
 
 # Columns of the float parameter matrix P (one row per channel, SI).
 P_K0, P_C, P_NSUP, P_NINF, P_SSUP, P_SINF, P_PSUP, P_PINF, P_KPA, P_KR, P_FF, P_CO, P_PW, P_CT, P_NROOT, \

@@ -10,12 +10,12 @@ from pathlib import Path
 from typing import Any, Mapping
 
 
-from bushings.effects import Effects, effects_to_si
-from bushings.parameters import MODELS, ChannelParams, to_si
-from vsim_core.documents import Document, dump_yaml
-from vsim_core.errors import InputError
-from vsim_core.files import atomic_output, is_file, read_text
-from vsim_core.shipped import PARAMETER_SET_DIR
+from elastokin.bushings.effects import Effects, effects_to_si
+from elastokin.bushings.parameters import MODELS, ChannelParams, to_si
+from elastokin.core.documents import Document, dump_yaml
+from elastokin.core.errors import InputError
+from elastokin.core.files import atomic_output, is_file, read_text
+from elastokin.core.shipped import PARAMETER_SET_DIR
 
 
 @dataclass(frozen=True)
@@ -28,7 +28,7 @@ class ParameterSet:
     values: Mapping[str, Any]  #: user-facing values in the thesis's units
     source: str                #: provenance (publication, figure, measurement, assumption)
     path: Path | None = None
-    effects: Mapping[str, Any] = field(default_factory=dict)  #: law extensions, see :mod:`bushings.effects`
+    effects: Mapping[str, Any] = field(default_factory=dict)  #: law extensions, see :mod:`elastokin.bushings.effects`
 
     def effects_si(self) -> Effects:
         """The set's state extensions (preload, asymmetry, Mullins, self-heating, backlash) in SI."""

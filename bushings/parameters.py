@@ -11,8 +11,8 @@ import math
 from dataclasses import dataclass, field, replace
 from typing import Any, Mapping
 
-from vsim_core import units
-from vsim_core.errors import InputError
+from elastokin.core import units
+from elastokin.core.errors import InputError
 
 #: Number of ladder cells when a set does not say (the thesis's choice for 0.05–2 mm).
 DEFAULT_CELLS = 15

@@ -13,7 +13,7 @@ import math
 import numba as nb
 import numpy as np
 
-from bushings.parameters import ChannelParams
+from elastokin.bushings.parameters import ChannelParams
 
 
 @nb.njit(cache=True)

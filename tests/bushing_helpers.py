@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from bushings import BushingBank, ChannelParams, load_parameter_set, to_si
+from elastokin.bushings import BushingBank, ChannelParams, load_parameter_set, to_si
 
 
 def channel(name: str, model: str | None = None) -> ChannelParams:

@@ -14,11 +14,11 @@ from typing import Callable
 
 import numpy as np
 
-from bushings.parameter_sets import load_parameter_set
-from vsim_cluster.executor import SCHEDULER_ENV, SERIAL, Outcome, executor
-from vsim_diagnosis.catalogue import CAUSES, applicable, draw, draw_parameters
-from vsim_diagnosis.truth_forms import FORMS
-from vsim_diagnosis.virtual_bench import OUTSIDE, measure_bench, parse_truth
+from elastokin.bushings.parameter_sets import load_parameter_set
+from elastokin.cluster.executor import SCHEDULER_ENV, SERIAL, Outcome, executor
+from elastokin.diagnosis.catalogue import CAUSES, applicable, draw, draw_parameters
+from elastokin.diagnosis.truth_forms import FORMS
+from elastokin.diagnosis.virtual_bench import OUTSIDE, measure_bench, parse_truth
 
 
 def _slow_seeds(spec: str) -> range:
@@ -107,8 +107,8 @@ def measure(tmp: Path, cause: str, seed: int) -> tuple[str, list[dict], Path]:
 
 
 def diagnose_fresh(directory: Path, baseline: str, report: Path | None = None) -> dict:
-    """``vsim diagnose DIR --bushing-model BASELINE --json`` in a fresh Python process."""
-    cmd = [sys.executable, "-m", "vsim_cli", "diagnose", str(directory), "--bushing-model", baseline, "--json"]
+    """``vsim diagnose DIR --bushing-set BASELINE --json`` in a fresh Python process."""
+    cmd = [sys.executable, "-m", "elastokin.cli", "diagnose", str(directory), "--bushing-set", baseline, "--json"]
     if report is not None:
         cmd += ["-o", str(report)]
     done = subprocess.run(cmd, capture_output=True, text=True, timeout=600, cwd=directory.parent)

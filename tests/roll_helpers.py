@@ -31,16 +31,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vehicle.model.definition import CORNERS, VehicleDefinition
-from vehicle.scenarios.channels import AXLES
-from vehicle.scenarios.kc_tests import TEST
-from vehicle.simulation.kc_triangles import design_contact_base, run_triangle
-from vehicle.simulation.outputs import RigOutputs
-from vehicle.simulation.rig import KCRig
-from vsim_analysis.kc_metrics import fit_window
-from vsim_analysis.loops import Branches, centre_slope
-from vsim_analysis.road_metrics import G
-from vsim_tyres import magic_formula as mf
+from elastokin.vehicle.model.definition import CORNERS, VehicleDefinition
+from elastokin.vehicle.scenarios.channels import AXLES
+from elastokin.vehicle.scenarios.kc_tests import TEST
+from elastokin.vehicle.simulation.kc_triangles import design_contact_base, run_triangle
+from elastokin.vehicle.simulation.outputs import RigOutputs
+from elastokin.vehicle.simulation.rig import KCRig
+from elastokin.analysis.kc_metrics import fit_window
+from elastokin.analysis.loops import Branches, centre_slope
+from elastokin.analysis.road_metrics import G
+from elastokin.tyres import magic_formula as mf
 
 #: Rest on the rig before and after a static load [s] (the shares and pitches move < 0.5 % from 0.5 s to 3 s).
 SETTLE_S = 1.0

@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 import yaml
 
-from bushings.bench.bench_file import load_bench, parse_bench, run_bench
-from bushings.bench.programmes import firtree, multisine, parse_programme, read_csv_record, sine, step, triangle
-from vsim_cli.main import build_parser, main
-from vsim_core.errors import InputError
-from vsim_core.files import atomic_output
+from elastokin.bushings.bench.bench_file import load_bench, parse_bench, run_bench
+from elastokin.bushings.bench.programmes import firtree, multisine, parse_programme, read_csv_record, sine, step, triangle
+from elastokin.cli.main import build_parser, main
+from elastokin.core.errors import InputError
+from elastokin.core.files import atomic_output
 
 MM = 1e-3
 BENCH_DIR = Path(__file__).resolve().parent.parent / "models" / "bushings" / "benches"
@@ -232,8 +232,8 @@ def test_atomic_output_keeps_the_old_file_on_failure(tmp_path):
 def test_bushing_group_has_run_and_fit():
     args = build_parser().parse_args(["bushing", "run", "b.yaml", "-o", "o.csv"])
     assert args.bench == "b.yaml" and args.plot is None
-    args = build_parser().parse_args(["bushing", "fit", "r.csv", "--model", "sts"])
-    assert args.bushing_command == "fit" and args.records == [Path("r.csv")] and args.model == "sts"
+    args = build_parser().parse_args(["bushing", "fit", "r.csv", "--bushing-model", "sts"])
+    assert args.bushing_command == "fit" and args.records == [Path("r.csv")] and args.bushing_model == "sts"
 
 
 def test_load_bench_reads_a_file(tmp_path):

@@ -12,9 +12,9 @@ import numba
 import numpy as np
 import pytest
 
-from bushings import BushingBank, kernel
-from bushings.parameters import MAX_CELLS
-from bushings.reference import explicit_reference
+from elastokin.bushings import BushingBank, kernel
+from elastokin.bushings.parameters import MAX_CELLS
+from elastokin.bushings.reference import explicit_reference
 from tests.bushing_helpers import channel, inline, simulate, sts_first_loading, triangle
 
 MM = 1e-3
@@ -334,7 +334,7 @@ def test_power_law_kernel_meets_its_error_bound():
     """The solver's branch-free x**p: relative error < 3e-10 + 7.2e-10·p + 2e-16·p·|ln x| against
     an extended-precision reference, from 1e-300 to 1e300, over the slip rates the solver passes it
     (1e-6 to 1e3 m/s) and around 1."""
-    from bushings.kernel import _pow
+    from elastokin.bushings.kernel import _pow
 
     @numba.njit
     def powers(x, p, out):
@@ -390,9 +390,9 @@ def test_continuous_sts_first_loading_and_masing():
 _FRESH_OR_CACHED = """
 import sys
 import numpy as np
-from bushings import BushingBank, available_parameter_sets, load_parameter_set
-from bushings import kernel
-from bushings.bench.programmes import multisine
+from elastokin.bushings import BushingBank, available_parameter_sets, load_parameter_set
+from elastokin.bushings import kernel
+from elastokin.bushings.bench.programmes import multisine
 channels = [load_parameter_set(name).channel() for name in available_parameter_sets()]
 _, e = multisine([1.5e-3, 0.3e-3], [1.0, 10.0], 0.5, 1e-3)  # the thesis's bi-sine, 1.5x
 forces, tangents = BushingBank(channels).run(np.repeat(e[:, None], len(channels), axis=1), 1e-3)

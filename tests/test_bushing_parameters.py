@@ -6,8 +6,8 @@ import math
 
 import pytest
 
-from bushings import available_parameter_sets, load_parameter_set, to_si
-from vsim_core.errors import InputError
+from elastokin.bushings import available_parameter_sets, load_parameter_set, to_si
+from elastokin.core.errors import InputError
 
 
 def test_shipped_sets_load_with_their_source():

@@ -1,4 +1,4 @@
-"""`vsim compare` (vsim_analysis/compare.py) and the metric functions it shares (vsim_analysis/run_metrics.py):
+"""`vsim compare` (elastokin/analysis/compare.py) and the metric functions it shares (elastokin/analysis/run_metrics.py):
 exact metrics on synthetic signals, a run against itself, against a copy with scaled camber and
 against a resampled bodiless copy written as a file, the CLI's outputs, and every input error."""
 
@@ -13,17 +13,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from vehicle.scenarios.scenario_file import load_scenario
-from vsim_analysis.compare import compare_runs
-from vsim_analysis.loops import dynamic_stiffness, loop_area, relaxation_amplitude, rms_error
-from vsim_cli import main as cli
-from vsim_core.errors import InputError
-from vsim_core.shipped import DEFAULT_VEHICLE
-from vsim_presentation.comparison_report import format_table
-from vsim_recordings.recorder import run_scenario
-from vsim_recordings.run_format import Run
-from vsim_recordings.run_reader import load_run
-from vsim_recordings.run_writer import RunWriter
+from elastokin.vehicle.scenarios.scenario_file import load_scenario
+from elastokin.analysis.compare import compare_runs
+from elastokin.analysis.loops import dynamic_stiffness, loop_area, relaxation_amplitude, rms_error
+from elastokin.cli import main as cli
+from elastokin.core.errors import InputError
+from elastokin.core.shipped import DEFAULT_VEHICLE
+from elastokin.presentation.comparison_report import format_table
+from elastokin.recordings.recorder import run_scenario
+from elastokin.recordings.run_format import Run
+from elastokin.recordings.run_reader import load_run
+from elastokin.recordings.run_writer import RunWriter
 
 #: Two pumping cases at 2 Hz, a triangle and a sine (which has a dynamic stiffness).
 PUMPING = """\

@@ -1,4 +1,4 @@
-"""The foundation (vsim_core): the one YAML reader's errors, the one units table, atomic folders."""
+"""The foundation (elastokin.core): the one YAML reader's errors, the one units table, atomic folders."""
 
 from __future__ import annotations
 
@@ -7,10 +7,10 @@ from pathlib import Path
 
 import pytest
 
-from vsim_core import units
-from vsim_core.documents import Document, Fields, check_number
-from vsim_core.errors import InputError
-from vsim_core.files import atomic_directory
+from elastokin.core import units
+from elastokin.core.documents import Document, Fields, check_number
+from elastokin.core.errors import InputError
+from elastokin.core.files import atomic_directory
 
 TEXT = """\
 name: car

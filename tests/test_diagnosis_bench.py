@@ -15,20 +15,20 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from bushings.bench.programmes import TimeSeries
-from bushings.bench.records import sample_steps
-from bushings.effects import Effects, broad_relaxation_branches, effects_to_si
-from bushings.extended_bank import ExtendedBank
-from bushings.parameter_sets import load_parameter_set
-from vsim_core.errors import InputError
+from elastokin.bushings.bench.programmes import TimeSeries
+from elastokin.bushings.bench.records import sample_steps
+from elastokin.bushings.effects import Effects, broad_relaxation_branches, effects_to_si
+from elastokin.bushings.extended_bank import ExtendedBank
+from elastokin.bushings.parameter_sets import load_parameter_set
+from elastokin.core.errors import InputError
 from tests.diagnosis_helpers import (MIN_PAIR_SUCCESS_RATE, MIN_SUCCESS_RATE, OWN_FORM_SUCCESS_RATE, PAIR, SLOW_SEEDS,
                                      assert_success_rate, diagnose_fresh, measure)
-from vsim_diagnosis.bench_alike import REST_BEFORE_S, Programme, extra_programmes, load_cell_noise_n, separations
-from vsim_diagnosis.bench_diagnosis import REST_STEP_S, Replay
-from vsim_diagnosis.catalogue import CAUSES, PAIR_SEPARATOR
-from vsim_diagnosis.truth_forms import BOX_PER_DECADE, BOX_TAU_MIN_S, FORMS, box_taus
-from vsim_diagnosis.verdict import pair_shares
-from vsim_diagnosis.virtual_bench import OUTSIDE
+from elastokin.diagnosis.bench_alike import REST_BEFORE_S, Programme, extra_programmes, load_cell_noise_n, separations
+from elastokin.diagnosis.bench_diagnosis import REST_STEP_S, Replay
+from elastokin.diagnosis.catalogue import CAUSES, PAIR_SEPARATOR
+from elastokin.diagnosis.truth_forms import BOX_PER_DECADE, BOX_TAU_MIN_S, FORMS, box_taus
+from elastokin.diagnosis.verdict import pair_shares
+from elastokin.diagnosis.virtual_bench import OUTSIDE
 
 BENCH_CAUSES = sorted(CAUSES)
 #: Seeds per cause in the default suite (one, for time: each diagnosis takes 15-60 s); the slow
@@ -281,7 +281,7 @@ def _loop_area(x: np.ndarray, force: np.ndarray) -> float:
 
 
 def test_a_slipping_interface_adds_the_elastoplastic_loop_and_its_tangent():
-    """bushings.effects' slip element (a spring k_s in series with a slider F_s, in parallel with the
+    """elastokin.bushings.effects' slip element (a spring k_s in series with a slider F_s, in parallel with the
     law): cycled between ±A it adds the parallelogram of area 4·F_s·(A − F_s/k_s), whatever the rate;
     the tangent is k_s while it sticks, 0 while it slips."""
     ch = load_parameter_set("fig5_9_progressive").channel("elastic")

@@ -20,29 +20,29 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from bushings.parameter_sets import load_parameter_set
+from elastokin.bushings.parameter_sets import load_parameter_set
 from tests.diagnosis_helpers import (MIN_PAIR_SUCCESS_RATE, MIN_SUCCESS_RATE, OWN_FORM_SUCCESS_RATE, PAIR, SLOW_SEEDS,
                                      assert_success_rate)
-from vehicle.model.file_overrides import vehicle_with
-from vehicle.model.vehicle_file import load_vehicle, with_extensions
-from vehicle.scenarios.scenario_file import load_scenario
-from vsim_core.errors import InputError
-from vsim_diagnosis.kc_catalogue import (OBSERVABLE, Hypothesis, draw, extended_vehicle, extended_vehicle_yaml,
+from elastokin.vehicle.model.file_overrides import vehicle_with
+from elastokin.vehicle.model.vehicle_file import load_vehicle, with_extensions
+from elastokin.vehicle.scenarios.scenario_file import load_scenario
+from elastokin.core.errors import InputError
+from elastokin.diagnosis.kc_catalogue import (OBSERVABLE, Hypothesis, draw, extended_vehicle, extended_vehicle_yaml,
                                          locations, parameters)
-from vsim_cluster.executor import SerialExecutor
-from vsim_core.shipped import DEFAULT_VEHICLE
-from vsim_diagnosis.catalogue import PAIR_SEPARATOR, Parameter
-from vsim_diagnosis.kc_alike import alike, separations
-from vsim_diagnosis.kc_diagnosis import _best_per_place, _second_stage, diagnose_kc, hypotheses
-from vsim_diagnosis.kc_fits import (Candidate, Scorer, fit, fit_pair, halfway, nominal, separation, significant,
+from elastokin.cluster.executor import SerialExecutor
+from elastokin.core.shipped import DEFAULT_VEHICLE
+from elastokin.diagnosis.catalogue import PAIR_SEPARATOR, Parameter
+from elastokin.diagnosis.kc_alike import alike, separations
+from elastokin.diagnosis.kc_diagnosis import _best_per_place, _second_stage, diagnose_kc, hypotheses
+from elastokin.diagnosis.kc_fits import (Candidate, Scorer, fit, fit_pair, halfway, nominal, separation, significant,
                                     verify)
-from vsim_diagnosis.kc_layout import Layout, Test
-from vsim_diagnosis.verdict import Separation, pair_named, split, told_apart
-from vsim_diagnosis.virtual_kc_rig import DEFAULT_SCENARIOS, measure_kc, parse_kc_truth
-from vsim_presentation.kc_report import _candidate, _parameters, summary
-from vsim_recordings.recorder import run_scenario, simulate
-from vsim_recordings.kc_dataset import read_kc_dataset
-from vsim_recordings.run_reader import load_run
+from elastokin.diagnosis.kc_layout import Layout, Test
+from elastokin.diagnosis.verdict import Separation, pair_named, split, told_apart
+from elastokin.diagnosis.virtual_kc_rig import DEFAULT_SCENARIOS, measure_kc, parse_kc_truth
+from elastokin.presentation.kc_report import _candidate, _parameters, summary
+from elastokin.recordings.recorder import run_scenario, simulate
+from elastokin.recordings.kc_dataset import read_kc_dataset
+from elastokin.recordings.run_reader import load_run
 
 KC_CAUSES = sorted(c for c in OBSERVABLE if c != "backlash")
 #: The default suite diagnoses one draw (about 2 min); the slow suite SLOW_SEEDS per cause.
@@ -452,7 +452,7 @@ def test_simulate_gives_the_recorded_run(tmp_path):
 
 def test_diagnose_refuses_a_bushing_model_for_a_kc_dataset(tmp_path):
     (tmp_path / "rig.yaml").write_text("level: kc\nvehicle: car\nrecordings: []\n")
-    done = subprocess.run([sys.executable, "-m", "vsim_cli", "diagnose", str(tmp_path), "--bushing-model",
+    done = subprocess.run([sys.executable, "-m", "elastokin.cli", "diagnose", str(tmp_path), "--bushing-set",
                            "fig5_9"], capture_output=True, text=True)
     assert done.returncode != 0
     assert "--vehicle" in done.stderr and "rig.yaml" in done.stderr
@@ -499,7 +499,7 @@ def measure_truth(tmp: Path, hs: list[Hypothesis], seed: int, *, duration_scale:
 
 def diagnose_fresh(directory: Path, *options: str) -> dict:
     """``vsim diagnose DIR --json [options]`` (the default car as baseline) in a fresh Python process."""
-    done = subprocess.run([sys.executable, "-m", "vsim_cli", "diagnose", str(directory), "--json", *options],
+    done = subprocess.run([sys.executable, "-m", "elastokin.cli", "diagnose", str(directory), "--json", *options],
                           capture_output=True, text=True, timeout=1800, cwd=directory.parent)
     assert done.returncode == 0, done.stderr
     return json.loads(done.stdout)

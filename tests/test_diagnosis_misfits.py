@@ -10,13 +10,13 @@ import math
 import numpy as np
 import pytest
 
-from vehicle.scenarios.scenario import Scenario
-from vsim_diagnosis.kc_diagnosis import located_misfits
-from vsim_diagnosis.kc_layout import Job, Layout, Test
-from vsim_diagnosis.kc_fits import Scorer
+from elastokin.vehicle.scenarios.scenario import Scenario
+from elastokin.diagnosis.kc_diagnosis import located_misfits
+from elastokin.diagnosis.kc_layout import Job, Layout, Test
+from elastokin.diagnosis.kc_fits import Scorer
 from scipy.special import gammaincc
 
-from vsim_diagnosis.verdict import (MIN_GAIN, MISFIT_CHANCE, alike, decide, explained, misfit, misfit_stretch,
+from elastokin.diagnosis.verdict import (MIN_GAIN, MISFIT_CHANCE, alike, decide, explained, misfit, misfit_stretch,
                                     single_verdict, split)
 
 CHANNELS = [f"camber_{t}" for t in ("fl", "fr", "rl", "rr")] + [f"toe_{t}" for t in ("fl", "fr", "rl", "rr")]

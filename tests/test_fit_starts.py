@@ -1,4 +1,4 @@
-"""Where a cause's fit starts and within which bounds (vsim_diagnosis.fit_starts): one side per
+"""Where a cause's fit starts and within which bounds (elastokin.diagnosis.fit_starts): one side per
 catalogue family for its sided parameters, each side fitted within bounds that stop at zero."""
 
 from __future__ import annotations
@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from vsim_diagnosis.catalogue import CAUSES, combined
-from vsim_diagnosis.fit_starts import corner_starts, fit_bounds, side_starts, sides_apart, to_fit
+from elastokin.diagnosis.catalogue import CAUSES, combined
+from elastokin.diagnosis.fit_starts import corner_starts, fit_bounds, side_starts, sides_apart, to_fit
 
 ASYMMETRY, PRELOAD, MULLINS = CAUSES["asymmetry"], CAUSES["preload"], CAUSES["mullins"]
 

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from vsim_diagnosis.fit_uncertainty import standard_errors
+from elastokin.diagnosis.fit_uncertainty import standard_errors
 
 TESTS, SAMPLES, DRAWS = 16, 400, 400
 PHASE = 2.0 * np.pi * np.arange(SAMPLES) / 4.0

@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from bushings import BushingBank, load_parameter_set, to_si
-from bushings.frequency import equivalent_damping, first_harmonic, harmonic_ratio, lossier, rate_scaled
-from vsim_core.errors import InputError
+from elastokin.bushings import BushingBank, load_parameter_set, to_si
+from elastokin.bushings.frequency import equivalent_damping, first_harmonic, harmonic_ratio, lossier, rate_scaled
+from elastokin.core.errors import InputError
 
 MM = 1e-3
 STVS = load_parameter_set("fig5_9").channel()

@@ -32,20 +32,20 @@ import yaml
 from hypothesis import HealthCheck, given, seed, settings
 from hypothesis import strategies as st
 
-from bushings.bench.bench_file import load_bench, run_bench
-from bushings.parameter_sets import load_parameter_set
-from vehicle.model.builder import build
-from vehicle.model.elements import BuildOptions
-from vehicle.model.statics import resolve_preloads
-from vehicle.model.vehicle_file import load_vehicle
-from vehicle.scenarios.scenario_file import load_scenario
-from vehicle.scenarios.schedule import schedule, timestep
-from vsim_core.errors import InputError
-from vsim_core.shipped import BENCH_DIR, DEFAULT_VEHICLE, PARAMETER_SET_DIR, SCENARIO_DIR, SWEEP_DIR
-from vsim_recordings.bench_dataset import read_bench_dataset
-from vsim_recordings.csv_import import import_csv
-from vsim_recordings.run_reader import load_run
-from vsim_sweeps.sweep_file import load_sweep
+from elastokin.bushings.bench.bench_file import load_bench, run_bench
+from elastokin.bushings.parameter_sets import load_parameter_set
+from elastokin.vehicle.model.builder import build
+from elastokin.vehicle.model.elements import BuildOptions
+from elastokin.vehicle.model.statics import resolve_preloads
+from elastokin.vehicle.model.vehicle_file import load_vehicle
+from elastokin.vehicle.scenarios.scenario_file import load_scenario
+from elastokin.vehicle.scenarios.schedule import schedule, timestep
+from elastokin.core.errors import InputError
+from elastokin.core.shipped import BENCH_DIR, DEFAULT_VEHICLE, PARAMETER_SET_DIR, SCENARIO_DIR, SWEEP_DIR
+from elastokin.recordings.bench_dataset import read_bench_dataset
+from elastokin.recordings.csv_import import import_csv
+from elastokin.recordings.run_reader import load_run
+from elastokin.sweeps.sweep_file import load_sweep
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "data" / "examples" / "kc_import"

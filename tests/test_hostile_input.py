@@ -17,19 +17,19 @@ import numpy as np
 import pytest
 import yaml
 
-from bushings.bench.bench_file import load_bench
-from bushings.bench.records import read_bench_csv
-from vehicle.model.builder import build
-from vehicle.model.elements import BuildOptions
-from vehicle.model.statics import resolve_preloads
-from vehicle.model.vehicle_file import load_vehicle
-from vehicle.scenarios.scenario_file import load_scenario
-from vsim_cli.main import main
-from vsim_core.documents import Document, dump_yaml
-from vsim_core.errors import InputError
-from vsim_core.shipped import BENCH_DIR, DEFAULT_VEHICLE, SCENARIO_DIR
-from vsim_recordings.csv_import import import_csv
-from vsim_recordings.run_reader import load_run
+from elastokin.bushings.bench.bench_file import load_bench
+from elastokin.bushings.bench.records import read_bench_csv
+from elastokin.vehicle.model.builder import build
+from elastokin.vehicle.model.elements import BuildOptions
+from elastokin.vehicle.model.statics import resolve_preloads
+from elastokin.vehicle.model.vehicle_file import load_vehicle
+from elastokin.vehicle.scenarios.scenario_file import load_scenario
+from elastokin.cli.main import main
+from elastokin.core.documents import Document, dump_yaml
+from elastokin.core.errors import InputError
+from elastokin.core.shipped import BENCH_DIR, DEFAULT_VEHICLE, SCENARIO_DIR
+from elastokin.recordings.csv_import import import_csv
+from elastokin.recordings.run_reader import load_run
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "data" / "examples" / "kc_import"
@@ -222,7 +222,7 @@ def test_a_read_only_output_folder_is_refused_before_the_run(tmp_path: Path, cap
 def test_sigterm_leaves_a_readable_incomplete_recording_and_status_143(tmp_path: Path) -> None:
     output = tmp_path / "run.mcap"
     # five times the main job's durations: a run of 20 s or so, never over before the signal (4 s at 1)
-    proc = subprocess.Popen([sys.executable, "-m", "vsim_cli", "run", "pumping", "-o", str(output),
+    proc = subprocess.Popen([sys.executable, "-m", "elastokin.cli", "run", "pumping", "-o", str(output),
                              "--duration-scale", "5"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             cwd=tmp_path)
     deadline = time.monotonic() + 120.0

@@ -8,12 +8,12 @@ import math
 import numpy as np
 import pytest
 
-from bushings import load_parameter_set
-from bushings.bench.identification import (CycleMeasures, fit, identify_sts, measure_cycle, sts_cycle_measures,
+from elastokin.bushings import load_parameter_set
+from elastokin.bushings.bench.identification import (CycleMeasures, fit, identify_sts, measure_cycle, sts_cycle_measures,
                                            sts_from_measures, stvs_initial)
-from bushings.bench.records import BenchRecord, read_bench_csv, simulate_record
-from vsim_cli import bushing_fit
-from vsim_core.errors import InputError
+from elastokin.bushings.bench.records import BenchRecord, read_bench_csv, simulate_record
+from elastokin.cli import bushing_fit
+from elastokin.core.errors import InputError
 
 MM = 1e-3
 
@@ -171,7 +171,7 @@ def test_fit_cli_writes_a_loadable_parameter_set(tmp_path, capsys):
     out = tmp_path / "fitted.yaml"
     parser = argparse.ArgumentParser(prog="vsim bushing")
     bushing_fit.register(parser.add_subparsers(dest="command", required=True))
-    args = parser.parse_args(["fit", *map(str, paths), "--model", "sts", "-o", str(out)])
+    args = parser.parse_args(["fit", *map(str, paths), "--bushing-model", "sts", "-o", str(out)])
     assert args.func(args) == 0
     printed = capsys.readouterr().out
     assert "Kr" in printed and "triangle.csv" in printed and "% of the" in printed

@@ -9,19 +9,20 @@ import os
 import shutil
 import subprocess
 import sys
+import zipfile
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from bushings.bench.bench_file import load_bench
-from vehicle.model.vehicle_file import load_vehicle
-from vehicle.scenarios.scenario_file import load_scenario
-import vsim_cli.main
-from vsim_cli import executable
-from vsim_core.errors import InputError
-from vsim_core.shipped import BENCH_DIR, DEFAULT_VEHICLE, KC_SCENARIO_DIR, SCENARIO_DIR
-from vsim_recordings.run_reader import load_run
+from elastokin.bushings.bench.bench_file import load_bench
+from elastokin.vehicle.model.vehicle_file import load_vehicle
+from elastokin.vehicle.scenarios.scenario_file import load_scenario
+import elastokin.cli.main
+from elastokin.cli import executable
+from elastokin.core.errors import InputError
+from elastokin.core.shipped import BENCH_DIR, DEFAULT_VEHICLE, KC_SCENARIO_DIR, SCENARIO_DIR
+from elastokin.recordings.run_reader import load_run
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -69,17 +70,27 @@ def test_the_wheel_runs_a_built_in_scenario_from_an_empty_folder(tmp_path: Path)
     wheels, target, empty, source = tmp_path / "wheels", tmp_path / "site", tmp_path / "empty", tmp_path / "source"
     empty.mkdir()
     # a copy without earlier builds (a stale build/ would hide a package missing from pyproject.toml)
-    shutil.copytree(ROOT, source, ignore=shutil.ignore_patterns(".git", ".venv", "build", "*.egg-info", "out", "data",
+    shutil.copytree(ROOT, source, ignore=shutil.ignore_patterns(".git", ".venv", "build", "*.egg-info", "out",
                                                                  "tests", "__pycache__", ".hypothesis"))
     subprocess.run([sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", "--no-build-isolation", "-w", str(wheels),
                     str(source)], check=True, capture_output=True, timeout=300, cwd=tmp_path)
-    wheel, = wheels.glob("vsim-*.whl")
+    wheel, = wheels.glob("elastokin-*.whl")
+    # one top-level import package (and its metadata): nothing of ours stands beside another project's modules
+    tops = {name.split("/")[0] for name in zipfile.ZipFile(wheel).namelist()}
+    assert {top for top in tops if not top.endswith(".dist-info")} == {"elastokin"}, tops
+    # another project's top-level `vehicle` and `bushings` installed first are still there after ours
+    for other in ("vehicle", "bushings"):
+        (target / other).mkdir(parents=True)
+        (target / other / "__init__.py").write_text(f"WHO = 'the other {other}'\n")
     subprocess.run([sys.executable, "-m", "pip", "install", "-q", "--no-deps", "--target", str(target), str(wheel)],
                    check=True, capture_output=True, timeout=300)
     env = {**os.environ, "PYTHONPATH": str(target)}
-    where = subprocess.run([sys.executable, "-c", "import vsim_core.shipped as s; print(s.SCENARIO_DIR, s.DEFAULT_TYRE.is_file())"],
+    where = subprocess.run([sys.executable, "-c", "import elastokin.core.shipped as s, vehicle, bushings, elastokin.vehicle;"
+                            "print(s.SCENARIO_DIR, s.DEFAULT_TYRE.is_file(), (s.DATASET_DIR / 'kc' / 'rig.yaml').is_file(),"
+                            "vehicle.WHO == 'the other vehicle', bushings.WHO == 'the other bushings')"],
                            env=env, cwd=empty, capture_output=True, text=True, check=True).stdout.split()
-    assert Path(where[0]) == target / "vsim_core" / "scenarios" and where[1] == "True"   # the .tir travels too
+    # the .tir and the example datasets travel too
+    assert Path(where[0]) == target / "elastokin" / "scenarios" and where[1:] == ["True"] * 4
     # the console script the README's first command runs (pip writes it into the target's bin/)
     done = subprocess.run([str(target / "bin" / "vsim"), "run", "pumping", "--duration-scale", "0.05"],
                           env=env, cwd=empty, capture_output=True, text=True, timeout=600)
@@ -92,7 +103,7 @@ def test_the_wheel_runs_a_built_in_scenario_from_an_empty_folder(tmp_path: Path)
 
 @pytest.mark.parametrize("preset", [None, "egl"])
 def test_the_executable_runs_the_command_with_the_collector_on(monkeypatch, preset) -> None:
-    """``vsim`` (``vsim_cli.executable``) passes the command's exit status through; the command runs
+    """``vsim`` (``elastokin.cli.executable``) passes the command's exit status through; the command runs
     with the garbage collector on (only what the imports made is set aside) and MuJoCo's OpenGL back
     end off unless the user chose one."""
     seen = {}
@@ -101,7 +112,7 @@ def test_the_executable_runs_the_command_with_the_collector_on(monkeypatch, pres
         seen.update(enabled=gc.isenabled(), frozen=gc.get_freeze_count(), gl=os.environ.get("MUJOCO_GL"))
         return 3
 
-    monkeypatch.setattr(vsim_cli.main, "main", command)
+    monkeypatch.setattr(elastokin.cli.main, "main", command)
     if preset is None:
         monkeypatch.delenv("MUJOCO_GL", raising=False)
     else:

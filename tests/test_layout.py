@@ -14,23 +14,29 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 #: The packages, lowest first: a package may import only packages of an earlier row (or itself).
 LAYERS = (
-    ("vsim_core",),                          # foundation
-    ("vsim_cluster",),                       # where runs execute (Dask)
-    ("bushings",),                           # bushing laws
-    ("bushings.bench",),                     # the bushing test bench
-    ("vsim_tyres",),                         # tyre property files and laws
-    ("vehicle", "vehicle.model"),            # the vehicle model
-    ("vehicle.scenarios",),                  # what the car is made to do
-    ("vehicle.simulation",),                 # running it
-    ("vsim_recordings",),                    # recorded runs and measured data
-    ("vsim_analysis",),                      # metrics and comparison
-    ("vsim_sweeps",),                        # sweeps over vehicle parameters
-    ("vsim_diagnosis",),                     # causes, virtual rigs, diagnoses
-    ("vsim_presentation",),                  # plots, replay, tables, reports
-    ("vsim_cli",),                           # the command line
+    ("elastokin.core",),                                       # foundation
+    ("elastokin.cluster",),                                    # where runs execute (Dask)
+    ("elastokin.bushings",),                                   # bushing laws
+    ("elastokin.bushings.bench",),                             # the bushing test bench
+    ("elastokin.tyres",),                                      # tyre property files and laws
+    ("elastokin.vehicle", "elastokin.vehicle.model"),          # the vehicle model
+    ("elastokin.vehicle.scenarios",),                          # what the car is made to do
+    ("elastokin.vehicle.simulation",),                         # running it
+    ("elastokin.recordings",),                                 # recorded runs and measured data
+    ("elastokin.analysis",),                                   # metrics and comparison
+    ("elastokin.sweeps",),                                     # sweeps over vehicle parameters
+    ("elastokin.diagnosis",),                                  # causes, virtual rigs, diagnoses
+    ("elastokin.presentation",),                               # plots, replay, tables, reports
+    ("elastokin.api",),                                        # the Python API
+    ("elastokin.cli",),                                        # the command line
+    ("elastokin",),                                            # the package's front door: the API re-exported
 )
 LAYER = {package: i for i, row in enumerate(LAYERS) for package in row}
-TOP = sorted({p.split(".")[0] for p in LAYER})
+SETUPTOOLS = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]
+#: The shipped data's packages: folders of files, no modules.
+DATA_PACKAGES = {"elastokin.models": "models", "elastokin.scenarios": "scenarios", "elastokin.data": "data"}
+#: Where each package's folder is: the repository's own top-level folders mapped into the one package.
+FOLDERS = {"elastokin": "elastokin", "elastokin.bushings": "bushings", "elastokin.vehicle": "vehicle"}
 #: Compiled kernels may be long: one function is one compiled unit.
 COMPILED_KERNELS = {"bushings/kernel.py"}
 MAX_LINES = 450
@@ -39,10 +45,10 @@ MAX_LINES = 450
 def _modules() -> dict[str, Path]:
     """Every module of the packages, by dotted name (a package by its own name)."""
     out = {}
-    for top in TOP:
-        for path in sorted((ROOT / top).rglob("*.py")):
-            parts = path.relative_to(ROOT).with_suffix("").parts
-            out[".".join(parts[:-1] if parts[-1] == "__init__" else parts)] = path
+    for package, folder in FOLDERS.items():
+        for path in sorted((ROOT / folder).rglob("*.py")):
+            parts = path.relative_to(ROOT / folder).with_suffix("").parts
+            out[".".join((package, *(parts[:-1] if parts[-1] == "__init__" else parts)))] = path
     return out
 
 
@@ -111,21 +117,23 @@ def test_no_import_cycle():
 
 
 def test_imports_stand_at_the_top_of_modules_except_in_the_command_line():
-    """Deferred imports are the command line's alone (`vsim --help` need not load MuJoCo); elsewhere an
-    import inside a function would hide a dependency."""
+    """Deferred imports are the command line's and the front door's alone (`vsim --help` and `import
+    elastokin.core` need not load MuJoCo: the package re-exports the API when it is first asked for);
+    elsewhere an import inside a function would hide a dependency."""
     top_level = {m: {id(n) for n in tree.body} for m, tree in TREES.items()}
     hidden = sorted(f"{MODULES[m].relative_to(ROOT)}:{node.lineno}" for m, tree in TREES.items()
-                    for node, _ in _imports(tree) if id(node) not in top_level[m] and package_of(m) != "vsim_cli")
+                    for node, _ in _imports(tree) if id(node) not in top_level[m] and package_of(m) not in ("elastokin.cli", "elastokin"))
     assert not hidden, "\n".join(hidden)
 
 
 def test_the_wheel_packages_every_package_and_the_shipped_data():
-    """pyproject.toml lists the packages (a wheel carries no other), and maps models/ and scenarios/
-    into vsim_core, where vsim_core.shipped looks for them in an installed copy."""
-    setuptools = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]
+    """pyproject.toml lists the packages (a wheel carries no other), all under the one import package,
+    and maps the repository's bushings/, vehicle/, models/, scenarios/ and data/ into it, where
+    elastokin.core.shipped looks for the data in an installed copy."""
     packages = {m for m, path in MODULES.items() if path.name == "__init__.py"}
-    assert sorted(setuptools["packages"]) == sorted(packages | {"vsim_core.models", "vsim_core.scenarios"})
-    assert setuptools["package-dir"] == {"vsim_core.models": "models", "vsim_core.scenarios": "scenarios"}
+    assert sorted(SETUPTOOLS["packages"]) == sorted(packages | set(DATA_PACKAGES))
+    assert {p.split(".")[0] for p in SETUPTOOLS["packages"]} == {"elastokin"}
+    assert SETUPTOOLS["package-dir"] == {**{p: f for p, f in FOLDERS.items() if p != "elastokin"}, **DATA_PACKAGES}
 
 
 def _readme_table() -> dict[str, tuple[str, str]]:
@@ -180,7 +188,7 @@ class Refuse:
         if name.split(".")[0] == "mujoco":
             raise ImportError("MuJoCo must not be loaded to " + WHAT)
 sys.meta_path.insert(0, Refuse())
-from vsim_cli.main import main
+from elastokin.cli.main import main
 for WHAT, argv in COMMANDS:
     assert main(argv) == 0, WHAT
 assert "mujoco" not in sys.modules
@@ -201,7 +209,7 @@ def test_measured_data_is_imported_compared_plotted_and_diagnosed_without_mujoco
         ("plot a run", ["plot", str(tmp_path / "a.mcap"), "-o", str(tmp_path / "p")]),
         ("run and plot a bench", ["bushing", "run", str(ROOT / "models" / "bushings" / "benches" / "bisine.yaml"),
                                   "-o", str(tmp_path / "bisine.csv"), "--plot", str(tmp_path / "bp")]),
-        ("diagnose bench data", ["diagnose", str(bench), "--bushing-model", "fig5_9", "-o", str(tmp_path / "d")]),
+        ("diagnose bench data", ["diagnose", str(bench), "--bushing-set", "fig5_9", "-o", str(tmp_path / "d")]),
     ]
     code = f"COMMANDS = {commands!r}\n" + _NO_MUJOCO
     done = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True, timeout=600)
@@ -211,8 +219,8 @@ def test_measured_data_is_imported_compared_plotted_and_diagnosed_without_mujoco
 
 def _small_bench_dataset(directory: Path) -> None:
     """Four short tests of fig5_9 with a little Mullins softening, written as a measured bench dataset."""
-    from bushings.bench.campaign import CAMPAIGN
-    from vsim_diagnosis.virtual_bench import measure_bench, parse_truth
+    from elastokin.bushings.bench.campaign import CAMPAIGN
+    from elastokin.diagnosis.virtual_bench import measure_bench, parse_truth
 
     truth = parse_truth({"level": "bench", "baseline": "fig5_9", "effects": [{"cause": "mullins", "mullins": 0.15}],
                          "seed": 1}, "truth.yaml")

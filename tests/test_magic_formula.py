@@ -13,11 +13,11 @@ import pytest
 from scipy.optimize import brentq
 
 from tests.tyre_helpers import assert_formula_is
-from vsim_core.errors import InputError
-from vsim_core.shipped import DEFAULT_TYRE
-from vsim_tyres import magic_formula as mf
-from vsim_tyres.tir_file import read_tir
-from vsim_tyres.transient import lag, low_speed_damping, relaxation_lengths
+from elastokin.core.errors import InputError
+from elastokin.core.shipped import DEFAULT_TYRE
+from elastokin.tyres import magic_formula as mf
+from elastokin.tyres.tir_file import read_tir
+from elastokin.tyres.transient import lag, low_speed_damping, relaxation_lengths
 
 
 @pytest.fixture(scope="module")

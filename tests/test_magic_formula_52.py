@@ -15,15 +15,15 @@ import numpy as np
 import pytest
 
 from tests.tyre_helpers import GRID, assert_formula_is
-from vehicle.model.vehicle_file import load_vehicle
-from vehicle.scenarios.scenario_file import load_scenario
-from vsim_analysis.road_metrics import road_metrics
-from vsim_core.errors import InputError
-from vsim_core.shipped import DEFAULT_TYRE, DEFAULT_VEHICLE
-from vsim_recordings.recorder import simulate
-from vsim_tyres import magic_formula as mf
-from vsim_tyres.tir_file import read_tir
-from vsim_tyres.transient import relaxation_lengths
+from elastokin.vehicle.model.vehicle_file import load_vehicle
+from elastokin.vehicle.scenarios.scenario_file import load_scenario
+from elastokin.analysis.road_metrics import road_metrics
+from elastokin.core.errors import InputError
+from elastokin.core.shipped import DEFAULT_TYRE, DEFAULT_VEHICLE
+from elastokin.recordings.recorder import simulate
+from elastokin.tyres import magic_formula as mf
+from elastokin.tyres.tir_file import read_tir
+from elastokin.tyres.transient import relaxation_lengths
 
 TYRE_52 = Path(__file__).parent / "data" / "mf52_195_65R15.tir"
 

@@ -17,14 +17,14 @@ import rerun.chunk
 from foxglove.messages import FrameTransform, FrameTransforms, Quaternion, Timestamp, Vector3
 from mcap.reader import make_reader
 
-from vsim_cli import plot as plot_cli
-from vsim_cli import view as view_cli
-from vsim_core.errors import InputError
-from vsim_recordings.message_layouts import FrameTransformsLayout, timestamp_field
-from vsim_recordings.recorder import geometry_from_model
-from vsim_recordings.run_format import RunMetadata, SignalSpec, rotation_matrix, signal_label
-from vsim_recordings.run_reader import load_run
-from vsim_recordings.run_writer import RunWriter
+from elastokin.cli import plot as plot_cli
+from elastokin.cli import view as view_cli
+from elastokin.core.errors import InputError
+from elastokin.recordings.message_layouts import FrameTransformsLayout, timestamp_field
+from elastokin.recordings.recorder import geometry_from_model
+from elastokin.recordings.run_format import RunMetadata, SignalSpec, rotation_matrix, signal_label
+from elastokin.recordings.run_reader import load_run
+from elastokin.recordings.run_writer import RunWriter
 
 BODIES = ["chassis", "arm", "wheel"]
 SIGNALS = [
@@ -364,7 +364,7 @@ class _Blocks:
 
 
 def _block(k: int):
-    from vehicle.simulation.outputs import SampleBlock
+    from elastokin.vehicle.simulation.outputs import SampleBlock
 
     t = np.arange(k * 3, k * 3 + 3) * 0.02 + 0.02
     return SampleBlock(t, 1, 2, t, np.zeros((3, 0)), np.full((3, 2), float(k)), np.empty((3, 0, 3)),
@@ -375,7 +375,7 @@ def test_background_writer_keeps_the_order_and_hands_its_errors_to_the_caller() 
     """Blocks are written in the order given and kept for the run in memory; a failed write is
     raised at the caller's next put (nothing after it is written) and, when the caller itself
     stops on an error, joined to that error as a note."""
-    from vsim_recordings.background import BackgroundWriter
+    from elastokin.recordings.background import BackgroundWriter
 
     sink = _Blocks()
     with BackgroundWriter(sink, sink) as writer:

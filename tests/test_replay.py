@@ -17,12 +17,12 @@ import pytest
 import rerun.blueprint as rrb
 import rerun.chunk
 
-from vehicle.scenarios.scenario_file import load_scenario
-from vsim_core.shipped import DEFAULT_VEHICLE
-from vsim_presentation.replay import FOV_Y_RAD, TIMELINE, VIEW_ASPECT, blueprint, car_bounds_m, replay
-from vsim_recordings.recorder import run_scenario
-from vsim_recordings.run_format import Run, rotation_matrix
-from vsim_recordings.run_reader import load_run
+from elastokin.vehicle.scenarios.scenario_file import load_scenario
+from elastokin.core.shipped import DEFAULT_VEHICLE
+from elastokin.presentation.replay import FOV_Y_RAD, TIMELINE, VIEW_ASPECT, blueprint, car_bounds_m, replay
+from elastokin.recordings.recorder import run_scenario
+from elastokin.recordings.run_format import Run, rotation_matrix
+from elastokin.recordings.run_reader import load_run
 
 RIG = """\
     type: pumping

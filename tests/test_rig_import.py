@@ -12,16 +12,16 @@ import pytest
 import yaml
 from mcap.reader import make_reader
 
-from vehicle.scenarios.scenario_file import load_scenario
-from vsim_cli import main as cli
-from vsim_core import units
-from vsim_core.errors import InputError
-from vsim_recordings.csv_import import import_csv
-from vsim_recordings.recorder import run_scenario
-from vsim_recordings.rig_recordings import measured_channels, write_rig_recording
-from vsim_recordings.run_format import RUN_RECORD, TF_TOPIC, Run, RunMetadata, SignalSpec
-from vsim_recordings.run_reader import load_run
-from vsim_recordings.run_writer import RunWriter
+from elastokin.vehicle.scenarios.scenario_file import load_scenario
+from elastokin.cli import main as cli
+from elastokin.core import units
+from elastokin.core.errors import InputError
+from elastokin.recordings.csv_import import import_csv
+from elastokin.recordings.recorder import run_scenario
+from elastokin.recordings.rig_recordings import measured_channels, write_rig_recording
+from elastokin.recordings.run_format import RUN_RECORD, TF_TOPIC, Run, RunMetadata, SignalSpec
+from elastokin.recordings.run_reader import load_run
+from elastokin.recordings.run_writer import RunWriter
 
 ROOT = Path(__file__).resolve().parent.parent
 PUMPING = ROOT / "scenarios/pumping.yaml"

@@ -9,16 +9,16 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from vehicle.model.builder import build
-from vehicle.model.definition import CORNERS
-from vehicle.model.elements import BuildOptions
-from vehicle.model.statics import resolve_preloads
-from vehicle.model.vehicle_file import load_vehicle
-from vehicle.simulation.rig import KCRig
-from vehicle.simulation.road import RoadCar
-from vsim_core.shipped import DEFAULT_VEHICLE
-from vsim_tyres import magic_formula as mf
-from vsim_tyres.road_contact import SIGNALS
+from elastokin.vehicle.model.builder import build
+from elastokin.vehicle.model.definition import CORNERS
+from elastokin.vehicle.model.elements import BuildOptions
+from elastokin.vehicle.model.statics import resolve_preloads
+from elastokin.vehicle.model.vehicle_file import load_vehicle
+from elastokin.vehicle.simulation.rig import KCRig
+from elastokin.vehicle.simulation.road import RoadCar
+from elastokin.core.shipped import DEFAULT_VEHICLE
+from elastokin.tyres import magic_formula as mf
+from elastokin.tyres.road_contact import SIGNALS
 
 FZ, FX, FY, VX = (SIGNALS.index(k) for k in ("Fz_N", "Fx_N", "Fy_N", "vx_mps"))
 
@@ -109,8 +109,8 @@ def test_the_compiled_road_measurement_is_its_definition() -> None:
     """The measured vector of a car turning at speed against its definition computed with MuJoCo's
     Python API and numpy: ISO 8855 body angles, speeds and accelerations in the intermediate axes
     (MuJoCo's accelerations carry −g), wheel angles and travel in the body frame, the tyres' signals."""
-    from vehicle.model.kinematics import wheel_angles
-    from vehicle.model.definition import SIDE_SIGN
+    from elastokin.vehicle.model.kinematics import wheel_angles
+    from elastokin.vehicle.model.definition import SIDE_SIGN
 
     car = settled(brakes=0.0, seconds=1.0)
     car.set_speed(15.0)

@@ -10,8 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from vsim_analysis.road_metrics import TYPE_METRICS, bandwidth_hz, first_harmonic, road_metrics, step_response
-from vsim_recordings.run_format import Run, RunMetadata
+from elastokin.analysis.road_metrics import TYPE_METRICS, bandwidth_hz, first_harmonic, road_metrics, step_response
+from elastokin.recordings.run_format import Run, RunMetadata
 
 
 @pytest.mark.parametrize("tau, rise", [(0.05, 0.1), (0.2, 0.01), (0.13, 0.15)])

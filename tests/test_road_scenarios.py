@@ -15,24 +15,24 @@ import numpy as np
 import pytest
 
 from tests.roll_helpers import rig_roll, roll_estimate
-from vehicle.model.elements import BuildOptions
-from vehicle.model.kinematics import steering_ratio
-from vehicle.model.vehicle_file import load_vehicle
-from vehicle.scenarios.road_scenario import ROAD_TYPES, RoadScenario
-from vehicle.scenarios.scenario_file import load_scenario
-from vehicle.scenarios.schedule import timestep
-from vehicle.simulation.rig import KCRig
-from vehicle.simulation.road import RoadCar
-from vehicle.simulation.runner import DivergenceError
-from vsim_analysis.kc_test import vehicle_kc
-from vsim_analysis.road_metrics import LINEAR_RANGE_MPS2, G, road_metrics
-from vsim_cli.main import main as vsim
-from vsim_core.errors import InputError
-from vsim_core.shipped import DEFAULT_VEHICLE, SCENARIO_DIR
-from vsim_recordings.recorder import run_scenario, simulate
-from vsim_recordings.run_reader import load_run
-from vsim_tyres import magic_formula as mf
-from vsim_tyres.tir_file import read_tir
+from elastokin.vehicle.model.elements import BuildOptions
+from elastokin.vehicle.model.kinematics import steering_ratio
+from elastokin.vehicle.model.vehicle_file import load_vehicle
+from elastokin.vehicle.scenarios.road_scenario import ROAD_TYPES, RoadScenario
+from elastokin.vehicle.scenarios.scenario_file import load_scenario
+from elastokin.vehicle.scenarios.schedule import timestep
+from elastokin.vehicle.simulation.rig import KCRig
+from elastokin.vehicle.simulation.road import RoadCar
+from elastokin.vehicle.simulation.runner import DivergenceError
+from elastokin.analysis.kc_test import vehicle_kc
+from elastokin.analysis.road_metrics import LINEAR_RANGE_MPS2, G, road_metrics
+from elastokin.cli.main import main as vsim
+from elastokin.core.errors import InputError
+from elastokin.core.shipped import DEFAULT_VEHICLE, SCENARIO_DIR
+from elastokin.recordings.recorder import run_scenario, simulate
+from elastokin.recordings.run_reader import load_run
+from elastokin.tyres import magic_formula as mf
+from elastokin.tyres.tir_file import read_tir
 
 SHORT = """\
     type: step_steer

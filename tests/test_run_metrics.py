@@ -1,7 +1,7 @@
-"""K&C metrics of a recorded run (vsim_analysis/run_metrics.py): agreement with `vsim kc`, exact recovery
+"""K&C metrics of a recorded run (elastokin/analysis/run_metrics.py): agreement with `vsim kc`, exact recovery
 of a known slope, loop width and area from synthetic signals, and the run summary.
 
-Agreement with `vsim kc`: one short run per K&C test (amplitude and rate of vehicle.scenarios.kc_tests.TESTS, two
+Agreement with `vsim kc`: one short run per K&C test (amplitude and rate of elastokin.vehicle.scenarios.kc_tests.TESTS, two
 cycles, durations × 0.5, so twice kc's rate) against kc_metrics on the same car. The bushings see
 another history (linear settling, a first cycle, the doubled rate), which moves gradients by less
 than 1 % (measured); the test allows 2 % (plus 2e-4 in the metric's unit for values near 0). Loop
@@ -17,20 +17,20 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from vehicle.model.vehicle_file import load_vehicle
-from vehicle.scenarios.channels import CORNER_TAGS
-from vehicle.scenarios.scenario_file import load_scenario
-from vehicle.simulation.kc_triangles import design_contact_base
-from vehicle.simulation.rig import KCRig
-from vsim_analysis.kc_metrics import BUMP_WINDOW_M, TEST_METRICS
-from vsim_analysis.kc_test import kc_metrics
-from vsim_analysis.run_metrics import case_loop, case_metrics, cases, contact_base_m, run_metrics
-from vsim_core.errors import InputError
-from vsim_core.shipped import DEFAULT_VEHICLE
-from vsim_presentation.run_summary import summary
-from vsim_recordings.recorder import run_scenario
-from vsim_recordings.run_format import Run, RunMetadata, SignalSpec
-from vsim_recordings.run_reader import load_run
+from elastokin.vehicle.model.vehicle_file import load_vehicle
+from elastokin.vehicle.scenarios.channels import CORNER_TAGS
+from elastokin.vehicle.scenarios.scenario_file import load_scenario
+from elastokin.vehicle.simulation.kc_triangles import design_contact_base
+from elastokin.vehicle.simulation.rig import KCRig
+from elastokin.analysis.kc_metrics import BUMP_WINDOW_M, TEST_METRICS
+from elastokin.analysis.kc_test import kc_metrics
+from elastokin.analysis.run_metrics import case_loop, case_metrics, cases, contact_base_m, run_metrics
+from elastokin.core.errors import InputError
+from elastokin.core.shipped import DEFAULT_VEHICLE
+from elastokin.presentation.run_summary import summary
+from elastokin.recordings.recorder import run_scenario
+from elastokin.recordings.run_format import Run, RunMetadata, SignalSpec
+from elastokin.recordings.run_reader import load_run
 
 SCALE = 1.0        #: duration scale of the runs (at vsim kc's rates)
 TOLERANCE = 0.02   #: relative agreement of gradients with `vsim kc`

@@ -10,15 +10,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from vehicle.scenarios.channels import INPUT_CHANNELS
-from vehicle.scenarios.scenario_file import load_scenario
-from vehicle.simulation.runner import DivergenceError
-from vsim_cli import main as cli
-from vsim_core.errors import InputError
-from vsim_presentation.run_summary import summary
-from vsim_recordings.recorder import run_scenario
-from vsim_recordings.run_format import PARTIAL_SUFFIX
-from vsim_recordings.run_reader import load_run
+from elastokin.vehicle.scenarios.channels import INPUT_CHANNELS
+from elastokin.vehicle.scenarios.scenario_file import load_scenario
+from elastokin.vehicle.simulation.runner import DivergenceError
+from elastokin.cli import main as cli
+from elastokin.core.errors import InputError
+from elastokin.presentation.run_summary import summary
+from elastokin.recordings.recorder import run_scenario
+from elastokin.recordings.run_format import PARTIAL_SUFFIX
+from elastokin.recordings.run_reader import load_run
 
 SCENARIO_DIR = Path(__file__).resolve().parent.parent / "scenarios"
 QUICK = 0.05   #: duration scale of the shortened default scenarios
@@ -178,7 +178,7 @@ def test_vsim_run_command(tmp_path: Path, capsys: pytest.CaptureFixture[str], mo
     before = default.read_bytes()
     assert cli.main(["run", str(scenario)]) == 2
     assert "--overwrite" in capsys.readouterr().err and default.read_bytes() == before
-    assert cli.main(["run", str(scenario), "-o", "other.mcap", "--bushings", "linear", "--duration-scale", "0.5"]) == 0
+    assert cli.main(["run", str(scenario), "-o", "other.mcap", "--bushing-model", "linear", "--duration-scale", "0.5"]) == 0
     run = load_run(tmp_path / "other.mcap")
     assert run.metadata.extra["bushing_model"] == "linear"
     assert all(p["model"] == "linear" for p in run.metadata.bushing_parameters.values())

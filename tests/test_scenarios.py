@@ -10,13 +10,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from vehicle.model.definition import CORNERS
-from vehicle.scenarios.channels import CORNER_TAGS, INPUT_CHANNELS, csv_columns
-from vehicle.scenarios.scenario import MAX_TIMESTEP_S, MIN_TIMESTEP_S
-from vehicle.scenarios.scenario_file import load_scenario, parse_scenario, with_case_values
-from vehicle.scenarios.schedule import check_timestep, output_interval, timestep
-from vsim_core.errors import InputError
-from vsim_core.shipped import DEFAULT_VEHICLE
+from elastokin.vehicle.model.definition import CORNERS
+from elastokin.vehicle.scenarios.channels import CORNER_TAGS, INPUT_CHANNELS, csv_columns
+from elastokin.vehicle.scenarios.scenario import MAX_TIMESTEP_S, MIN_TIMESTEP_S
+from elastokin.vehicle.scenarios.scenario_file import load_scenario, parse_scenario, with_case_values
+from elastokin.vehicle.scenarios.schedule import check_timestep, output_interval, timestep
+from elastokin.core.errors import InputError
+from elastokin.core.shipped import DEFAULT_VEHICLE
 
 SCENARIO_DIR = Path(__file__).resolve().parent.parent / "scenarios"
 DEFAULT_SET = ("pumping", "roll", "lateral_force", "pumping_speeds", "rack_step", "double_rack_step_same",

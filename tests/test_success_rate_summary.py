@@ -37,7 +37,7 @@ def test_draws_spread_on_a_cluster_give_the_tally_of_draws_in_turn(tmp_path):
     """VSIM_SLOW_SCHEDULER: the draws as tasks of a local Dask cluster, each in a folder of its own
     with its diagnosis kept in its worker's process, tally as the draws made one after the other."""
     from tests.diagnosis_helpers import assert_success_rate
-    from vsim_cluster.executor import LOCAL, SCHEDULER_ENV, SERIAL
+    from elastokin.cluster.executor import LOCAL, SCHEDULER_ENV, SERIAL
 
     here = os.getpid()
 

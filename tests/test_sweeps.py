@@ -21,20 +21,20 @@ import numpy as np
 import pytest
 from distributed import KilledWorker
 
-from vehicle.model.file_overrides import PlaceError, file_value, vehicle_with
-from vehicle.model.vehicle_file import load_vehicle
-from vehicle.scenarios.scenario_file import load_scenario
-from vsim_analysis.run_metrics import run_metrics
-from vsim_cli.main import main
-from vsim_cluster.executor import WORKERS_DIED, ClusterLost, Outcome, SerialExecutor, executor, reason
-from vsim_core.documents import Document
-from vsim_core.errors import InputError
-from vsim_core.shipped import DEFAULT_VEHICLE
-from vsim_recordings.recorder import simulate
-from vsim_sweeps.designs import Design, design_points, unit_points
-from vsim_sweeps.sensitivity import sobol_indices
-from vsim_sweeps.sweep import run_sweep
-from vsim_sweeps.sweep_file import load_sweep
+from elastokin.vehicle.model.file_overrides import PlaceError, file_value, vehicle_with
+from elastokin.vehicle.model.vehicle_file import load_vehicle
+from elastokin.vehicle.scenarios.scenario_file import load_scenario
+from elastokin.analysis.run_metrics import run_metrics
+from elastokin.cli.main import main
+from elastokin.cluster.executor import WORKERS_DIED, ClusterLost, Outcome, SerialExecutor, executor, reason
+from elastokin.core.documents import Document
+from elastokin.core.errors import InputError
+from elastokin.core.shipped import DEFAULT_VEHICLE
+from elastokin.recordings.recorder import simulate
+from elastokin.sweeps.designs import Design, design_points, unit_points
+from elastokin.sweeps.sensitivity import sobol_indices
+from elastokin.sweeps.sweep import run_sweep
+from elastokin.sweeps.sweep_file import load_sweep
 
 #: A short pumping of the front axle: one 30 mm triangle (a few tenths of a second of wall time).
 SCENARIO = """name: short_pumping
@@ -227,7 +227,7 @@ def test_a_folder_another_sweep_is_writing_is_refused(serial_table, tmp_path):
     import subprocess
     import sys
 
-    from vsim_core.files import LOCK_NAME
+    from elastokin.core.files import LOCK_NAME
 
     sweep, _ = serial_table
     folder = tmp_path / "out"

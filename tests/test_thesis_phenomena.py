@@ -16,15 +16,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from vehicle.model.file_overrides import PlaceError, lossier_places, vehicle_with
-from vehicle.model.vehicle_file import load_vehicle
-from vehicle.scenarios.scenario import Scenario
-from vehicle.scenarios.scenario_file import load_scenario, parse_scenario, with_case_values
-from bushings.bank import BushingBank
-from bushings.parameter_sets import load_parameter_set
-from vsim_analysis.run_metrics import case_lag_s, case_loop, case_mask, cases
-from vsim_core.shipped import DEFAULT_VEHICLE
-from vsim_recordings.recorder import simulate
+from elastokin.vehicle.model.file_overrides import PlaceError, lossier_places, vehicle_with
+from elastokin.vehicle.model.vehicle_file import load_vehicle
+from elastokin.vehicle.scenarios.scenario import Scenario
+from elastokin.vehicle.scenarios.scenario_file import load_scenario, parse_scenario, with_case_values
+from elastokin.bushings.bank import BushingBank
+from elastokin.bushings.parameter_sets import load_parameter_set
+from elastokin.analysis.run_metrics import case_lag_s, case_loop, case_mask, cases
+from elastokin.core.shipped import DEFAULT_VEHICLE
+from elastokin.recordings.recorder import simulate
 
 NO_DAMPERS = {f"{axle}.damper.curve.{i}.1": value for axle in ("front", "rear") for i, value in ((0, -1.0), (2, 1.0))}
 
@@ -66,7 +66,7 @@ LATERAL = _front_axle("lateral_force", "[{amplitude_daN: 100, frequency_hz: 0.1}
 
 def _toe_loop(directions: tuple[str, ...]) -> float:
     """The front left toe loop's width [deg] against the lateral force with ``directions`` lossier at
-    the same |K*| where the test works them (0.2 mm, 0.1 Hz: vehicle.model.file_overrides.lossier_places)."""
+    the same |K*| where the test works them (0.2 mm, 0.1 Hz: elastokin.vehicle.model.file_overrides.lossier_places)."""
     vehicle = load_vehicle(DEFAULT_VEHICLE)
     values = {k: v for d in directions for k, v in lossier_places(vehicle, d, 0.2e-3, 0.1).items()}
     run = simulate(LATERAL,

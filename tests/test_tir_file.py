@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from vsim_core.errors import InputError
-from vsim_tyres.tir_file import read_tir
+from elastokin.core.errors import InputError
+from elastokin.tyres.tir_file import read_tir
 
 SAMPLE = """[MDI_HEADER]
 FILE_TYPE                ='tir'

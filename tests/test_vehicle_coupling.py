@@ -18,9 +18,9 @@ import mujoco
 import numpy as np
 import pytest
 
-from bushings import to_si
-from vehicle.model.elements import Channel, joint_stiffness
-from vehicle.simulation.coupling import BushingForces
+from elastokin.bushings import to_si
+from elastokin.vehicle.model.elements import Channel, joint_stiffness
+from elastokin.vehicle.simulation.coupling import BushingForces
 
 M_NS, K, TAN_D, R_UNB, M_UNB = 45.0, 4.93e6, 0.15, 0.2, 0.01
 W_N = math.sqrt(K / M_NS)
@@ -84,10 +84,10 @@ def test_tendon_damper_intercept_acts_through_the_tendon_jacobian():
     qfrc_applied through MuJoCo's sparse tendon Jacobian."""
     import dataclasses
 
-    from vehicle.model.definition import Curve, Damper
-    from vehicle.model.elements import BuildOptions
-    from vehicle.model.vehicle_file import load_vehicle
-    from vehicle.simulation.rig import KCRig
+    from elastokin.vehicle.model.definition import Curve, Damper
+    from elastokin.vehicle.model.elements import BuildOptions
+    from elastokin.vehicle.model.vehicle_file import load_vehicle
+    from elastokin.vehicle.simulation.rig import KCRig
 
     v = load_vehicle()
     knee = Damper(Curve((-1.0, 0.0, 1.0), (-2900.0, 100.0, 1300.0)))

@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 import yaml
 
-from bushings import load_parameter_set
-from vehicle.model.geometry import mirror_axes
-from vehicle.model.statics import axle_loads, resolve_preloads
-from vehicle.model.vehicle_file import load_vehicle
-from vsim_core.errors import InputError
-from vsim_core.shipped import DEFAULT_VEHICLE
+from elastokin.bushings import load_parameter_set
+from elastokin.vehicle.model.geometry import mirror_axes
+from elastokin.vehicle.model.statics import axle_loads, resolve_preloads
+from elastokin.vehicle.model.vehicle_file import load_vehicle
+from elastokin.core.errors import InputError
+from elastokin.core.shipped import DEFAULT_VEHICLE
 
 
 def test_default_car_is_plausible():

@@ -1,6 +1,6 @@
 """The catalogue's extensions switched on in the vehicle (spec measured-data.md §2).
 
-Bushing law effects (bushings.effects) on the vehicle's channels, strut friction, the twist beam's
+Bushing law effects (elastokin.bushings.effects) on the vehicle's channels, strut friction, the twist beam's
 torsion scale and a bushing's directional coupling: each test says what it holds and to what
 tolerance, with numbers.
 """
@@ -14,21 +14,21 @@ import mujoco
 import numpy as np
 import pytest
 
-from bushings import BushingBank, load_parameter_set
-from bushings.effects import NO_EFFECTS
-from bushings.extended_bank import ExtendedBank
+from elastokin.bushings import BushingBank, load_parameter_set
+from elastokin.bushings.effects import NO_EFFECTS
+from elastokin.bushings.extended_bank import ExtendedBank
 from tests.test_vehicle_definition import _write
-from vehicle.model.definition import VehicleDefinition
-from vehicle.model.elements import BuildOptions
-from vehicle.model.kinematics import front_corner
-from vehicle.model.vehicle_file import load_vehicle, with_extensions
-from vehicle.scenarios.kc_tests import TEST
-from vehicle.simulation.kc_triangles import design_contact_base, run_triangle
-from vehicle.simulation.rig import KCRig
-from vsim_analysis.kc_metrics import fit_window, triangle_metrics
-from vsim_analysis.kc_test import rig_leg
-from vsim_analysis.loops import Branches, centre_slope, loop_width
-from vsim_core.errors import InputError
+from elastokin.vehicle.model.definition import VehicleDefinition
+from elastokin.vehicle.model.elements import BuildOptions
+from elastokin.vehicle.model.kinematics import front_corner
+from elastokin.vehicle.model.vehicle_file import load_vehicle, with_extensions
+from elastokin.vehicle.scenarios.kc_tests import TEST
+from elastokin.vehicle.simulation.kc_triangles import design_contact_base, run_triangle
+from elastokin.vehicle.simulation.rig import KCRig
+from elastokin.analysis.kc_metrics import fit_window, triangle_metrics
+from elastokin.analysis.kc_test import rig_leg
+from elastokin.analysis.loops import Branches, centre_slope, loop_width
+from elastokin.core.errors import InputError
 
 LINEAR = BuildOptions(bushing_model="linear")
 
@@ -296,8 +296,8 @@ def test_extension_keys_are_validated_in_the_vehicle_file(tmp_path):
 def test_a_mirrored_direction_is_the_left_law_turned_about_the_origin():
     """The right side's law of a mirrored direction is F_right(e) = −F_left(−e), its preload and
     both parts of its asymmetry (kink and progressive) included, along a loading history."""
-    from bushings.effects import Effects
-    from vehicle.model.geometry import mirrored_law
+    from elastokin.bushings.effects import Effects
+    from elastokin.vehicle.model.geometry import mirrored_law
 
     ch = load_parameter_set("fig5_9_progressive").channel("elastic")
     left = Effects(preload=2e-4, asymmetry=0.1e3, asymmetry_step=0.3)

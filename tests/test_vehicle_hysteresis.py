@@ -1,6 +1,6 @@
 """STVS camber loops in pumping (issue 3): non-zero width that changes with speed; none when linear.
 
-Pumping triangle 0 → +60 → −60 → +60 mm (vehicle.simulation.kc_triangles.run_triangle) at 1.5 and 15 mm/s and at
+Pumping triangle 0 → +60 → −60 → +60 mm (elastokin.vehicle.simulation.kc_triangles.run_triangle) at 1.5 and 15 mm/s and at
 0.1 Hz (24 mm/s), the loop width taken at design height. The strut dampers are removed: their
 viscous loop (1.3e-3 deg measured at 15 mm/s) is wider than the change the bushings' rate
 dependence makes (4e-4 deg at the front) and would hide it. At the default step (2 ms) the front
@@ -17,14 +17,14 @@ import math
 
 import pytest
 
-from vehicle.model.definition import Curve, Damper
-from vehicle.model.elements import BuildOptions
-from vehicle.model.vehicle_file import load_vehicle
-from vehicle.scenarios.kc_tests import Triangle
-from vehicle.simulation.kc_triangles import run_triangle
-from vehicle.simulation.rig import KCRig
-from vsim_analysis.kc_test import branches
-from vsim_analysis.loops import loop_width
+from elastokin.vehicle.model.definition import Curve, Damper
+from elastokin.vehicle.model.elements import BuildOptions
+from elastokin.vehicle.model.vehicle_file import load_vehicle
+from elastokin.vehicle.scenarios.kc_tests import Triangle
+from elastokin.vehicle.simulation.kc_triangles import run_triangle
+from elastokin.vehicle.simulation.rig import KCRig
+from elastokin.analysis.kc_test import branches
+from elastokin.analysis.loops import loop_width
 
 H = BuildOptions.timestep
 AMPLITUDE = 0.06

@@ -1,6 +1,6 @@
-"""K&C metrics of the default car (vsim_analysis/kc_metrics.py) fall in plausible ranges.
+"""K&C metrics of the default car (elastokin/analysis/kc_metrics.py) fall in plausible ranges.
 
-Ranges, per axle, as (low, high) in the metric's unit and sign convention (vsim_analysis/kc_metrics.py):
+Ranges, per axle, as (low, high) in the metric's unit and sign convention (elastokin/analysis/kc_metrics.py):
 
 * from spec vehicle.md §4 (plausible C-segment values): front bump steer −10 … 0 deg/m, rear bump
   steer 0 … +4 deg/m (toe-in), aligning-torque compliance steer 0.5 … 1.5 deg/kN·m (front; the
@@ -20,9 +20,9 @@ from __future__ import annotations
 
 import pytest
 
-from vehicle.model.vehicle_file import load_vehicle
-from vsim_analysis.kc_metrics import METRICS
-from vsim_analysis.kc_test import vehicle_kc
+from elastokin.vehicle.model.vehicle_file import load_vehicle
+from elastokin.analysis.kc_metrics import METRICS
+from elastokin.analysis.kc_test import vehicle_kc
 
 RANGES = {
     "front": {
@@ -74,8 +74,8 @@ def test_metric_in_plausible_range(metrics, axle, key):
 def test_vsim_kc_json_has_the_issue_keys(metrics, monkeypatch, capsys):
     import json
 
-    from vsim_analysis import kc_test
-    from vsim_cli.main import main
+    from elastokin.analysis import kc_test
+    from elastokin.cli.main import main
 
     monkeypatch.setattr(kc_test, "vehicle_kc", lambda vehicle, options: metrics)
     assert main(["kc", "--json"]) == 0

@@ -8,12 +8,12 @@ import math
 import numpy as np
 import pytest
 
-from vehicle.model.definition import CORNERS
-from vehicle.model.elements import BuildOptions
-from vehicle.model.kinematics import front_corner, rear_heave
-from vehicle.model.statics import axle_loads
-from vehicle.model.vehicle_file import load_vehicle
-from vehicle.simulation.rig import KCRig
+from elastokin.vehicle.model.definition import CORNERS
+from elastokin.vehicle.model.elements import BuildOptions
+from elastokin.vehicle.model.kinematics import front_corner, rear_heave
+from elastokin.vehicle.model.statics import axle_loads
+from elastokin.vehicle.model.vehicle_file import load_vehicle
+from elastokin.vehicle.simulation.rig import KCRig
 
 
 @pytest.fixture(scope="module")

@@ -7,12 +7,12 @@ import numpy as np
 import pytest
 import yaml
 
-from bushings.bench.campaign import CAMPAIGN
-from bushings.extended_bank import ExtendedBank
-from vsim_cli.main import main as vsim
-from vsim_core.errors import InputError
-from vsim_diagnosis.virtual_bench import OVERSAMPLING, measure_bench, parse_truth, rest_before
-from vsim_recordings.bench_dataset import read_bench_dataset
+from elastokin.bushings.bench.campaign import CAMPAIGN
+from elastokin.bushings.extended_bank import ExtendedBank
+from elastokin.cli.main import main as vsim
+from elastokin.core.errors import InputError
+from elastokin.diagnosis.virtual_bench import OVERSAMPLING, measure_bench, parse_truth, rest_before
+from elastokin.recordings.bench_dataset import read_bench_dataset
 
 SHORT = CAMPAIGN[:3]
 TRUTH = {"level": "bench", "baseline": "fig5_9_progressive", "seed": 7,

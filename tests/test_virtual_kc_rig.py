@@ -13,18 +13,18 @@ import numpy as np
 import pytest
 import yaml
 
-from vehicle.scenarios.channels import INPUT_CHANNELS
-from vsim_cli.main import main as vsim
-from vsim_core.errors import InputError
-from vsim_core.shipped import DEFAULT_VEHICLE
-from vsim_diagnosis.truths import load_truth
-from vsim_diagnosis.virtual_kc_rig import (DEFAULT_SCENARIOS, MEASUREMENT_DEFAULTS, KCTruth, measure_kc, parse_kc_truth,
+from elastokin.vehicle.scenarios.channels import INPUT_CHANNELS
+from elastokin.cli.main import main as vsim
+from elastokin.core.errors import InputError
+from elastokin.core.shipped import DEFAULT_VEHICLE
+from elastokin.diagnosis.truths import load_truth
+from elastokin.diagnosis.virtual_kc_rig import (DEFAULT_SCENARIOS, MEASUREMENT_DEFAULTS, KCTruth, measure_kc, parse_kc_truth,
                                            sensor)
-from vsim_recordings.kc_dataset import read_kc_dataset
-from vsim_recordings.recorder import simulate
-from vsim_recordings.rig_recordings import DERIVED, measured_channels
-from vsim_recordings.run_reader import load_run
-from vsim_recordings.run_writer import RunWriter
+from elastokin.recordings.kc_dataset import read_kc_dataset
+from elastokin.recordings.recorder import simulate
+from elastokin.recordings.rig_recordings import DERIVED, measured_channels
+from elastokin.recordings.run_reader import load_run
+from elastokin.recordings.run_writer import RunWriter
 
 SCALE = 0.2
 PUMPING = """name: tiny_pumping

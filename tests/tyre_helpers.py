@@ -7,7 +7,7 @@ from typing import Callable
 
 import numpy as np
 
-from vsim_tyres import magic_formula as mf
+from elastokin.tyres import magic_formula as mf
 
 #: Loads [N], slips, slip angles and inclinations [rad], speeds [m/s] (below VXLOW, about LONGVL,
 #: above): the linear range, the peaks and beyond, both signs.

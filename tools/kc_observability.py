@@ -5,7 +5,7 @@ Prints the model error it makes in excess of the noise: the RMS over every compa
 sample of the change, each channel's mean per recording removed (the diagnosis takes it for a zero
 error), in units of the channel's noise (the virtual rig's defaults). A baseline held-out error of
 √(1 + excess²) is what the diagnosis must explain; it names nothing below 1.11 (excess 0.48).
-``vsim_diagnosis.kc_catalogue.OBSERVABLE`` lists the places whose excess is at least
+``elastokin.diagnosis.kc_catalogue.OBSERVABLE`` lists the places whose excess is at least
 ``kc_catalogue.MIN_EXCESS`` at the test campaign's speed (``--duration-scale 0.25``).
 
     python tools/kc_observability.py [--vehicle V.yaml] [--duration-scale S] [--cause C ...] [--json]
@@ -24,22 +24,22 @@ from pathlib import Path
 
 import numpy as np
 
-from vehicle.model.definition import VehicleDefinition
-from vehicle.model.vehicle_file import load_vehicle
-from vehicle.scenarios.scenario_file import load_scenario
-from vsim_cluster.executor import TaskFailed, executor
-from vsim_core.shipped import DEFAULT_VEHICLE
-from vsim_diagnosis.kc_catalogue import (BUSHING_CAUSES, MIN_EXCESS, VEHICLE_CAUSES, Hypothesis, extended_vehicle,
+from elastokin.vehicle.model.definition import VehicleDefinition
+from elastokin.vehicle.model.vehicle_file import load_vehicle
+from elastokin.vehicle.scenarios.scenario_file import load_scenario
+from elastokin.cluster.executor import TaskFailed, executor
+from elastokin.core.shipped import DEFAULT_VEHICLE
+from elastokin.diagnosis.kc_catalogue import (BUSHING_CAUSES, MIN_EXCESS, VEHICLE_CAUSES, Hypothesis, extended_vehicle,
                                          locations, parameters)
-from vsim_diagnosis.kc_layout import COMPARED
-from vsim_diagnosis.kc_fits import nominal
-from vsim_diagnosis.virtual_kc_rig import DEFAULT_SCENARIOS, MEASUREMENT_DEFAULTS, sensor
-from vsim_recordings.recorder import simulate
+from elastokin.diagnosis.kc_layout import COMPARED
+from elastokin.diagnosis.kc_fits import nominal
+from elastokin.diagnosis.virtual_kc_rig import DEFAULT_SCENARIOS, MEASUREMENT_DEFAULTS, sensor
+from elastokin.recordings.recorder import simulate
 
 
 def weak(cause: str) -> list[dict[str, float]]:
     """The cause's values at the weak end of its range: the first parameter at the low end of its
-    draw (of either sign, for a cause screened on both: :attr:`vsim_diagnosis.catalogue.Parameter.signs`),
+    draw (of either sign, for a cause screened on both: :attr:`elastokin.diagnosis.catalogue.Parameter.signs`),
     the others mid-range."""
     first = parameters(cause)[0]
     return [{**nominal(cause), first.name: sign * first.draw[0]} for sign in first.signs]

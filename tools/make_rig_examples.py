@@ -20,7 +20,7 @@ EXAMPLES = {"bench": TRUTHS / "bench_example.yaml", "kc": TRUTHS / "kc_example.y
 
 
 def main(argv: list[str] | None = None) -> int:
-    from vsim_cli.main import main as vsim
+    from elastokin.cli.main import main as vsim
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("names", nargs="*", metavar="NAME",

@@ -21,17 +21,17 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from bushings.bank import BushingBank  # noqa: E402
-from bushings.frequency import first_harmonic, lossier  # noqa: E402
-from bushings.parameter_sets import load_parameter_set  # noqa: E402
-from vehicle.model.file_overrides import lossier_places, vehicle_with  # noqa: E402
-from vehicle.model.definition import DirectionDef  # noqa: E402
-from vehicle.model.vehicle_file import load_vehicle  # noqa: E402
-from vehicle.scenarios.scenario_file import load_scenario, with_case_values  # noqa: E402
-from vsim_analysis.run_metrics import case_lag_s, case_loop, case_mask, case_relaxation, cases  # noqa: E402
-from vsim_cluster.executor import executor  # noqa: E402
-from vsim_core.shipped import DEFAULT_VEHICLE  # noqa: E402
-from vsim_recordings.recorder import simulate  # noqa: E402
+from elastokin.bushings.bank import BushingBank  # noqa: E402
+from elastokin.bushings.frequency import first_harmonic, lossier  # noqa: E402
+from elastokin.bushings.parameter_sets import load_parameter_set  # noqa: E402
+from elastokin.vehicle.model.file_overrides import lossier_places, vehicle_with  # noqa: E402
+from elastokin.vehicle.model.definition import DirectionDef  # noqa: E402
+from elastokin.vehicle.model.vehicle_file import load_vehicle  # noqa: E402
+from elastokin.vehicle.scenarios.scenario_file import load_scenario, with_case_values  # noqa: E402
+from elastokin.analysis.run_metrics import case_lag_s, case_loop, case_mask, case_relaxation, cases  # noqa: E402
+from elastokin.cluster.executor import executor  # noqa: E402
+from elastokin.core.shipped import DEFAULT_VEHICLE  # noqa: E402
+from elastokin.recordings.recorder import simulate  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 #: The dampers reduced to 1 N at 1 m/s (they must still dissipate): the car without its dampers.
@@ -51,7 +51,7 @@ SLOW_RISE_S = 0.5
 BEAM_BENDING_NM_PER_RAD = 5e4
 #: The shares of a rack step at which the toe's lag behind the rack is measured.
 LAG_AT = (0.1, 0.5, 0.9)
-#: Where a lossier law keeps its |K*| (bushings.frequency.lossier): amplitude [m] and frequency [Hz]
+#: Where a lossier law keeps its |K*| (elastokin.bushings.frequency.lossier): amplitude [m] and frequency [Hz]
 #: (E2 front's lateral direction works about there in the lateral-force test; E1 front's, at 0.3–2 mm).
 LOSS_AT = (0.2e-3, 0.1)
 
@@ -370,7 +370,7 @@ def report(r: dict, files: dict[str, str]) -> str:
         "",
         "Scenario `lateral_force`, the vehicle file's laws, and the same with the law of one front "
         "bushing direction (or of all five front directions with ladder laws) made lossier: its ladder twice "
-        "as stiff and its linear spring lowered to keep |K*| at 0.2 mm and 0.1 Hz (`bushings.frequency.lossier`; "
+        "as stiff and its linear spring lowered to keep |K*| at 0.2 mm and 0.1 Hz (`elastokin.bushings.frequency.lossier`; "
         "tan δ there " + ", ".join(f"{d} {a[0]:.3f} → {b[0]:.3f}" for d, (a, b) in loss.items() if d.endswith(".y"))
         + "). Where the test works them the stiffness moves too: E1 front y, worked at "
         f"{min(worked['e1_front.y']):.2f}–{max(worked['e1_front.y']):.2f} mm, is "

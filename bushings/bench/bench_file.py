@@ -3,7 +3,7 @@
 The file is in the thesis's units (N, mm, s); it is validated and converted to SI once, by
 :func:`load_bench`. Time-series programmes give the columns ``t_s, e_mm, F_N``; a sweep gives
 ``amplitude_mm, frequency_hz, k_dyn_n_per_mm, tan_delta`` (first harmonic of the stabilised last
-cycle, :func:`bushings.frequency.first_harmonic`).
+cycle, :func:`elastokin.bushings.frequency.first_harmonic`).
 """
 
 from __future__ import annotations
@@ -14,16 +14,16 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from bushings.bench.programmes import Sweep, TimeSeries, read_programme
-from bushings.effects import NO_EFFECTS, Effects
-from bushings.extended_bank import ExtendedBank
-from bushings.frequency import first_harmonic
-from bushings.parameter_sets import load_parameter_set
-from bushings.parameters import MODELS, ChannelParams, to_si
-from vsim_core.documents import Document, Fields
-from vsim_core.errors import InputError
-from vsim_core.shipped import BENCH_DIR, resolve
-from vsim_core.units import MM
+from elastokin.bushings.bench.programmes import Sweep, TimeSeries, read_programme
+from elastokin.bushings.effects import NO_EFFECTS, Effects
+from elastokin.bushings.extended_bank import ExtendedBank
+from elastokin.bushings.frequency import first_harmonic
+from elastokin.bushings.parameter_sets import load_parameter_set
+from elastokin.bushings.parameters import MODELS, ChannelParams, to_si
+from elastokin.core.documents import Document, Fields
+from elastokin.core.errors import InputError
+from elastokin.core.shipped import BENCH_DIR, resolve
+from elastokin.core.units import MM
 
 #: Longest bench time step accepted [s]: the bench samples rubber that relaxes in tenths of a second.
 MAX_DT_S = 1.0

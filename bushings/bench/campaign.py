@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from bushings.bench.programmes import parse_programme
+from elastokin.bushings.bench.programmes import parse_programme
 
 
 @dataclass(frozen=True)

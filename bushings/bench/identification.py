@@ -23,11 +23,11 @@ from typing import Mapping, Sequence
 import numpy as np
 from scipy.optimize import least_squares
 
-from bushings.bench.records import BenchRecord, simulate_record
-from bushings.parameter_sets import ParameterSet
-from bushings.parameters import DEFAULT_CELLS, FITTED_MODELS, MODELS, PW_MIN, to_si
-from vsim_core.errors import InputError
-from vsim_core.units import MM
+from elastokin.bushings.bench.records import BenchRecord, simulate_record
+from elastokin.bushings.parameter_sets import ParameterSet
+from elastokin.bushings.parameters import DEFAULT_CELLS, FITTED_MODELS, MODELS, PW_MIN, to_si
+from elastokin.core.errors import InputError
+from elastokin.core.units import MM
 
 #: Parameters adjusted by :func:`fit`, per model: the model's required ones (N is fixed).
 FIT_PARAMETERS: dict[str, tuple[str, ...]] = {model: MODELS[model][0] for model in FITTED_MODELS}

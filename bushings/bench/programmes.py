@@ -4,7 +4,7 @@ A programme mapping (from a bench YAML file, in mm and s) is validated and conve
 by :func:`parse_programme`. Time-series programmes become a :class:`TimeSeries` (time [s] and
 deflection [m] on a uniform grid of step dt_s, starting at rest at e = 0); a frequency ``sweep``
 becomes a :class:`Sweep` of (amplitude, frequency) pairs, each analysed by
-:mod:`bushings.frequency`. A sine may carry ``static_mm``: it is then played about that static
+:mod:`elastokin.bushings.frequency`. A sine may carry ``static_mm``: it is then played about that static
 offset, reached and left by 1 mm/s ramps (the standard campaign's static-offset sines).
 """
 
@@ -17,10 +17,10 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from vsim_core.documents import Document, Fields, KeyPath, check_number
-from vsim_core import units
-from vsim_core.tables import read_csv_columns
-from vsim_core.units import MM
+from elastokin.core.documents import Document, Fields, KeyPath, check_number
+from elastokin.core import units
+from elastokin.core.tables import read_csv_columns
+from elastokin.core.units import MM
 
 #: Fewest samples per period of the fastest sine component that a bench accepts.
 MIN_SAMPLES_PER_PERIOD = 20

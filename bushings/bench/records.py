@@ -13,11 +13,11 @@ from typing import Sequence
 
 import numpy as np
 
-from bushings.bank import BushingBank
-from bushings.bench.programmes import RECORD_LIMITS
-from bushings.parameters import ChannelParams
-from vsim_core.tables import read_csv_columns
-from vsim_core.units import MM
+from elastokin.bushings.bank import BushingBank
+from elastokin.bushings.bench.programmes import RECORD_LIMITS
+from elastokin.bushings.parameters import ChannelParams
+from elastokin.core.tables import read_csv_columns
+from elastokin.core.units import MM
 
 #: Columns a bench record must have (extra columns are ignored).
 RECORD_COLUMNS = ("t_s", "e_mm", "F_N")

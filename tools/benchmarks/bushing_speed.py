@@ -23,9 +23,9 @@ from typing import Callable
 
 import numpy as np
 
-from bushings import BushingBank, load_parameter_set
-from bushings.extended_bank import ExtendedBank
-from bushings.reference import explicit_reference
+from elastokin.bushings import BushingBank, load_parameter_set
+from elastokin.bushings.extended_bank import ExtendedBank
+from elastokin.bushings.reference import explicit_reference
 
 H_S = 1e-3
 DURATION_S = 4.0
@@ -86,7 +86,7 @@ def time_bank(e: np.ndarray) -> tuple[float, float, float, int]:
 
 def time_compiled(e: np.ndarray) -> float:
     """Best CPU time per step [µs] (see per_step_us) of the same 36-channel steps run by compiled
-    loops (:meth:`ExtendedBank.run`, whose step is the one ``vehicle.simulation.stepping`` calls), one call
+    loops (:meth:`ExtendedBank.run`, whose step is the one ``elastokin.vehicle.simulation.stepping`` calls), one call
     per chunk."""
     ch = load_parameter_set("fig5_9").channel()
     ExtendedBank([ch] * e.shape[1]).run(e[:2], H_S)  # compile / warm up outside the timing

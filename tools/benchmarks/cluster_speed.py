@@ -28,15 +28,15 @@ from pathlib import Path
 import numpy as np
 
 from processes import run_measured
-from vsim_cluster.executor import executor
-from vsim_core.shipped import DEFAULT_VEHICLE
-from vsim_diagnosis.kc_layout import Layout, run_job
-from vsim_recordings.kc_dataset import read_kc_dataset
-from vsim_sweeps.designs import design_points
-from vsim_sweeps.sweep import run_sweep
-from vsim_sweeps.sweep_file import load_sweep
-from vsim_sweeps.sweep_runs import run_point, tasks
-from vehicle.model.vehicle_file import load_vehicle
+from elastokin.cluster.executor import executor
+from elastokin.core.shipped import DEFAULT_VEHICLE
+from elastokin.diagnosis.kc_layout import Layout, run_job
+from elastokin.recordings.kc_dataset import read_kc_dataset
+from elastokin.sweeps.designs import design_points
+from elastokin.sweeps.sweep import run_sweep
+from elastokin.sweeps.sweep_file import load_sweep
+from elastokin.sweeps.sweep_runs import run_point, tasks
+from elastokin.vehicle.model.vehicle_file import load_vehicle
 
 ROOT = Path(__file__).resolve().parents[2]
 KC = ROOT / "data" / "rig" / "kc"
@@ -63,7 +63,7 @@ metrics: [front.toe_loop_width_deg, front.camber_loop_width_deg]
 def _diagnosis(figures: dict) -> None:
     verdicts = []
     for workers in (1, 2):
-        done = run_measured([sys.executable, "-m", "vsim_cli", "diagnose", str(KC), "--workers", str(workers),
+        done = run_measured([sys.executable, "-m", "elastokin.cli", "diagnose", str(KC), "--workers", str(workers),
                              "--json"])
         if done.returncode:
             raise SystemExit(done.stderr)

@@ -19,7 +19,7 @@ from processes import run_measured
 
 ROOT = Path(__file__).resolve().parents[2]
 DATASETS = {
-    "bench": (ROOT / "data" / "rig" / "bench", ["--bushing-model", "fig5_9_progressive"], 60.0),
+    "bench": (ROOT / "data" / "rig" / "bench", ["--bushing-set", "fig5_9_progressive"], 60.0),
     "kc": (ROOT / "data" / "rig" / "kc", ["--vehicle", str(ROOT / "models" / "vehicles" / "c_segment.yaml")], 600.0),
 }
 
@@ -34,7 +34,7 @@ def main() -> int:
             figures[f"{name}_wall_s"] = None
             figures[f"{name}_note"] = f"{path.relative_to(ROOT)} is not shipped yet"
             continue
-        done = run_measured([sys.executable, "-m", "vsim_cli", "diagnose", str(path), *baseline, "--json"])
+        done = run_measured([sys.executable, "-m", "elastokin.cli", "diagnose", str(path), *baseline, "--json"])
         if done.returncode:
             print(done.stderr, file=sys.stderr)
             return done.returncode

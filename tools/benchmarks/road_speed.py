@@ -28,14 +28,14 @@ from dataclasses import replace
 
 import numpy as np
 
-from vehicle.model.elements import BuildOptions
-from vehicle.model.vehicle_file import load_vehicle
-from vehicle.scenarios.schedule import timestep
-from vehicle.scenarios.scenario_file import load_scenario
-from vehicle.simulation.rig import KCRig
-from vehicle.simulation.road import RoadCar
-from vsim_analysis.road_metrics import road_metrics
-from vsim_recordings.recorder import simulate
+from elastokin.vehicle.model.elements import BuildOptions
+from elastokin.vehicle.model.vehicle_file import load_vehicle
+from elastokin.vehicle.scenarios.schedule import timestep
+from elastokin.vehicle.scenarios.scenario_file import load_scenario
+from elastokin.vehicle.simulation.rig import KCRig
+from elastokin.vehicle.simulation.road import RoadCar
+from elastokin.analysis.road_metrics import road_metrics
+from elastokin.recordings.recorder import simulate
 
 SECONDS = 4.0
 SPEED = 80 / 3.6

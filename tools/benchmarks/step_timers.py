@@ -17,9 +17,9 @@ import time
 import mujoco
 import numpy as np
 
-from vehicle.model.elements import BuildOptions
-from vehicle.model.vehicle_file import load_vehicle
-from vehicle.simulation.rig import KCRig
+from elastokin.vehicle.model.elements import BuildOptions
+from elastokin.vehicle.model.vehicle_file import load_vehicle
+from elastokin.vehicle.simulation.rig import KCRig
 
 RAMP_S, AMPLITUDE_M = 2.5, 0.06   #: a quarter of the benchmark's pumping period
 

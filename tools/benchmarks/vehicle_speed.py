@@ -5,22 +5,22 @@
 * ``rtf_linear``, ``rtf_stvs_all``: simulated time / wall time of one pumping period (60 mm
   triangle at 0.1 Hz, inputs ramped inside the compiled loop, no sampling) with every bushing
   direction linear, and with STVS (N = 15) on all six directions of the six main bushings
-  (``--bushings stvs``: 36 channels, models/vehicles/README.md); best of five periods, the two
+  (``--bushing-model stvs``: 36 channels, models/vehicles/README.md); best of five periods, the two
   cars alternating, after a warm-up period each;
 * ``ratio_stvs_to_linear``: ratio of their step times; ``step_us_*``: the step times [µs];
 * ``camber_change_on_half_step_deg``: largest difference between the camber loops computed at H
-  and at H/2 (60 mm, 0.1 Hz pumping, vehicle.simulation.kc_triangles.run_triangle, STVS; both branches compared at
+  and at H/2 (60 mm, 0.1 Hz pumping, elastokin.vehicle.simulation.kc_triangles.run_triangle, STVS; both branches compared at
   the same pad heights over ±55 mm, four wheels); ``closure_error_max_m``: largest loop-closure error on that loop at H;
   ``camber_loop_width_deg_front|rear`` and ``..._half_step``: the widest gap between the branches
   at H and at H/2 (the twist-beam rear's loop is a hundredth of the front's: a time step can keep
   the absolute change under target and still double it, as 2 ms did while the closures softened
-  with the step; vehicle.model.builder.CLOSURE_SOLREF).
+  with the step; elastokin.vehicle.model.builder.CLOSURE_SOLREF).
 
 * ``end_to_end_*``: the README's main job as a user runs it (``vsim run pumping``, a fresh
   process, ``--run-scale`` on its durations; the run of median ratio of three, ``ratio_min`` and
   ``ratio_max`` the others'): ``wall_s`` from the process's start to its end,
   ``stepping_s`` the part spent in the compiled stepping loop (as the command reports it; the
-  loop also measures the outputs at every sample, vehicle.simulation.probes), ``ratio`` their
+  loop also measures the outputs at every sample, elastokin.vehicle.simulation.probes), ``ratio`` their
   quotient, ``rtf`` simulated time / wall time, ``peak_rss_mb`` the process's peak resident
   memory; ``measuring_s`` the part of ``stepping_s`` the measurement takes (the run's samples times
   the cost of one, timed apart: ``mj_forward`` and the probe, without steps), and
@@ -45,14 +45,14 @@ from pathlib import Path
 import numpy as np
 from processes import run_measured
 
-from vehicle.model.definition import CORNERS
-from vehicle.model.elements import BuildOptions
-from vehicle.model.vehicle_file import load_vehicle
-from vehicle.scenarios.kc_tests import Triangle
-from vehicle.simulation.kc_triangles import run_triangle
-from vehicle.simulation.rig import KCRig
-from vsim_analysis.kc_test import branches
-from vsim_recordings.run_reader import load_run
+from elastokin.vehicle.model.definition import CORNERS
+from elastokin.vehicle.model.elements import BuildOptions
+from elastokin.vehicle.model.vehicle_file import load_vehicle
+from elastokin.vehicle.scenarios.kc_tests import Triangle
+from elastokin.vehicle.simulation.kc_triangles import run_triangle
+from elastokin.vehicle.simulation.rig import KCRig
+from elastokin.analysis.kc_test import branches
+from elastokin.recordings.run_reader import load_run
 
 AMPLITUDE = 0.06     #: pumping amplitude [m]
 PERIOD = 10.0        #: [s] (0.1 Hz)
@@ -130,7 +130,7 @@ def end_to_end(scale: float, runs: int = 3) -> dict[str, float]:
 
 def _end_to_end_once(scale: float) -> dict[str, float]:
     with tempfile.TemporaryDirectory() as folder:
-        done = run_measured([sys.executable, "-m", "vsim_cli", "run", "pumping", "--duration-scale", str(scale),
+        done = run_measured([sys.executable, "-m", "elastokin.cli", "run", "pumping", "--duration-scale", str(scale),
                              "-o", str(Path(folder) / "run.mcap")])
         samples = load_run(Path(folder) / "run.mcap").t_s.size if not done.returncode else 0
     if done.returncode:

@@ -18,11 +18,11 @@ Topology (per side; the right side mirrors the left):
   by a ``connect``; wheel hinges are locked (brakes on); the rack position is driven.
 * road (``road=True``): the body free, the wheels spinning on their hinges, the rack position
   driven (the steering), a ground plane to look at; the tyres' forces come from
-  :mod:`vehicle.simulation.road` (MuJoCo's contacts stay off).
+  :mod:`elastokin.vehicle.simulation.road` (MuJoCo's contacts stay off).
 
 Linear bushing directions live in the joints' ``stiffness``/``damping`` (implicit under
 ``integrator="discrete"``); the others (and any law with effects) get a reference stiffness in the
-joint and the rest of their force from :mod:`vehicle.simulation.coupling`, as do the bushings' cross
+joint and the rest of their force from :mod:`elastokin.vehicle.simulation.coupling`, as do the bushings' cross
 stiffnesses. The right side's laws, effects and cross stiffnesses are the mirror images of the
 left's (:func:`mirror_signs`).
 """
@@ -36,11 +36,11 @@ from dataclasses import dataclass, field, replace
 import mujoco
 import numpy as np
 
-from bushings.effects import NO_EFFECTS
-from vehicle.model.definition import DIRECTIONS, SIDES, BushingDef, Spring, VehicleDefinition
-from vehicle.model.elements import BuildOptions, Channel, CrossTerm, Element, joint_stiffness
-from vehicle.model.geometry import frame_from, mirror, mirror_axes, mirror_signs, mirrored_law, wheel_axis
-from vsim_core.errors import InputError
+from elastokin.bushings.effects import NO_EFFECTS
+from elastokin.vehicle.model.definition import DIRECTIONS, SIDES, BushingDef, Spring, VehicleDefinition
+from elastokin.vehicle.model.elements import BuildOptions, Channel, CrossTerm, Element, joint_stiffness
+from elastokin.vehicle.model.geometry import frame_from, mirror, mirror_axes, mirror_signs, mirrored_law, wheel_axis
+from elastokin.core.errors import InputError
 
 #: Stiffness of a "rigid" bushing translation [N/m] (kinematics mode).
 RIGID_TRANSLATION = 1e9
@@ -405,5 +405,5 @@ class _Builder:
 
 
 def build(vehicle: VehicleDefinition, options: BuildOptions = BuildOptions()) -> CarModel:
-    """Compile the MuJoCo model of ``vehicle`` (spring preloads must be resolved, see ``vehicle.model.statics``)."""
+    """Compile the MuJoCo model of ``vehicle`` (spring preloads must be resolved, see ``elastokin.vehicle.model.statics``)."""
     return _Builder(vehicle, options).build()

@@ -3,7 +3,7 @@ z up); hardpoints are the left side's, the right side being their mirror image.
 
 Bushing directions keep their parameters in the bushing library's user-facing form and are
 converted by :meth:`DirectionDef.channel` (and their law extensions by :meth:`DirectionDef.effects_si`).
-The file is read by :mod:`vehicle.model.vehicle_file`, which also sets the catalogue's extensions
+The file is read by :mod:`elastokin.vehicle.model.vehicle_file`, which also sets the catalogue's extensions
 (spec measured-data.md §2) without a file.
 """
 
@@ -15,10 +15,10 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from bushings.effects import Effects, effects_to_si
-from bushings.parameter_sets import load_parameter_set
-from bushings.parameters import MODELS, ChannelParams, to_si
-from vsim_core.errors import InputError
+from elastokin.bushings.effects import Effects, effects_to_si
+from elastokin.bushings.parameter_sets import load_parameter_set
+from elastokin.bushings.parameters import MODELS, ChannelParams, to_si
+from elastokin.core.errors import InputError
 
 FRONT_POINTS = ("wheel_centre", "lower_ball_joint", "wishbone_front_pivot", "wishbone_rear_pivot",
                 "strut_top", "strut_lower", "tie_rod_outer", "tie_rod_inner")
@@ -125,11 +125,11 @@ class DirectionDef:
     params: Mapping[str, Any] | None    #: inline parameters (thesis units), or None
     source: str = field(compare=False)  #: file and key, for error messages (not what the law is)
     families: Families = NO_FAMILIES    #: laws for run-time models this one cannot be read as
-    #: state extensions of the law (:mod:`bushings.effects`, parameter-set units), over the set's own
+    #: state extensions of the law (:mod:`elastokin.bushings.effects`, parameter-set units), over the set's own
     effects: Mapping[str, Any] = field(default_factory=dict)
 
     def effects_si(self) -> Effects:
-        """The law's :class:`bushings.effects.Effects` (SI): its set's ``effects`` with this
+        """The law's :class:`elastokin.bushings.effects.Effects` (SI): its set's ``effects`` with this
         direction's own ``effects`` keys over them. They apply whatever model the law is read as."""
         own = load_parameter_set(self.set_name).effects if self.set_name is not None else {}
         return effects_to_si({**own, **self.effects}, self.quantity, self.source)

@@ -7,9 +7,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from bushings.effects import NO_EFFECTS, Effects
-from bushings.parameters import ChannelParams
-from vehicle.model.definition import Curve, Spring
+from elastokin.bushings.effects import NO_EFFECTS, Effects
+from elastokin.bushings.parameters import ChannelParams
+from elastokin.vehicle.model.definition import Curve, Spring
 
 
 @dataclass(frozen=True)
@@ -18,11 +18,11 @@ class BuildOptions:
 
     rig: bool = True                    #: add the K&C rig (pads, rack drive, wheel locks)
     clamped: bool = True                #: body fixed to the world; otherwise a free joint
-    road: bool = False                  #: on a flat road: free body, rack drive, ground plane (tyres: vehicle.simulation.road)
+    road: bool = False                  #: on a flat road: free body, rack drive, ground plane (tyres: elastokin.vehicle.simulation.road)
     bushing_model: str | None = None    #: read every named bushing set as this model
     rigid_bushings: bool = False        #: translations rigid (kinematics); rotations unchanged
     #: [s]: the longest step of a run (a scenario's divides its output interval and resolves its
-    #: inputs: vehicle.scenarios.schedule.timestep). At 2 ms the rig's camber loop moves by
+    #: inputs: elastokin.vehicle.scenarios.schedule.timestep). At 2 ms the rig's camber loop moves by
     #: < 0.005° and the road's yaw-rate response time by < 0.1 ms when it halves (tools/benchmarks).
     timestep: float = 2e-3
 
@@ -34,7 +34,7 @@ class Channel:
     name: str                            #: e.g. ``e1_front_left.y``
     joint: str
     params: ChannelParams                #: the law (SI)
-    effects: Effects = NO_EFFECTS        #: state extensions of the law (bushings.effects, SI)
+    effects: Effects = NO_EFFECTS        #: state extensions of the law (elastokin.bushings.effects, SI)
 
     @property
     def linear(self) -> bool:
@@ -68,6 +68,6 @@ class Element:
 
 def joint_stiffness(channel: Channel) -> float:
     """Stiffness to put in a bushing joint: the whole law if linear (implicit), else the
-    reference tangent K0 + Kpa (the rest is applied explicitly by :mod:`vehicle.simulation.coupling`)."""
+    reference tangent K0 + Kpa (the rest is applied explicitly by :mod:`elastokin.vehicle.simulation.coupling`)."""
     p = channel.params
     return p.K0 if channel.linear else p.K0 + p.Kpa

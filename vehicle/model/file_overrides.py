@@ -15,12 +15,12 @@ import copy
 from pathlib import Path
 from typing import Any, Mapping
 
-from bushings.frequency import lossier
-from bushings.parameter_sets import load_parameter_set
-from bushings.parameters import MODELS
-from vehicle.model.definition import DIRECTIONS, VehicleDefinition
-from vehicle.model.vehicle_file import parse_vehicle
-from vsim_core.documents import Document, dump_yaml
+from elastokin.bushings.frequency import lossier
+from elastokin.bushings.parameter_sets import load_parameter_set
+from elastokin.bushings.parameters import MODELS
+from elastokin.vehicle.model.definition import DIRECTIONS, VehicleDefinition
+from elastokin.vehicle.model.vehicle_file import parse_vehicle
+from elastokin.core.documents import Document, dump_yaml
 
 _AXES = {"x": 0, "y": 1, "z": 2}
 
@@ -132,7 +132,7 @@ def lossier_places(vehicle: VehicleDefinition, direction: str, amplitude_m: floa
     """The places and values (the file's units, for :func:`vehicle_with`) that give the bushing
     direction ``direction`` (``"e1_front.y"``) of ``vehicle`` its law with the ladder ``factor``
     times as stiff and the same |K*| at (``amplitude_m``, ``frequency_hz``): a lossier part of the
-    same stiffness there (:func:`bushings.frequency.lossier`; for a rotation, in rad for m).
+    same stiffness there (:func:`elastokin.bushings.frequency.lossier`; for a rotation, in rad for m).
     :class:`PlaceError` for a direction without a ladder."""
     bushing, _, axis = direction.partition(".")
     found = [b for b in vehicle.bushings if b.name == bushing and axis in b.directions]

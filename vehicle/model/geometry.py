@@ -8,8 +8,8 @@ import math
 
 import numpy as np
 
-from bushings.effects import Effects
-from bushings.parameters import ChannelParams
+from elastokin.bushings.effects import Effects
+from elastokin.bushings.parameters import ChannelParams
 
 
 def mirror(p, sign: float) -> np.ndarray:

@@ -15,8 +15,8 @@ from dataclasses import dataclass
 import numba as nb
 import numpy as np
 
-from vehicle.model.definition import VehicleDefinition
-from vehicle.model.geometry import wheel_axis
+from elastokin.vehicle.model.definition import VehicleDefinition
+from elastokin.vehicle.model.geometry import wheel_axis
 
 
 @dataclass(frozen=True)
@@ -100,7 +100,7 @@ def wheel_orientation(left_x: float, left_y: float, left_z: float, sign: float) 
     """(toe-in, camber, steer) [rad] of a wheel from its spin axis pointing to the vehicle's left
     (components in the frame the angles are taken in); ``sign`` +1 for a left wheel, −1 for a right
     one. Steer is the yaw of the heading ``spin_left × z``, to the left positive. Compiled: the
-    rig's measurement calls it at every sample (vehicle.simulation.probes)."""
+    rig's measurement calls it at every sample (elastokin.vehicle.simulation.probes)."""
     out_x, out_y, out_z = sign * left_x, sign * left_y, sign * left_z   # the outward spin axis
     toe = math.atan2(out_x, sign * out_y)
     camber = -math.asin(1.0 if out_z > 1.0 else (-1.0 if out_z < -1.0 else out_z))

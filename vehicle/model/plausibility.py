@@ -10,8 +10,8 @@ from typing import Callable
 
 import numpy as np
 
-from vehicle.model.definition import Curve, VehicleDefinition
-from vsim_core.documents import Document, KeyPath
+from elastokin.vehicle.model.definition import Curve, VehicleDefinition
+from elastokin.core.documents import Document, KeyPath
 
 # Largest magnitudes accepted (SI but for the angles): far beyond a passenger car, below what only a
 # unit or typing error gives.

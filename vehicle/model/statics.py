@@ -1,7 +1,7 @@
 """Static spring preloads: the springs carry the vehicle at design ride height.
 
 ``preload: auto`` in the vehicle file is resolved here by virtual work on the rigid-bushing
-kinematics of :mod:`vehicle.model.kinematics`: with the wheel load W of the corner (from the total mass
+kinematics of :mod:`elastokin.vehicle.model.kinematics`: with the wheel load W of the corner (from the total mass
 and its CG), the preload P satisfies W = P·MR + g·Σ m_i·dz_i/dz_wheel, where MR = −dL/dz_wheel is
 the spring's motion ratio and the sum runs over the corner's moving parts.
 """
@@ -15,12 +15,12 @@ from typing import Callable
 import mujoco
 import numpy as np
 
-from vehicle.model.builder import build
-from vehicle.model.definition import VehicleDefinition
-from vehicle.model.elements import BuildOptions
-from vehicle.model.kinematics import CornerState, front_corner, rear_heave
-from vehicle.model.plausibility import MAX_PRELOAD_N
-from vsim_core.errors import InputError
+from elastokin.vehicle.model.builder import build
+from elastokin.vehicle.model.definition import VehicleDefinition
+from elastokin.vehicle.model.elements import BuildOptions
+from elastokin.vehicle.model.kinematics import CornerState, front_corner, rear_heave
+from elastokin.vehicle.model.plausibility import MAX_PRELOAD_N
+from elastokin.core.errors import InputError
 
 GRAVITY = 9.81
 _STEP = 5e-4  # finite-difference travel [m]

@@ -16,18 +16,18 @@ from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 
-from bushings.parameter_sets import ParameterSet, load_parameter_set
-from bushings.parameters import LENGTH_UNIT_SI, MODELS, UNIT_LABELS
-from vehicle.model.definition import (BUSHING_PARTS, DIRECTIONS, FRONT_MASSES, FRONT_POINTS, NO_FAMILIES, REAR_MASSES,
+from elastokin.bushings.parameter_sets import ParameterSet, load_parameter_set
+from elastokin.bushings.parameters import LENGTH_UNIT_SI, MODELS, UNIT_LABELS
+from elastokin.vehicle.model.definition import (BUSHING_PARTS, DIRECTIONS, FRONT_MASSES, FRONT_POINTS, NO_FAMILIES, REAR_MASSES,
                                       REAR_POINTS, Body, BushingDef, CrossStiffness, Curve, Damper, DirectionDef,
                                       Families, FrontAxle, RearAxle, Spring, Tyre, Vec3, VehicleDefinition)
-from vehicle.model.plausibility import (MAX_BODY_MASS_KG, MAX_CAMBER_DEG, MAX_COORDINATE_M, MAX_FRICTION_N,
+from elastokin.vehicle.model.plausibility import (MAX_BODY_MASS_KG, MAX_CAMBER_DEG, MAX_COORDINATE_M, MAX_FRICTION_N,
                                         MAX_INERTIA_KGM2, MAX_PART_MASS_KG, MAX_PRELOAD_N, MAX_RACK_TRAVEL_M,
                                         MAX_RADIUS_M, MAX_SCALE, MAX_STIFFNESS_N_PER_M, MAX_TOE_DEG,
                                         MAX_TORSION_NM_PER_RAD, check_geometry)
-from vsim_core.documents import Document, Fields, KeyPath, check_number, check_vector, dotted
-from vsim_core.errors import InputError
-from vsim_core.shipped import DEFAULT_VEHICLE, TYRE_DIR, VEHICLE_DIR, resolve
+from elastokin.core.documents import Document, Fields, KeyPath, check_number, check_vector, dotted
+from elastokin.core.errors import InputError
+from elastokin.core.shipped import DEFAULT_VEHICLE, TYRE_DIR, VEHICLE_DIR, resolve
 
 #: Source named in the errors of :func:`with_extensions`.
 EXTENSIONS_SOURCE = "with_extensions"
@@ -119,7 +119,7 @@ def with_extensions(v: VehicleDefinition, *, strut_friction: float | Mapping[str
     laid over the direction's own; ``coupling`` maps a bushing name to its new ``coupling`` list
     (``{"e1_rear": [{"directions": ["x", "z"], "stiffness": 50.0}]}``, N/mm or N·m/deg), which
     replaces the old one; ``laws`` maps ``"bushing.direction"`` to a
-    :class:`bushings.parameter_sets.ParameterSet` that replaces the direction's law, its effects
+    :class:`elastokin.bushings.parameter_sets.ParameterSet` that replaces the direction's law, its effects
     included (a catalogue cause applied to the direction's own set). Values are checked as in a
     vehicle file; errors name ``with_extensions``.
     """

@@ -3,10 +3,10 @@ their order, their units in scenario files, and the corner tags (fl, fr, rl, rr)
 
 from __future__ import annotations
 
-from vehicle.model.definition import CORNERS
-from vsim_core import units
+from elastokin.vehicle.model.definition import CORNERS
+from elastokin.core import units
 
-#: Corner names of the rig (order of ``vehicle.model.definition.CORNERS``) and their short tags (fl, fr, rl, rr).
+#: Corner names of the rig (order of ``elastokin.vehicle.model.definition.CORNERS``) and their short tags (fl, fr, rl, rr).
 CORNER_TAGS = {corner: "".join(word[0] for word in corner.split("_")) for corner in CORNERS}
 AXLES = ("front", "rear")
 

@@ -29,7 +29,7 @@ class Triangle:
     """One quasi-static triangle applied to all four wheels."""
 
     name: str
-    input: str               #: ``pads``, ``fx``, ``fy`` or ``mz`` (see :meth:`vehicle.simulation.rig.KCRig.ramp`)
+    input: str               #: ``pads``, ``fx``, ``fy`` or ``mz`` (see :meth:`elastokin.vehicle.simulation.rig.KCRig.ramp`)
     pattern: tuple[float, float, float, float]   #: per corner (order of CORNERS), times the amplitude
     amplitude: float         #: [m, N or N·m]
     rate: float              #: [m/s, N/s or N·m/s]

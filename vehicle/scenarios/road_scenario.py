@@ -26,11 +26,11 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from vehicle.model.definition import BUSHING_MODELS
-from vehicle.scenarios.scenario import MAX_INPUT_S, MAX_SETTLE_S, Limits, Waveform
-from vehicle.scenarios.scenario_fields import LIMIT_KEYS, case_fields, limit_values, output_rate, scenario_name, vehicle_file
-from vsim_core.documents import Fields
-from vsim_core.units import DEG, si
+from elastokin.vehicle.model.definition import BUSHING_MODELS
+from elastokin.vehicle.scenarios.scenario import MAX_INPUT_S, MAX_SETTLE_S, Limits, Waveform
+from elastokin.vehicle.scenarios.scenario_fields import LIMIT_KEYS, case_fields, limit_values, output_rate, scenario_name, vehicle_file
+from elastokin.core.documents import Fields
+from elastokin.core.units import DEG, si
 
 ROAD_TYPES = ("step_steer", "double_step_steer", "sine_steer", "steady_state_circular")
 #: Top-level keys of a road scenario file.

@@ -11,7 +11,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from vehicle.model.elements import BuildOptions
+from elastokin.vehicle.model.elements import BuildOptions
 
 #: Scenario types driving one input quantity with a triangle or a sine, and that quantity.
 SIGNAL_TYPES = {"pumping": "pad_z", "roll": "pad_z", "lateral_force": "pad_fy",
@@ -22,7 +22,7 @@ TYPES = (*SIGNAL_TYPES, "rack_step", "double_rack_step", "bisine", "csv")
 SHAPES = ("triangle", "sine")
 
 #: The longest time step [s] of a run; each run takes the longest at most this that divides its
-#: output interval and resolves its inputs (vehicle.scenarios.schedule.timestep).
+#: output interval and resolves its inputs (elastokin.vehicle.scenarios.schedule.timestep).
 MAX_TIMESTEP_S = BuildOptions().timestep
 #: The shortest time step [s] a run takes: an input faster than it asks for (a 1 µs ramp) is a
 #: step to the car, not hours of run.

@@ -7,11 +7,11 @@ import math
 from pathlib import Path
 from typing import Iterator
 
-from vehicle.scenarios.scenario import MAX_OUTPUT_RATE_HZ, NAME_PATTERN, Limits
-from vsim_core.documents import Fields
-from vsim_core.errors import InputError
-from vsim_core.shipped import DEFAULT_VEHICLE, VEHICLE_DIR, resolve
-from vsim_core.units import MM, MM_PER_M
+from elastokin.vehicle.scenarios.scenario import MAX_OUTPUT_RATE_HZ, NAME_PATTERN, Limits
+from elastokin.core.documents import Fields
+from elastokin.core.errors import InputError
+from elastokin.core.shipped import DEFAULT_VEHICLE, VEHICLE_DIR, resolve
+from elastokin.core.units import MM, MM_PER_M
 
 #: Keys of a ``limits`` mapping that every scenario accepts.
 LIMIT_KEYS = ("translation_mm", "rotation_deg", "closure_error_mm")

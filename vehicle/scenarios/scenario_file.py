@@ -13,20 +13,20 @@ from typing import Mapping
 
 import numpy as np
 
-from vehicle.model.definition import BUSHING_MODELS
-from vehicle.scenarios.channels import (AXLES, CORNER_TAGS, FILE_UNITS, INPUT_CHANNELS, csv_columns, file_si,
+from elastokin.vehicle.model.definition import BUSHING_MODELS
+from elastokin.vehicle.scenarios.channels import (AXLES, CORNER_TAGS, FILE_UNITS, INPUT_CHANNELS, csv_columns, file_si,
                                         input_quantity)
-from vehicle.scenarios.road_scenario import ROAD_TOP_KEYS, ROAD_TYPES, RoadScenario, parse_road_scenario
-from vehicle.scenarios.scenario import (BISINE_INPUTS, MAX_FREQUENCY_HZ, MAX_INPUT_S, MAX_SETTLE_S, SHAPES,
+from elastokin.vehicle.scenarios.road_scenario import ROAD_TOP_KEYS, ROAD_TYPES, RoadScenario, parse_road_scenario
+from elastokin.vehicle.scenarios.scenario import (BISINE_INPUTS, MAX_FREQUENCY_HZ, MAX_INPUT_S, MAX_SETTLE_S, SHAPES,
                                         SIGNAL_TYPES, TYPES, Case, InputTable, Limits, Scenario, Settle, Waveform)
-from vehicle.scenarios.scenario_fields import LIMIT_KEYS, case_fields, limit_values, output_rate, scenario_name, vehicle_file
-from vsim_core import units
-from vsim_core.documents import Document, Fields, dump_yaml
-from vsim_core.errors import InputError
-from vsim_core.files import is_file, read_text
-from vsim_core.shipped import SCENARIO_DIR, resolve
-from vsim_core.tables import read_csv_columns, read_csv_header
-from vsim_core.units import MM
+from elastokin.vehicle.scenarios.scenario_fields import LIMIT_KEYS, case_fields, limit_values, output_rate, scenario_name, vehicle_file
+from elastokin.core import units
+from elastokin.core.documents import Document, Fields, dump_yaml
+from elastokin.core.errors import InputError
+from elastokin.core.files import is_file, read_text
+from elastokin.core.shipped import SCENARIO_DIR, resolve
+from elastokin.core.tables import read_csv_columns, read_csv_header
+from elastokin.core.units import MM
 
 # -- cases ------------------------------------------------------------------------------------------
 #: Keys a case (merged over ``defaults``) may have, per type; ``label`` is always allowed.
@@ -164,7 +164,7 @@ def read_input_csv(path: Path) -> InputTable:
     """Read a scenario time series: a header ``t_s`` plus any of :func:`csv_columns` (absent
     channels stay at 0), then one line per time, from 0. Raises InputError naming the file, the
     line and the column for an unknown or missing column, a non-number, or a time that does not
-    start at 0 or does not increase (the numbers are read by :func:`vsim_core.tables.read_csv_columns`)."""
+    start at 0 or does not increase (the numbers are read by :func:`elastokin.core.tables.read_csv_columns`)."""
     columns = csv_columns()
     header = read_csv_header(path)
     unknown = [c for c in header if c != "t_s" and c not in columns]

@@ -7,9 +7,9 @@ from __future__ import annotations
 import math
 from dataclasses import astuple, dataclass
 
-from vehicle.scenarios.road_scenario import RoadScenario
-from vehicle.scenarios.scenario import MAX_TIMESTEP_S, MIN_TIMESTEP_S, Scenario
-from vsim_core.errors import InputError
+from elastokin.vehicle.scenarios.road_scenario import RoadScenario
+from elastokin.vehicle.scenarios.scenario import MAX_TIMESTEP_S, MIN_TIMESTEP_S, Scenario
+from elastokin.core.errors import InputError
 
 #: Largest factor on a scenario's durations (slower runs than that are typing errors).
 MAX_DURATION_SCALE = 100.0

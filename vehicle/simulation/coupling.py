@@ -6,7 +6,7 @@ joint stiffness and damping implicitly, forces written to ``qfrc_applied`` expli
 * a linear bushing direction lives entirely in its joint (stiffness K0, damping C);
 * any other direction keeps a reference stiffness K_ref = K0 + Kpa (its tangent at small
   amplitude, the largest tangent of the ladder family) and its damping C in the joint; before each
-  step ONE compiled call of the bushing bank (:func:`bushings.extended_bank.step_extended`: the law with
+  step ONE compiled call of the bushing bank (:func:`elastokin.bushings.extended_bank.step_extended`: the law with
   its state extensions, if any) gives F(e) at the current deflections and only F(e) − K_ref·e is
   applied explicitly. That remainder's stiffness lies in [−Kpa, 0] ⊂ (−K_ref, 0], so the explicit
   part can never destabilise the implicit one (laws that may stiffen beyond K_ref, the nonlinear
@@ -19,7 +19,7 @@ joint stiffness and damping implicitly, forces written to ``qfrc_applied`` expli
 * dampers: the slope of the active curve segment set as the joint/tendon damping each step
   (implicit), the segment's intercept applied explicitly.
 
-:meth:`ForceCoupling.apply` does all of it in one compiled call (:mod:`vehicle.simulation.stepping`, which
+:meth:`ForceCoupling.apply` does all of it in one compiled call (:mod:`elastokin.vehicle.simulation.stepping`, which
 also runs whole stretches of steps with ``mj_step`` inside the compiled loop).
 """
 
@@ -31,10 +31,10 @@ from typing import Sequence
 import mujoco
 import numpy as np
 
-from bushings.extended_bank import ExtendedBank
-from vehicle.model.builder import CarModel
-from vehicle.model.elements import CrossTerm
-from vehicle.simulation import probes, stepping
+from elastokin.bushings.extended_bank import ExtendedBank
+from elastokin.vehicle.model.builder import CarModel
+from elastokin.vehicle.model.elements import CrossTerm
+from elastokin.vehicle.simulation import probes, stepping
 
 
 def _pad_curves(curves) -> tuple[np.ndarray, np.ndarray]:
@@ -55,11 +55,11 @@ class BushingForces:
     """The bushing directions of a model: one bank call per step, remainder into ``qfrc_applied``.
 
     Each channel's joint must carry its reference stiffness (K0 for linear laws, K0 + Kpa
-    otherwise, see :func:`vehicle.model.elements.joint_stiffness`). The parallel damping C is taken where
+    otherwise, see :func:`elastokin.vehicle.model.elements.joint_stiffness`). The parallel damping C is taken where
     the model put it: in the joint if the joint has damping (implicit), else in the bank (explicit).
-    The bank is an :class:`bushings.extended_bank.ExtendedBank`: a channel with a preload is mounted at
+    The bank is an :class:`elastokin.bushings.extended_bank.ExtendedBank`: a channel with a preload is mounted at
     the design position (deflection 0) on every reset, with zero force there. ``cross`` are the
-    bushings' cross stiffnesses between channels (:class:`vehicle.model.elements.CrossTerm`).
+    bushings' cross stiffnesses between channels (:class:`elastokin.vehicle.model.elements.CrossTerm`).
     """
 
     def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, channels, cross: Sequence[CrossTerm] = ()):
@@ -106,7 +106,7 @@ class BushingForces:
             d.qfrc_applied[self.dof] -= self.cross_forces()
 
     def probe_args(self) -> tuple:
-        """Arguments of :func:`vehicle.simulation.probes.bushings` after (qpos, qvel)."""
+        """Arguments of :func:`elastokin.vehicle.simulation.probes.bushings` after (qpos, qvel)."""
         on = self.bank is not None
         return (self.qpos.astype(np.int64), self.dof.astype(np.int64), self.K, self.C, on,
                 self.bank_idx.astype(np.int64) if on else np.zeros(0, np.int64),
@@ -185,7 +185,7 @@ class ForceCoupling:
 
     # -- every step --------------------------------------------------------------------------
     def kernel_arrays(self) -> tuple:
-        """Arguments of :func:`vehicle.simulation.stepping.coupling_step` after ``h`` (views of the model and
+        """Arguments of :func:`elastokin.vehicle.simulation.stepping.coupling_step` after ``h`` (views of the model and
         data, and this coupling's tables), rebuilt when the bank is swapped (see BushingForces.bank)."""
         b = self.bushings
         if self._kernel_bank is not b.bank:
@@ -202,9 +202,9 @@ class ForceCoupling:
 
     # -- outputs -----------------------------------------------------------------------------
     def probe_args(self) -> tuple:
-        """(bushings, springs, dampers): the arguments of :func:`vehicle.simulation.probes.bushings`
-        after (qpos, qvel), of :func:`~vehicle.simulation.probes.springs` after (qpos, ten_length)
-        and of :func:`~vehicle.simulation.probes.dampers` after (qvel, ten_velocity)."""
+        """(bushings, springs, dampers): the arguments of :func:`elastokin.vehicle.simulation.probes.bushings`
+        after (qpos, qvel), of :func:`~elastokin.vehicle.simulation.probes.springs` after (qpos, ten_length)
+        and of :func:`~elastokin.vehicle.simulation.probes.dampers` after (qvel, ten_velocity)."""
         spring = (np.asarray(self.sp_joint, bool), self.sp_qadr.astype(np.int64), self.sp_index.astype(np.int64),
                   self.sp_design, self.sp_sign.astype(float), self.sp_xs, self.sp_ys, self.sp_preload, self.sp_y0)
         damp = (np.asarray(self.dp_joint, bool), self.dp_index.astype(np.int64), self.dp_sign.astype(float),

@@ -6,10 +6,10 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from vehicle.scenarios.channels import AXLES
-from vehicle.scenarios.kc_tests import SAMPLES_PER_LEG, SETTLE, Triangle
-from vehicle.simulation.outputs import RigOutputs
-from vehicle.simulation.rig import KCRig
+from elastokin.vehicle.scenarios.channels import AXLES
+from elastokin.vehicle.scenarios.kc_tests import SAMPLES_PER_LEG, SETTLE, Triangle
+from elastokin.vehicle.simulation.outputs import RigOutputs
+from elastokin.vehicle.simulation.rig import KCRig
 
 
 def run_triangle(rig: KCRig, test: Triangle) -> tuple[list[RigOutputs], list[RigOutputs]]:

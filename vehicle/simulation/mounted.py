@@ -1,5 +1,5 @@
-"""What every mounting of the car shares (the K&C rig, :mod:`vehicle.simulation.rig`; the road,
-:mod:`vehicle.simulation.road`): the vehicle built with its springs' preloads, its MuJoCo state,
+"""What every mounting of the car shares (the K&C rig, :mod:`elastokin.vehicle.simulation.rig`; the road,
+:mod:`elastokin.vehicle.simulation.road`): the vehicle built with its springs' preloads, its MuJoCo state,
 the bushing coupling, the wheels, the columns of its measured vector and the suspension's part of
 it, MuJoCo's resets, the body's ride height, switching the bushing laws off while the car
 settles, and the time spent in the compiled stepping loop."""
@@ -13,13 +13,13 @@ from typing import Any, Callable, Iterator
 import mujoco
 import numpy as np
 
-from vehicle.model.builder import CarModel, build
-from vehicle.model.definition import CORNERS, VehicleDefinition
-from vehicle.model.elements import BuildOptions
-from vehicle.model.statics import resolve_preloads
-from vehicle.simulation import probes
-from vehicle.simulation.coupling import ForceCoupling
-from vehicle.simulation.outputs import MeasuredColumns
+from elastokin.vehicle.model.builder import CarModel, build
+from elastokin.vehicle.model.definition import CORNERS, VehicleDefinition
+from elastokin.vehicle.model.elements import BuildOptions
+from elastokin.vehicle.model.statics import resolve_preloads
+from elastokin.vehicle.simulation import probes
+from elastokin.vehicle.simulation.coupling import ForceCoupling
+from elastokin.vehicle.simulation.outputs import MeasuredColumns
 
 # a plain int: comparing an array with the pybind enum goes element by element through Python (100 µs)
 _EQUALITY_ROW = int(mujoco.mjtConstraint.mjCNSTR_EQUALITY)
@@ -110,12 +110,12 @@ class MountedCar:
         return probes.first_rows(d.efc_type, d.efc_id, d.nefc, self.model.neq, _EQUALITY_ROW)
 
     def suspension_args(self, rows: np.ndarray) -> tuple:
-        """The arguments of :func:`vehicle.simulation.probes.suspension` after its data (bushings,
+        """The arguments of :func:`elastokin.vehicle.simulation.probes.suspension` after its data (bushings,
         springs, dampers, closures), ``rows`` from :meth:`equality_rows`."""
         closure = (rows[self.closure_eq].astype(np.int64), self.closure_rows.astype(np.int64))
         return (*self.coupling.probe_args(), closure)
 
     def suspension_data(self) -> tuple:
-        """The data arguments of :func:`vehicle.simulation.probes.suspension` (views of MuJoCo's memory)."""
+        """The data arguments of :func:`elastokin.vehicle.simulation.probes.suspension` (views of MuJoCo's memory)."""
         d = self.data
         return d.qpos, d.qvel, d.ten_length, d.ten_velocity, d.efc_pos

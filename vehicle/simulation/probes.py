@@ -1,9 +1,9 @@
 """Compiled measurement of the car at one instant, into one vector of SI values (the columns of
-:class:`vehicle.simulation.outputs.MeasuredColumns`): what the suspension's parts carry (springs,
+:class:`elastokin.vehicle.simulation.outputs.MeasuredColumns`): what the suspension's parts carry (springs,
 dampers, bushing directions, loop closures) and what the K&C rig reads at its wheels.
 
 The stepping loops call :func:`rig_sample` and :func:`road_sample` at every output sample without
-coming back to Python (:mod:`vehicle.simulation.stepping`); the coupling's readers
+coming back to Python (:mod:`elastokin.vehicle.simulation.stepping`); the coupling's readers
 (``BushingForces.forces``) call the same functions from Python, so that there is one formula for
 every measured quantity. All of them read MuJoCo's arrays after ``mj_forward``.
 """
@@ -15,10 +15,10 @@ import math
 import numba as nb
 import numpy as np
 
-from vehicle.model import kinematics
-from vehicle.model.kinematics import wheel_orientation
-from vehicle.simulation.outputs import RIG_WHEEL, ROAD_BODY, ROAD_WHEEL
-from vsim_core.compiled_cache import follow
+from elastokin.vehicle.model import kinematics
+from elastokin.vehicle.model.kinematics import wheel_orientation
+from elastokin.vehicle.simulation.outputs import RIG_WHEEL, ROAD_BODY, ROAD_WHEEL
+from elastokin.core.compiled_cache import follow
 
 #: Files the probes compile into themselves (the wheel angles): their cache follows them.
 FOLLOWED = (kinematics.__file__,)
@@ -127,10 +127,10 @@ def suspension(out, qpos, qvel, ten_length, ten_velocity, efc_pos, bush, spring,
 @nb.njit(cache=True)
 def rig_wheels(out, xmat, site_xpos, xfrc, qpos, pad_force, wheel, centre_site, carriage, pad_qpos, sign, design_z):
     """What the rig reads at its four wheels into ``out`` (the columns of
-    vehicle.simulation.outputs.RIG_WHEEL, in its order, for each wheel): wheel angles, half-track,
+    elastokin.vehicle.simulation.outputs.RIG_WHEEL, in its order, for each wheel): wheel angles, half-track,
     travel (centre height from ``design_z``) and centre from the wheel's pose; the pad's commanded
     Fx, Fy, its Fz (``pad_force``: the drive equality's force in the last step, see
-    vehicle.simulation.stepping._run), its height and aligning torque."""
+    elastokin.vehicle.simulation.stepping._run), its height and aligning torque."""
     for k in range(wheel.shape[0]):
         base = RIG_WHEEL_SIZE * k
         w, s, c = wheel[k], centre_site[k], carriage[k]
@@ -162,7 +162,7 @@ def rig_sample(out, wheels, data, suspension_args):
 @nb.njit(cache=True)
 def road_body(out, motion, acceleration, xmat, xipos, qpos, chassis, rack_qpos, driver_state, gravity, min_speed):
     """What the car on the road measures of its body and driver into ``out`` (the columns of
-    vehicle.simulation.outputs.ROAD_BODY): ``motion`` and ``acceleration`` are MuJoCo's
+    elastokin.vehicle.simulation.outputs.ROAD_BODY): ``motion`` and ``acceleration`` are MuJoCo's
     (rotational, linear) velocity and acceleration of the body at its centre of mass, world axes
     (``mj_objectVelocity``, ``mj_objectAcceleration``), the acceleration carrying −g."""
     r = xmat[chassis]
@@ -188,7 +188,7 @@ def road_body(out, motion, acceleration, xmat, xipos, qpos, chassis, rack_qpos, 
 @nb.njit(cache=True)
 def road_wheels(out, xmat, xipos, xpos, wheel, chassis, sign, design_z, tyre_signals):
     """What the car on the road measures at its four wheels into ``out`` (the columns of
-    vehicle.simulation.outputs.ROAD_WHEEL, then the tyre's ``tyre_signals``, for each wheel):
+    elastokin.vehicle.simulation.outputs.ROAD_WHEEL, then the tyre's ``tyre_signals``, for each wheel):
     angles relative to the body, travel (wheel-centre height in the body frame from ``design_z``)."""
     r = xmat[chassis]
     size = len(ROAD_WHEEL) + tyre_signals.shape[1]

@@ -13,12 +13,12 @@ import dataclasses
 import mujoco
 import numpy as np
 
-from vehicle.model.builder import CarModel
-from vehicle.model.definition import CORNERS, SIDE_SIGN, VehicleDefinition
-from vehicle.model.elements import BuildOptions
-from vehicle.simulation import stepping
-from vehicle.simulation.mounted import RESET_WARNINGS, MountedCar
-from vehicle.simulation.outputs import RIG_WHEEL, RigOutputs, WheelOutputs
+from elastokin.vehicle.model.builder import CarModel
+from elastokin.vehicle.model.definition import CORNERS, SIDE_SIGN, VehicleDefinition
+from elastokin.vehicle.model.elements import BuildOptions
+from elastokin.vehicle.simulation import stepping
+from elastokin.vehicle.simulation.mounted import RESET_WARNINGS, MountedCar
+from elastokin.vehicle.simulation.outputs import RIG_WHEEL, RigOutputs, WheelOutputs
 
 _NO_INPUTS = np.zeros((0, 17))
 _INACTIVE = np.zeros(5, dtype=bool)
@@ -30,7 +30,7 @@ class KCRig(MountedCar):
 
     def __init__(self, vehicle: VehicleDefinition, options: BuildOptions = BuildOptions(),
                  built: CarModel | None = None):
-        """``built``: see :class:`~vehicle.simulation.mounted.MountedCar`."""
+        """``built``: see :class:`~elastokin.vehicle.simulation.mounted.MountedCar`."""
         super().__init__(vehicle, dataclasses.replace(options, rig=True), built)
         m = self.model
         eq = lambda n: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_EQUALITY, n)
@@ -79,7 +79,7 @@ class KCRig(MountedCar):
         d.xfrc_applied[self.wheel_body, 5] = mz
 
     def set_inputs(self, u: np.ndarray) -> None:
-        """Set every rig input at once from ``u`` (SI, in the order of ``vehicle.scenarios.channels.INPUT_CHANNELS``,
+        """Set every rig input at once from ``u`` (SI, in the order of ``elastokin.vehicle.scenarios.channels.INPUT_CHANNELS``,
         as :meth:`play` reads its rows)."""
         self.set_pads(u[0:4])
         self.set_pad_loads(fx=u[4:8], fy=u[8:12], mz=u[12:16])
@@ -101,14 +101,14 @@ class KCRig(MountedCar):
 
     def play(self, inputs: np.ndarray) -> None:
         """Advance one time step per row of ``inputs`` (rig inputs in the order of
-        ``vehicle.scenarios.channels.INPUT_CHANNELS``, SI), each row set before its step."""
+        ``elastokin.vehicle.scenarios.channels.INPUT_CHANNELS``, SI), each row set before its step."""
         inputs = np.ascontiguousarray(inputs, dtype=float)
         if inputs.ndim != 2 or inputs.shape[1] != _NO_INPUTS.shape[1]:  # the compiled loop does not check
             raise ValueError(f"expected rig inputs of shape (steps, {_NO_INPUTS.shape[1]}), got {inputs.shape}")
         self._run(len(inputs), inputs, _ALL_ACTIVE)
 
     def _run(self, n: int, inputs: np.ndarray, active: np.ndarray) -> None:
-        """``n`` compiled steps (vehicle.simulation.stepping.run) with ``inputs`` and ``active`` as it documents."""
+        """``n`` compiled steps (elastokin.vehicle.simulation.stepping.run) with ``inputs`` and ``active`` as it documents."""
         m, d = self.model, self.data
         self._timed(stepping.run, n, inputs, active, m.eq_data, self.pad_eq, self.rack_eq, d.xfrc_applied,
                     self.carriage_body, self.wheel_body, self._efc_force, self._pad_row, self.pad_force, m._address,
@@ -190,7 +190,7 @@ class KCRig(MountedCar):
                           closure_error=float(v[cols.closure_error]), wheels=wheels)
 
     def _probe_args(self) -> tuple:
-        """The arguments of :func:`vehicle.simulation.probes.rig_sample` after ``out`` (rebuilt when
+        """The arguments of :func:`elastokin.vehicle.simulation.probes.rig_sample` after ``out`` (rebuilt when
         the bushing laws are switched, see MountedCar.bushing_laws_off)."""
         bank = self.coupling.bushings.bank
         if self._probe_bank is not bank:

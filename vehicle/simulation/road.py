@@ -1,16 +1,16 @@
 """The car on a flat road: the same vehicle as on the K&C rig, mounted free, on Magic Formula tyres.
 
 The body is free; the wheels spin on their hinges and stand on the road through their tyres
-(:mod:`vsim_tyres.road_contact`, computed every step in the compiled loop with the bushings, see
-:func:`vehicle.simulation.stepping.run_road`); the steering wheel drives the rack through the car's
+(:mod:`elastokin.tyres.road_contact`, computed every step in the compiled loop with the bushings, see
+:func:`elastokin.vehicle.simulation.stepping.run_road`); the steering wheel drives the rack through the car's
 ``front.steering.rack_travel_per_rev``; a driver holds the speed with a PI controller of the front
 wheels' drive torque (front-wheel drive), or holds its last torque (a fixed throttle); each wheel
 also takes an extra drive torque and a brake (the spin joint's dry friction). Inputs per step
 (:data:`N_INPUTS` columns): rack [m], target speed [m/s] (NaN: the throttle held), four drive
 torques [N·m] (order of ``CORNERS``, positive driving), four brake torques [N·m].
 
-Outputs (:meth:`RoadCar.sampled`, measured in the compiled loop by vehicle.simulation.probes; the
-columns of vehicle.simulation.outputs.ROAD_BODY and ROAD_WHEEL) follow ISO 8855: the body's motion
+Outputs (:meth:`RoadCar.sampled`, measured in the compiled loop by elastokin.vehicle.simulation.probes; the
+columns of elastokin.vehicle.simulation.outputs.ROAD_BODY and ROAD_WHEEL) follow ISO 8855: the body's motion
 in the intermediate axis system (x forward and y left in the road's plane, turned by the yaw
 angle), at the body's centre of mass; wheel angles relative to the body as on the rig (toe-in,
 camber top-out, steer to the left positive).
@@ -25,17 +25,17 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from vehicle.model.builder import CarModel
-from vehicle.model.definition import CORNERS, SIDE_SIGN, VehicleDefinition
-from vehicle.model.elements import BuildOptions
-from vehicle.model.kinematics import steering_ratio
-from vehicle.simulation import stepping
-from vehicle.simulation.mounted import RESET_WARNINGS, MountedCar
-from vehicle.simulation.outputs import ROAD_BODY, ROAD_WHEEL
-from vsim_core.errors import InputError
-from vsim_tyres import magic_formula
-from vsim_tyres.road_contact import N_SIGNALS, N_STATE, SIGNALS, effective_rolling_radius, mirrored_wheels
-from vsim_tyres.tir_file import read_tir
+from elastokin.vehicle.model.builder import CarModel
+from elastokin.vehicle.model.definition import CORNERS, SIDE_SIGN, VehicleDefinition
+from elastokin.vehicle.model.elements import BuildOptions
+from elastokin.vehicle.model.kinematics import steering_ratio
+from elastokin.vehicle.simulation import stepping
+from elastokin.vehicle.simulation.mounted import RESET_WARNINGS, MountedCar
+from elastokin.vehicle.simulation.outputs import ROAD_BODY, ROAD_WHEEL
+from elastokin.core.errors import InputError
+from elastokin.tyres import magic_formula
+from elastokin.tyres.road_contact import N_SIGNALS, N_STATE, SIGNALS, effective_rolling_radius, mirrored_wheels
+from elastokin.tyres.tir_file import read_tir
 
 #: Columns of a row of road inputs: the rack, the target speed, four drive torques, four brake torques.
 N_INPUTS = 10
@@ -55,7 +55,7 @@ class RoadCar(MountedCar):
                  options: BuildOptions = BuildOptions(), built: CarModel | None = None):
         """``tyre_file``: the .tir of all four tyres (default: the vehicle file's ``tyre.property_file``).
         InputError naming the vehicle file when neither names one. ``built``: see
-        :class:`~vehicle.simulation.mounted.MountedCar`."""
+        :class:`~elastokin.vehicle.simulation.mounted.MountedCar`."""
         tyre_file = tyre_file or vehicle.tyre.property_file
         if tyre_file is None:
             raise InputError("the car on the road needs a tyre: give tyre.property_file (a .tir file)",
@@ -73,7 +73,7 @@ class RoadCar(MountedCar):
         self.chassis = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "chassis")
         self.rack_qpos = int(m.jnt_qposadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, "rack")])
         self.chassis_dof = int(m.jnt_dofadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, "chassis_free")])
-        #: Lagged slips (κ', tan α') of each wheel and its signals (vsim_tyres.road_contact.SIGNALS).
+        #: Lagged slips (κ', tan α') of each wheel and its signals (elastokin.tyres.road_contact.SIGNALS).
         self.tyre_state = np.zeros((len(CORNERS), N_STATE))
         self.tyre_signals = np.zeros((len(CORNERS), N_SIGNALS))
         # the steering wheel turned left steers left: the rack moves towards the steering arms' side

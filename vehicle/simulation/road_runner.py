@@ -1,13 +1,13 @@
 """Playing a road scenario: the cases one after the other on one time axis, each on a freshly built
-car, yielding the samples that a recording keeps in blocks (:mod:`vsim_recordings.recorder`).
+car, yielding the samples that a recording keeps in blocks (:mod:`elastokin.recordings.recorder`).
 
-Each case goes through :data:`vehicle.scenarios.schedule.ROAD_PHASES`: 0, at rest and braked with
+Each case goes through :data:`elastokin.vehicle.scenarios.schedule.ROAD_PHASES`: 0, at rest and braked with
 every bushing direction linear (the car settles on its tyres); 1, at rest with the bushing laws on
 from their virgin state; 2, launched at the case's speed (wheels rolling without slip) and run
 straight with the speed held; 3, the input: the steering wheel and the driver's speed as the
 scenario says. The car runs in the world's x direction at the start of phase 2.
 
-A run stops with :class:`~vehicle.simulation.runner.DivergenceError` when the suspension leaves
+A run stops with :class:`~elastokin.vehicle.simulation.runner.DivergenceError` when the suspension leaves
 its valid range (as on the rig) or, once at speed, when the body's sideslip exceeds the
 scenario's limit (the car spun) or a wheel stays off the ground longer than allowed; the samples
 up to the one that shows it are yielded first.
@@ -20,13 +20,13 @@ from typing import Callable, Iterator
 
 import numpy as np
 
-from vehicle.model.definition import CORNERS, VehicleDefinition
-from vehicle.scenarios.road_scenario import RoadCase, RoadScenario, steering_and_speed
-from vehicle.scenarios.schedule import ROAD_PHASES, CaseSchedule, Progress, output_interval
-from vehicle.simulation.outputs import MeasuredColumns, SampleBlock
-from vehicle.simulation.road import N_INPUTS, RoadCar
-from vehicle.simulation.runner import CaseSamples, PlayedScenario, blocks_of
-from vsim_core.units import DEG_PER_RAD
+from elastokin.vehicle.model.definition import CORNERS, VehicleDefinition
+from elastokin.vehicle.scenarios.road_scenario import RoadCase, RoadScenario, steering_and_speed
+from elastokin.vehicle.scenarios.schedule import ROAD_PHASES, CaseSchedule, Progress, output_interval
+from elastokin.vehicle.simulation.outputs import MeasuredColumns, SampleBlock
+from elastokin.vehicle.simulation.road import N_INPUTS, RoadCar
+from elastokin.vehicle.simulation.runner import CaseSamples, PlayedScenario, blocks_of
+from elastokin.core.units import DEG_PER_RAD
 
 #: The brake that holds the car while it settles [N·m per wheel] (far above what the slope of the
 #: settling car asks).
@@ -66,7 +66,7 @@ class RoadRun(PlayedScenario):
 
     def _case(self, car: RoadCar, case: RoadCase, number: int, when: CaseSchedule) -> Iterator[SampleBlock]:
         """The samples of one case from a fresh car, one every output interval, in blocks of at most
-        :data:`~vehicle.simulation.runner.BLOCK_SAMPLES`."""
+        :data:`~elastokin.vehicle.simulation.runner.BLOCK_SAMPLES`."""
         dt, scenario = self.dt, self.scenario
         every = output_interval(scenario, dt)
         blocks = CaseSamples(self, car, number, case.label, when, sum(when.steps[:3]))

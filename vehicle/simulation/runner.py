@@ -1,10 +1,10 @@
 """Playing a scenario on the K&C rig: the cases one after the other on one time axis, each from a
 freshly built rig, yielding the samples that a recording keeps in blocks
-(:class:`vehicle.simulation.outputs.SampleBlock`; :mod:`vsim_recordings.recorder` records them in a
+(:class:`elastokin.vehicle.simulation.outputs.SampleBlock`; :mod:`elastokin.recordings.recorder` records them in a
 file or in memory). A block's samples are stepped and measured in one compiled call
-(:meth:`vehicle.simulation.rig.KCRig.sampled`): no Python runs between them.
+(:meth:`elastokin.vehicle.simulation.rig.KCRig.sampled`): no Python runs between them.
 
-Each case goes through the three phases of :data:`vehicle.scenarios.schedule.PHASES`: 0, rest with
+Each case goes through the three phases of :data:`elastokin.vehicle.scenarios.schedule.PHASES`: 0, rest with
 every bushing direction linear at its reference stiffness (the car settles under gravity); 1, rest
 with the bushing laws switched on from their virgin state; 2, the input. Case k+1's first sample
 follows case k's last one by one output interval.
@@ -24,19 +24,19 @@ from typing import Any, Callable, Iterator
 import mujoco
 import numpy as np
 
-from vehicle.model.builder import CarModel
-from vehicle.model.definition import VehicleDefinition, is_rotation
-from vehicle.model.elements import BuildOptions
-from vehicle.model.statics import resolve_preloads
-from vehicle.scenarios.channels import INPUT_CHANNELS
-from vehicle.scenarios.road_scenario import RoadScenario
-from vehicle.scenarios.scenario import Case, Scenario
-from vehicle.scenarios.schedule import (PHASES, CaseSchedule, Progress, check_timestep, output_interval, schedule,
+from elastokin.vehicle.model.builder import CarModel
+from elastokin.vehicle.model.definition import VehicleDefinition, is_rotation
+from elastokin.vehicle.model.elements import BuildOptions
+from elastokin.vehicle.model.statics import resolve_preloads
+from elastokin.vehicle.scenarios.channels import INPUT_CHANNELS
+from elastokin.vehicle.scenarios.road_scenario import RoadScenario
+from elastokin.vehicle.scenarios.scenario import Case, Scenario
+from elastokin.vehicle.scenarios.schedule import (PHASES, CaseSchedule, Progress, check_timestep, output_interval, schedule,
                                         timestep)
-from vehicle.simulation.mounted import MountedCar
-from vehicle.simulation.outputs import MeasuredColumns, SampleBlock
-from vehicle.simulation.rig import KCRig
-from vsim_core.units import DEG_PER_RAD, MM_PER_M
+from elastokin.vehicle.simulation.mounted import MountedCar
+from elastokin.vehicle.simulation.outputs import MeasuredColumns, SampleBlock
+from elastokin.vehicle.simulation.rig import KCRig
+from elastokin.core.units import DEG_PER_RAD, MM_PER_M
 
 
 class DivergenceError(RuntimeError):
@@ -113,7 +113,7 @@ class PlayedScenario:
     for the first case), the simulated time and the time spent in
     the compiled stepping loop. ``duration_scale`` multiplies every duration (settle phases,
     periods, holds) for quick runs; ``progress`` is called after every block with a :class:`Progress`;
-    ``timestep_s`` is the car's time step (default the scenario's: :func:`~vehicle.scenarios.schedule.timestep`);
+    ``timestep_s`` is the car's time step (default the scenario's: :func:`~elastokin.vehicle.scenarios.schedule.timestep`);
     ``poses`` whether the blocks carry the bodies' poses (a recording's replay needs them)."""
 
     #: Names of a case's phases (the ``phase`` signal is the index).

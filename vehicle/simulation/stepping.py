@@ -1,12 +1,12 @@
-"""Compiled stepping: the coupling of :mod:`vehicle.simulation.coupling` and ``mj_step`` in one numba loop.
+"""Compiled stepping: the coupling of :mod:`elastokin.vehicle.simulation.coupling` and ``mj_step`` in one numba loop.
 
 A numpy coupling called from a Python loop cost ~150–250 µs per step on the rig, more than
 ``mj_step``; here the rig inputs, the bushing bank step (the laws with their state extensions,
-:func:`bushings.extended_bank.step_extended`), the bushings' cross stiffnesses, the damper and spring
+:func:`elastokin.bushings.extended_bank.step_extended`), the bushings' cross stiffnesses, the damper and spring
 laws and ``mj_step`` (called through ctypes on the model's and data's addresses) all run in
 compiled code, so a step costs ``mj_step`` plus the bank kernel. :func:`run` gives bit-identical
 results to calling ``ForceCoupling.apply`` and ``mujoco.mj_step`` from Python (tests/test_vehicle_rig.py);
-:func:`run_sampled` also measures the rig's outputs every so many steps (vehicle.simulation.probes)
+:func:`run_sampled` also measures the rig's outputs every so many steps (elastokin.vehicle.simulation.probes)
 without coming back to Python.
 
 Arrays of ``MjModel``/``MjData`` are numpy views of MuJoCo's memory, so the loop reads and writes
@@ -23,12 +23,12 @@ import mujoco
 import numba as nb
 import numpy as np
 
-from bushings import extended_bank as _xb
-from vehicle.simulation import probes
-from vehicle.simulation.probes import rig_sample, road_sample, segment
-from vsim_core.compiled_cache import follow
-from vsim_tyres import road_contact
-from vsim_tyres.road_contact import tyre_wrenches
+from elastokin.bushings import extended_bank as _xb
+from elastokin.vehicle.simulation import probes
+from elastokin.vehicle.simulation.probes import rig_sample, road_sample, segment
+from elastokin.core.compiled_cache import follow
+from elastokin.tyres import road_contact
+from elastokin.tyres.road_contact import tyre_wrenches
 
 # the loops compile the bushing kernels and the tyres into themselves: their cache follows those files
 follow(__file__, *_xb.KERNEL_FILES, *road_contact.TYRE_FILES, probes.__file__, *probes.FOLLOWED)
@@ -64,10 +64,10 @@ def _push(qfrc, ten_J, ten_J_rowadr, ten_J_rownnz, ten_J_colind, joint, index, g
 @nb.njit(cache=True)
 def coupling_step(h, qpos, qvel, qfrc, ten_length, ten_velocity, ten_J, ten_J_rowadr, ten_J_rownnz, ten_J_colind,
                   jnt_stiffness, dof_damping, tendon_damping, bush, bank, cross, damp, spring):
-    """Write the non-implicit forces for the next step of ``h`` [s] (see vehicle.simulation.coupling).
+    """Write the non-implicit forces for the next step of ``h`` [s] (see elastokin.vehicle.simulation.coupling).
 
     ``bush`` = (qpos adr, dof adr, joint ids, least K_ref, K_ref, saturating, e work) of the
-    bank channels, ``bank`` = :meth:`bushings.extended_bank.ExtendedBank.kernel_args`, ``cross`` = (qpos adr
+    bank channels, ``bank`` = :meth:`elastokin.bushings.extended_bank.ExtendedBank.kernel_args`, ``cross`` = (qpos adr
     (P, 2), dof adr (P, 2), stiffness (P,)) of the cross stiffnesses, ``damp`` = (is joint, dof or
     tendon index, sign, xs, ys, intercept out [N], work), ``spring`` = (is joint, index, qpos adr,
     design, sign, xs, ys, rate, y0, nonlinear?, remainder work).
@@ -114,7 +114,7 @@ def _run(mj_step, n, inputs, active, eq_data, pad_eq, rack_eq, xfrc, carriage, w
          jnt_stiffness, dof_damping, tendon_damping, bush, bank, cross, damp, spring):
     """Advance ``n`` steps, row i of ``inputs`` set before step i (none if ``inputs`` has no rows).
 
-    A row holds the rig inputs in the order of ``vehicle.scenarios.channels.INPUT_CHANNELS`` (17 values):
+    A row holds the rig inputs in the order of ``elastokin.vehicle.scenarios.channels.INPUT_CHANNELS`` (17 values):
     pad heights [m], Fx, Fy [N] at the carriages, Mz [N·m] at the wheels, four corners each, then
     the rack [m]; ``active[g]`` says whether group g (pads, Fx, Fy, Mz, rack) is driven (else left
     as is). After each step ``pad_force`` holds the force of each pad's drive row (``pad_row``) in
@@ -163,13 +163,13 @@ def _kept(s, bodies, xpos, xquat, body_pos, body_quat, warnings, resets, counts)
     return False
 
 
-@nb.njit(cache=True, nogil=True)   # a recording's writer thread runs meanwhile (vsim_recordings.background)
+@nb.njit(cache=True, nogil=True)   # a recording's writer thread runs meanwhile (elastokin.recordings.background)
 def _run_sampled(mj_step, mj_forward, every, inputs, active, rig, m_addr, d_addr, h, coupling, probe, bodies, xpos,
                  xquat, measured, body_pos, body_quat, warnings, resets):
     """One sample every ``every`` steps for each row of ``measured``: :func:`_run` of ``every`` steps
     (their rows of ``inputs``, none if it has no rows; ``rig`` = its arguments from ``eq_data`` to
     ``pad_force``), ``mj_forward``, the rig's measured vector into the row
-    (:func:`vehicle.simulation.probes.rig_sample`, ``probe`` its arguments after ``out``) and the
+    (:func:`elastokin.vehicle.simulation.probes.rig_sample`, ``probe`` its arguments after ``out``) and the
     poses of ``bodies`` into ``body_pos``, ``body_quat``. Stops after the first sample at which one
     of MuJoCo's warning counters ``warnings[resets]`` rose (MuJoCo reset the state); returns the
     number of samples taken."""
@@ -197,7 +197,7 @@ def _run_road(mj_step1, mj_step2, n, inputs, eq_data, rack_eq, spin_dof, frictio
     positive driving, reacting on the knuckle) and four brake torques [N·m] (the spin joints' dry
     friction: it holds a wheel still up to that torque). Each step: the coupling's forces, the
     driver, ``mj_step1`` (positions and velocities), the tyres' wrenches from them (``tyres`` = the
-    arguments of :func:`vsim_tyres.road_contact.tyre_wrenches` after ``h``), ``mj_step2``: MuJoCo's
+    arguments of :func:`elastokin.tyres.road_contact.tyre_wrenches` after ``h``), ``mj_step2``: MuJoCo's
     split step, bit-identical to ``mj_step``, so that the tyres see this step's state and not the
     last one's.
 
@@ -236,7 +236,7 @@ def _run_road_sampled(mj_step1, mj_step2, mj_forward, mj_rne_post_constraint, mj
     """:func:`_run_sampled` on the road: :func:`_run_road` of ``every`` steps (``road`` = its
     arguments from ``eq_data`` to ``frictionloss``), ``mj_forward``, the bodies' accelerations
     (``mj_rnePostConstraint``) and the velocity and acceleration of the body ``chassis``, then
-    :func:`vehicle.simulation.probes.road_sample` (``probe`` its arguments after ``acceleration``)."""
+    :func:`elastokin.vehicle.simulation.probes.road_sample` (``probe`` its arguments after ``acceleration``)."""
     counts = warnings[resets].copy()
     motion, acceleration = np.zeros(6), np.zeros(6)
     for s in range(measured.shape[0]):

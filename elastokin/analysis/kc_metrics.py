@@ -1,0 +1,124 @@
+"""The standard K&C metrics (spec vehicle.md §4) from the down and up legs of a triangle: the centre
+line is the mean of the two branches; a compliance or gradient is its least-squares slope over ±80 %
+of the amplitude around design (±20 mm in bump); a loop width is the difference between the
+branches at design (and its maximum over that range). Rig samples and recorded runs both provide
+the legs (:data:`Leg`), so that `vsim kc`, the run summary and the comparison share one definition.
+
+Sign conventions (ISO 8855; see :data:`METRICS` for each metric): toe-in positive, camber
+positive with the wheel top leaning outward, steer angle positive to the left (axle steer = mean
+of the two wheels), bump positive, roll positive with the left side of the body up (right wheels
+in bump, as in a left turn); roll camber is the outer (right) wheel's camber relative to the
+ground (pad plane) per degree of body roll; lateral compliance camber is the camber of a wheel
+whose contact-point force points inboard (an outer wheel in cornering).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Callable
+
+import numpy as np
+
+from elastokin.vehicle.scenarios.kc_tests import TEST, TESTS
+from elastokin.analysis.loops import Branches, centre_slope, loop_width
+
+FIT_FRACTION = 0.8       #: slopes and loop widths over ±80 % of the amplitude
+
+#: JSON key, unit, and sign convention of each metric.
+METRICS = (
+    ("bump_steer_deg_per_m", "deg/m", "toe-in per metre of bump (mean of left and right)"),
+    ("bump_camber_deg_per_m", "deg/m", "camber (top out +) per metre of bump"),
+    ("roll_steer_deg_per_deg", "deg/deg", "axle steer (left +) per degree of roll (left side up +)"),
+    ("roll_camber_deg_per_deg", "deg/deg", "outer-wheel camber to ground per degree of roll"),
+    ("lateral_force_compliance_steer_deg_per_kn", "deg/kN", "axle steer (left +) per kN of Fy (left +) per wheel"),
+    ("lateral_force_compliance_camber_deg_per_kn", "deg/kN", "camber (top out +) per kN of inboard Fy"),
+    ("lateral_compliance_mm_per_kn", "mm/kN", "wheel-centre lateral displacement per kN of Fy, along it"),
+    ("longitudinal_compliance_steer_deg_per_kn", "deg/kN", "toe-in per kN of braking force (−x) at the contact point"),
+    ("aligning_torque_compliance_steer_deg_per_knm", "deg/kN·m", "axle steer (left +) per kN·m of Mz (left +) per wheel"),
+    ("toe_loop_width_deg", "deg", "toe loop width at design height in the bump test"),
+    ("camber_loop_width_deg", "deg", "camber loop width at design height in the bump test"),
+    ("toe_loop_width_max_deg", "deg", "largest toe loop width over ±20 mm of bump"),
+    ("camber_loop_width_max_deg", "deg", "largest camber loop width over ±20 mm of bump"),
+)
+
+#: The metrics (keys of :data:`METRICS`) each test gives for an axle, the bump test's loop widths included.
+TEST_METRICS = {
+    "bump": ("bump_steer_deg_per_m", "bump_camber_deg_per_m", "toe_loop_width_deg", "toe_loop_width_max_deg",
+             "camber_loop_width_deg", "camber_loop_width_max_deg"),
+    "roll": ("roll_steer_deg_per_deg", "roll_camber_deg_per_deg"),
+    "lateral": ("lateral_force_compliance_steer_deg_per_kn", "lateral_force_compliance_camber_deg_per_kn",
+                "lateral_compliance_mm_per_kn"),
+    "longitudinal": ("longitudinal_compliance_steer_deg_per_kn",),
+    "aligning": ("aligning_torque_compliance_steer_deg_per_knm",),
+}
+
+
+#: One leg of a triangle: ``leg(quantity, corner)`` is that quantity's samples on the leg (SI;
+#: quantities of :data:`elastokin.analysis.kc_test.WHEEL_QUANTITIES`, corners of
+#: ``elastokin.vehicle.model.definition.CORNERS``). Rig samples and recorded runs both provide legs, so that
+#: both use the definitions below.
+Leg = Callable[[str, str], np.ndarray]
+
+
+def fit_window(test: str, amplitude: float, base: float) -> float:
+    """Half-width of the fits of ``test`` [its fitted input's unit: m, N, N·m; roll: deg of roll]
+    for an input of ``amplitude`` [m, N or N·m] and an axle's contact-point base ``base`` [m]."""
+    return FIT_FRACTION * amplitude * _input_scale(test, base)
+
+
+def triangle_metrics(test: str, axle: str, down: Leg, up: Leg, window: float, base: float) -> dict[str, float]:
+    """The gradients and compliances of :data:`METRICS` that ``test`` (a :data:`TESTS` name) gives
+    for ``axle``, fitted over ±``window`` (:func:`fit_window`); ``base`` [m] is the axle's
+    contact-point base at design (used by roll only)."""
+    L, R = f"{axle}_left", f"{axle}_right"
+    deg = np.degrees
+
+    def slope(x: Callable[[Leg], np.ndarray], y: Callable[[Leg], np.ndarray]) -> float:
+        return centre_slope(Branches(x(down), y(down), x(up), y(up)), window)
+
+    def each(x: str, y: str, scale: Callable[[np.ndarray], np.ndarray] = deg) -> float:
+        """Mean over the axle's two wheels of the slope of scale(quantity y) against quantity x."""
+        return 0.5 * sum(slope(lambda g, c=c: g(x, c), lambda g, c=c: scale(g(y, c))) for c in (L, R))
+
+    steer = lambda g: deg(0.5 * (g("steer", L) + g("steer", R)))
+    # right minus left: the right wheel is the outer one in roll, and +Fy points inboard on it
+    camber = lambda g: deg(g("camber", R) - g("camber", L)) / 2
+    if test == "bump":
+        return {"bump_steer_deg_per_m": each("pad_height", "toe"), "bump_camber_deg_per_m": each("pad_height", "camber")}
+    if test == "roll":
+        roll = lambda g: deg((g("pad_height", R) - g("pad_height", L)) / base)
+        # the outer wheel's camber to the ground gains the roll angle itself
+        return {"roll_steer_deg_per_deg": slope(roll, steer), "roll_camber_deg_per_deg": 1.0 + slope(roll, camber)}
+    if test == "lateral":
+        fy = lambda g: g("pad_fy", L)
+        return {"lateral_force_compliance_steer_deg_per_kn": 1e3 * slope(fy, steer),
+                "lateral_force_compliance_camber_deg_per_kn": 1e3 * slope(fy, camber),
+                "lateral_compliance_mm_per_kn": 1e6 * each("pad_fy", "wheel_centre_y", lambda v: v)}
+    if test == "longitudinal":
+        return {"longitudinal_compliance_steer_deg_per_kn": -1e3 * each("pad_fx", "toe")}
+    if test == "aligning":
+        return {"aligning_torque_compliance_steer_deg_per_knm": 1e3 * slope(lambda g: g("pad_mz", L), steer)}
+    raise ValueError(f"unknown K&C test {test!r}; expected one of {', '.join(t.name for t in TESTS)}")
+
+
+def bump_loop_widths(axle: str, down: Leg, up: Leg, window: float) -> dict[str, float]:
+    """Toe and camber loop widths [deg] of the bump test (keys of :data:`METRICS`), mean of the
+    axle's two wheels, against the pad height over ±``window`` [m]."""
+    m = {}
+    for angle in ("toe", "camber"):
+        widths = [loop_width(Branches(down("pad_height", c), np.degrees(down(angle, c)),
+                                      up("pad_height", c), np.degrees(up(angle, c))), window)
+                  for c in (f"{axle}_left", f"{axle}_right")]
+        m[f"{angle}_loop_width_deg"] = float(np.mean([w[0] for w in widths]))
+        m[f"{angle}_loop_width_max_deg"] = float(np.mean([w[1] for w in widths]))
+    return m
+
+
+def _input_scale(test: str, base: float) -> float:
+    """Factor from a test's amplitude to the unit of its fitted input (roll: pad m → body deg)."""
+    return math.degrees(2.0 / base) if test == "roll" else 1.0
+
+
+#: Gradients against wheel travel or pad height over at most ±20 mm around design (spec §4), the
+#: window of `vsim kc`'s bump test [m].
+BUMP_WINDOW_M = fit_window("bump", TEST["bump"].amplitude, math.nan)

@@ -1,0 +1,54 @@
+"""The K&C test of a vehicle (`vsim kc`): the standard triangles played on a fresh rig, their samples
+turned into the legs the metric definitions read."""
+
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+
+from elastokin.vehicle.model.definition import VehicleDefinition
+from elastokin.vehicle.model.elements import BuildOptions
+from elastokin.vehicle.scenarios.channels import AXLES
+from elastokin.vehicle.scenarios.kc_tests import TEST, TESTS
+from elastokin.vehicle.simulation.kc_triangles import design_contact_base, run_triangle
+from elastokin.vehicle.simulation.outputs import RigOutputs, WheelOutputs
+from elastokin.vehicle.simulation.rig import KCRig
+from elastokin.analysis.kc_metrics import Leg, bump_loop_widths, fit_window, triangle_metrics
+from elastokin.analysis.loops import Branches
+
+#: Per-wheel quantities the metric definitions read, from one rig sample's wheel (SI).
+WHEEL_QUANTITIES: dict[str, Callable[[WheelOutputs], float]] = {
+    "pad_height": lambda w: w.pad_height, "toe": lambda w: w.toe, "camber": lambda w: w.camber,
+    "steer": lambda w: w.steer, "wheel_centre_y": lambda w: w.wheel_centre[1],
+    "pad_fx": lambda w: w.pad_force[0], "pad_fy": lambda w: w.pad_force[1], "pad_mz": lambda w: w.pad_torque,
+}
+
+def rig_leg(samples: list[RigOutputs]) -> Leg:
+    """The :data:`Leg` of samples measured on the rig."""
+    return lambda quantity, corner: np.array([WHEEL_QUANTITIES[quantity](o.wheels[corner]) for o in samples])
+
+
+def branches(down: list[RigOutputs], up: list[RigOutputs], x, y) -> Branches:
+    """Branches of ``y(sample)`` against ``x(sample)`` from the samples of :func:`run_triangle`."""
+    return Branches(np.array([x(o) for o in down]), np.array([y(o) for o in down]),
+                    np.array([x(o) for o in up]), np.array([y(o) for o in up]))
+
+
+def kc_metrics(rig: KCRig) -> dict[str, dict[str, float]]:
+    """Run the K&C sequence (:data:`TESTS`) on ``rig``; metrics per axle (keys of :data:`elastokin.analysis.kc_metrics.METRICS`)."""
+    base = design_contact_base(rig)
+    legs = {t.name: [rig_leg(samples) for samples in run_triangle(rig, t)] for t in TESTS}
+    out: dict[str, dict[str, float]] = {}
+    for axle in AXLES:
+        m = {}
+        for t in TESTS:
+            m |= triangle_metrics(t.name, axle, *legs[t.name], fit_window(t.name, t.amplitude, base[axle]), base[axle])
+        out[axle] = m | bump_loop_widths(axle, *legs["bump"], fit_window("bump", TEST["bump"].amplitude, base[axle]))
+    rig.reset()
+    return out
+
+
+def vehicle_kc(vehicle: VehicleDefinition, options: BuildOptions = BuildOptions()) -> dict[str, dict[str, float]]:
+    """K&C metrics of ``vehicle`` built with ``options`` (on a fresh rig)."""
+    return kc_metrics(KCRig(vehicle, options))

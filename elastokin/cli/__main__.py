@@ -1,0 +1,7 @@
+"""``python -m elastokin.cli``: the ``vsim`` command."""
+
+import sys
+
+from elastokin.cli.executable import main
+
+sys.exit(main())

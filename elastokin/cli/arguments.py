@@ -1,0 +1,56 @@
+"""Argument types the commands share: output paths, checked as soon as the command line is read
+(before any work), and durations scales that are finite and positive."""
+
+from __future__ import annotations
+
+import argparse
+import math
+from pathlib import Path
+
+from elastokin.core.errors import InputError
+from elastokin.core.files import check_output
+
+
+def output_file(text: str) -> Path:
+    """A file path an output can be written to (:func:`elastokin.core.files.check_output`)."""
+    return _output(text, folder=False)
+
+
+def output_folder(text: str) -> Path:
+    """A folder path outputs can be written into."""
+    return _output(text, folder=True)
+
+
+def _output(text: str, folder: bool) -> Path:
+    try:
+        return check_output(text, folder=folder)
+    except InputError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def positive_scale(text: str) -> float:
+    """A finite factor > 0 (``--duration-scale``)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not (math.isfinite(value) and value > 0.0):
+        raise argparse.ArgumentTypeError(f"expected a finite number > 0, got {text!r}")
+    return value
+
+
+def add_scheduler_options(parser: argparse.ArgumentParser, scope: str = "") -> None:
+    """``--scheduler`` and ``--workers``: where a command's runs execute (:mod:`elastokin.cluster.executor`)."""
+    parser.add_argument("--scheduler", metavar="ADDRESS",
+                        help=f"{scope}the runs on a running Dask scheduler (tcp://HOST:8786), 'local' (a cluster on "
+                             f"this machine for the command) or 'serial' (this process); default: $VSIM_SCHEDULER, "
+                             f"else local")
+    parser.add_argument("--workers", type=positive_count, metavar="N",
+                        help="worker processes of a local cluster (default: one per core)")
+
+
+def positive_count(text: str) -> int:
+    """A whole number >= 1 (``--workers``)."""
+    if not text.strip().isdigit() or int(text) < 1:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}")
+    return int(text)

@@ -1,0 +1,37 @@
+"""`vsim compare SIM.mcap RIG.mcap [-o DIR]`: a simulated run against a measured rig recording."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from elastokin.cli.arguments import output_folder
+
+
+def _compare(args: argparse.Namespace) -> int:
+    from elastokin.analysis.compare import compare_runs
+    from elastokin.presentation.comparison_report import format_table, write_outputs
+    from elastokin.recordings.run_reader import load_run
+
+    sim, rig = load_run(args.sim), load_run(args.rig)
+    comparison = compare_runs(sim, rig)
+    print(format_table(comparison))
+    if args.output is not None:
+        written = write_outputs(comparison, sim, rig, args.output)
+        print(f"wrote {written[0]} and {len(written) - 1} PNG(s) in {args.output}")
+    return 0
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add the ``compare`` sub-command."""
+    compare = subparsers.add_parser(
+        "compare", help="compare a simulated run with a measured rig recording of the same scenario",
+        description="Per test (case) and channel (camber, toe, steer, half-track, wheel centre, pad vertical "
+                    "force of each wheel in both files): gradient, loop width at design, loop area, RMS error, "
+                    "relaxation over a final hold and first-harmonic dynamic stiffness for sine inputs; "
+                    "simulation, rig and their difference (elastokin/analysis/compare.py).")
+    compare.add_argument("sim", type=Path, metavar="SIM.mcap", help="simulated run (vsim run)")
+    compare.add_argument("rig", type=Path, metavar="RIG.mcap", help="measured rig recording of the same scenario")
+    compare.add_argument("-o", "--output", type=output_folder, metavar="DIR",
+                         help="also write DIR/comparison.json and loop and time-history overlays (PNG)")
+    compare.set_defaults(func=_compare)

@@ -1,0 +1,70 @@
+"""`vsim`: the command-line entry point: the parser of every command, and input errors as one line.
+
+Each command lives in its own module exposing ``register(subparsers)``, which adds the command with
+``set_defaults(func=...)`` where ``func(args) -> int`` is the exit code. Commands import what they
+run when they run, so that ``vsim --help`` loads neither MuJoCo nor matplotlib.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from types import ModuleType
+
+from elastokin.cli import (built_ins, bushing_fit, bushing_run, bushings_on_road, compare, diagnose, kc, model_export, plot,
+                           rig_import, rig_measure, run, sweep, view)
+from elastokin.core.provenance import software_version
+from elastokin.cli.interrupts import handle_sigterm, status
+from elastokin.core.errors import InputError
+
+#: Command groups: name -> (help, description, their commands' modules).
+GROUPS: dict[str, tuple[str, str, tuple[ModuleType, ...]]] = {
+    "bushing": ("virtual bushing bench and identification",
+                "Rubber-bushing models (STS, RT, STVS, ...) on a virtual bench.", (bushing_run, bushing_fit)),
+    "model": ("vehicle models", "Vehicle models.", (model_export,)),
+    "rig": ("measured data: import a K&C rig's CSV export, or measure on the virtual rig",
+            "Measured K&C rig data (data/README.md).", (rig_import, rig_measure)),
+}
+#: Commands and groups in the order of ``vsim --help``.
+ORDER: tuple[ModuleType | str, ...] = (built_ins, "bushing", view, plot, "model", kc, run, bushings_on_road, sweep,
+                                        diagnose, "rig", compare)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The full ``vsim`` argument parser with every command."""
+    parser = argparse.ArgumentParser(prog="vsim", description="Full-vehicle transient simulation with hysteretic, "
+                                                              "viscoelastic rubber bushings.",
+                                     epilog="Built-in vehicles, scenarios and data: `vsim list`. From Python: "
+                                            "`import elastokin` (README: the Python API).")
+    parser.add_argument("--version", action="version", version=f"vsim (elastokin) {software_version()}")
+    sub = parser.add_subparsers(dest="command", required=True)
+    for entry in ORDER:
+        if isinstance(entry, str):
+            help_, description, modules = GROUPS[entry]
+            group = sub.add_parser(entry, help=help_, description=description)
+            commands = group.add_subparsers(dest=f"{entry}_command", required=True)
+            for module in modules:
+                module.register(commands)
+        else:
+            entry.register(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run ``vsim`` with ``argv``; input errors print one clear line and exit with status 2, Ctrl-C
+    and SIGTERM one line and 128 + the signal's number."""
+    args = build_parser().parse_args(argv)
+    handle_sigterm()
+    try:
+        return int(args.func(args) or 0)
+    except InputError as exc:
+        print(f"vsim: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt as exc:
+        print(f"vsim: interrupted ({exc or 'SIGINT'}); outputs are as they were, a run's recording is kept incomplete",
+              file=sys.stderr)
+        return status(exc)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,355 @@
+"""Diagnosis of a K&C dataset: what the baseline vehicle gets wrong, the cause, where it sits, the gain.
+
+1. The baseline vehicle plays exactly the recorded tests, case by case (the recordings carry their
+   scenarios; a scenario's ``bushings:`` choice is a simulation option and is ignored: the
+   vehicle's own laws are the model under test). Every measured channel but the rig inputs is
+   compared in units of its measurement noise, estimated from the data (sample-to-sample
+   differences of the residual, which a smooth model error hardly affects); each channel's zero
+   error in each recording is a nuisance, removed.
+2. Screening: every catalogue cause at every place it can sit (:mod:`elastokin.diagnosis.kc_catalogue`)
+   is run once on the training tests (every other one) at mid-range magnitude (a sided cause, whose
+   sign picks another effect, or one whose effect is not odd in its magnitude, such as a cross
+   stiffness, once per sign); its magnitude is fitted by taking the effect
+   proportional to it (to its logarithm for a factor on a design value).
+3. The best few are run on every test with their fitted magnitudes, refitted once along the effect
+   that run gave (a cause with a second parameter, such as a damper's exponent, also along the
+   effect of one more run with that parameter moved: both are fitted), run again, and scored on the
+   held-out tests: the verdict rests on full vehicle simulations, never on the screening's
+   linearisation.
+4. A rival that the campaign cannot tell from the best (:mod:`elastokin.diagnosis.kc_alike`) is reported
+   with the shipped test that would separate them.
+5. When the best leaves a mismatch beyond the noise, or a test it does not fit: every other
+   hypothesis beside it, its magnitude fitted on what the best's run leaves from its own screening
+   run; the best few run beside it on every test (a second cause with a shape parameter once more,
+   with it moved), both magnitudes and that shape refitted together, run again and scored (a refit
+   worse than where it started once more at half its step: the linearised step can overshoot); the best
+   pair whose second magnitude stands off no effect (:func:`elastokin.diagnosis.kc_fits.significant`) is
+   named when :func:`elastokin.diagnosis.verdict.pair_named` says so.
+
+Why not the cheaper screen of replaying each bushing's recorded deflections through the extended
+law and mapping the force change through the response to a probe force: in a hysteretic direction
+a constant probe force is absorbed by the stick phase, and the mapped prediction of a coupling in
+the rear pivot bushing came out up to 18 times too small, with the wrong sign in half of the
+channels. Full runs cost more and are right.
+
+The verdict follows :func:`elastokin.diagnosis.verdict.single_verdict` with the noise as the floor. Every test
+the baseline does not fit is found (the baseline fitted nothing: training tests count), with where
+in it the misfit sits; a misfit the held-out tests taken together do not show (confined to a
+training test, or to a stretch) makes the verdict "unexplained", not "none".
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from contextlib import closing, nullcontext
+from dataclasses import dataclass, field, replace
+from typing import Callable, Iterable, Sequence
+
+import numpy as np
+
+from elastokin.vehicle.model.definition import VehicleDefinition
+from elastokin.cluster.executor import Executor, TaskFailed, executor as open_executor
+from elastokin.diagnosis.catalogue import PAIR_SEPARATOR
+from elastokin.diagnosis.kc_alike import alike, extra_scenarios, run_unless_diverged, separations
+from elastokin.diagnosis.kc_catalogue import (BUSHING_CAUSES, VEHICLE_CAUSES, Hypothesis, extended_vehicle, locations,
+                                         parameters)
+from elastokin.diagnosis.kc_fits import (Candidate, Scorer, fit, fit_pair, halfway, kept, nominal, nudged, significant,
+                                    verify)
+from elastokin.diagnosis.kc_layout import Layout, run_job
+from elastokin.diagnosis.verdict import (Outcome, Separation, decide, explained, misfit, misfit_stretch, pair_named,
+                                    pair_shares, second_cause_wanted, single_verdict, split)
+from elastokin.recordings.kc_dataset import KCDataset
+
+#: Hypotheses re-run on the full vehicle after the screening.
+VERIFIED = 3
+
+
+@dataclass(frozen=True)
+class Misfit:
+    """A test a model does not fit, and where in it (:func:`elastokin.diagnosis.verdict.misfit_stretch`)."""
+
+    test: str
+    heldout: bool
+    error: float          #: the model's RMS error on it (1 = the noise), each recording's zeros its medians
+    chance: float         #: the chance that the noise alone shows a stretch as unlikely in the test
+    start_s: float        #: the stretch of the test holding the excess: from, to [s of its input]
+    end_s: float
+    channel: str          #: the channel with the most excess there
+
+
+@dataclass
+class KCDiagnosis(Outcome):
+    """The outcome of :func:`diagnose_kc`."""
+
+    verdict: str                     #: a cause id, two joined by "+", "none" or "unexplained"
+    best: Candidate | None
+    ranking: list[Candidate]
+    heldout: np.ndarray              #: per test, held out from the fits
+    test_names: list[str]
+    baseline_errors: np.ndarray      #: per test, noise-normalised RMS of the baseline
+    heldout_error_before: float
+    layout: Layout
+    noise: np.ndarray                #: per channel, estimated noise standard deviation (channel units)
+    baseline: np.ndarray             #: the baseline's rows
+    extended: VehicleDefinition | None   #: the baseline with the named cause
+    misfits: list[Misfit] = field(default_factory=list)   #: the tests the baseline does not fit
+    misfits_after: list[Misfit] = field(default_factory=list)   #: those the named cause does not fit
+    wall_s: float = 0.0
+    #: the second stage (:func:`elastokin.diagnosis.verdict.second_cause_wanted`): other hypotheses run
+    #: beside ``best``, best first (their errors and rows are the pair's); empty when not needed
+    pairs: list[Candidate] = field(default_factory=list)
+    second: Candidate | None = None       #: the second cause named (one of ``pairs``), if any
+    #: held-out error of the second cause alone, at its own single fit as ``best`` is (for its share)
+    second_alone_error: float = math.nan
+    #: verified rivals of a single named cause that the campaign cannot tell from it (kc_alike), best first
+    alike: list[Candidate] = field(default_factory=list)
+    #: per rival, the shipped test the dataset lacks that separates it from the named cause best
+    #: (None: none ran for both)
+    separations: list[Separation | None] = field(default_factory=list)
+    extra_tests: int = 0                  #: shipped rig tests the dataset lacks (read when there are rivals)
+
+    @property
+    def final(self) -> Candidate:
+        """The candidate whose run is the extended model's: the pair's when two causes are named."""
+        return self.second if self.second is not None else self.best
+
+    @property
+    def causes(self) -> list[Candidate]:
+        """The named causes, the first found first (each candidate's hypothesis is its cause, with the
+        values fitted together when there are two)."""
+        if self.second is None:
+            return [self.best] if self.named else []
+        return [self.second.beside or self.best, self.second]
+
+    @property
+    def explained(self) -> tuple[str, float]:
+        """``full``, ``partial`` or ``none``, and the share of the excess over the noise explained
+        (:func:`elastokin.diagnosis.verdict.explained`)."""
+        return explained(self.verdict, self.heldout_error_before, self.heldout_error_after, 1.0,
+                         bool(self.misfits_after))
+
+    @property
+    def shares(self) -> list[float]:
+        """Per named cause, the share of the mismatch it explains; of two, each one's gain averaged over
+        the two orders of adding them (:func:`elastokin.diagnosis.verdict.pair_shares`)."""
+        if self.second is None:
+            return [self.explained[1]] if self.named else []
+        return list(pair_shares(self.heldout_error_before, [self.best.heldout_error, self.second_alone_error],
+                                self.second.heldout_error, 1.0))
+
+    @property
+    def heldout_error_after(self) -> float:
+        """The held-out error with the named cause(s) (the baseline's when none is named)."""
+        return self.final.heldout_error if self.named else self.heldout_error_before
+
+
+def hypotheses(vehicle: VehicleDefinition) -> list[Hypothesis]:
+    """Every catalogue cause at every place it can sit in ``vehicle``, at mid-range values; a sided
+    cause once per side (all its sided parameters on it), a cause whose effect has an even part
+    once per sign of its magnitude (:attr:`elastokin.diagnosis.catalogue.Parameter.signs`)."""
+    out = []
+    for c in (*BUSHING_CAUSES, *VEHICLE_CAUSES):
+        params, values = parameters(c), nominal(c)
+        signed = [p.name for p in params if p.sided or p.even_part]
+        out += [Hypothesis(c, loc, {**values, **{k: sign * values[k] for k in signed}})
+                for loc in locations(vehicle, c) for sign in params[0].signs]
+    return out
+
+
+def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, executor: Executor | None = None,
+                progress: Callable[[str], None] | None = None) -> KCDiagnosis:
+    """Diagnose a K&C dataset against a baseline vehicle (see the module docstring); the vehicle runs
+    go to ``executor`` (default: :func:`elastokin.cluster.executor.executor`'s, a local Dask cluster
+    unless ``VSIM_SCHEDULER`` names another). Every run is a pure function of its job: the verdict
+    is the same bits on any executor."""
+    started = time.perf_counter()
+    say = progress or (lambda _: None)
+    layout = Layout.of(data, vehicle)
+    every = range(len(layout.tests))
+    heldout = split(len(layout.tests))
+    training = [i for i in every if not heldout[i]]
+    candidates = hypotheses(vehicle)
+    with nullcontext(executor) if executor is not None else open_executor() as pool:
+        def rows(vehicles: list[VehicleDefinition], tests: Sequence[int]) -> list[np.ndarray]:
+            """The compared rows of each vehicle on ``tests`` (NaN elsewhere), the runs in parallel."""
+            n = len(tests)
+            flat: list[dict[str, np.ndarray]] = [{}] * (n * len(vehicles))
+            jobs = [j for v in vehicles for j in layout.jobs(v, tests)]
+            with closing(pool.each(run_job, jobs)) as outcomes:   # a failure cancels the others at once
+                for done, o in enumerate(outcomes, 1):
+                    if o.error:
+                        raise TaskFailed(f"vehicle {o.index // n + 1} of {len(vehicles)} on "
+                                         f"{layout.tests[tests[o.index % n]].name}: {o.error}")
+                    flat[o.index] = o.result
+                    if len(vehicles) > 1 and done % n == 0:
+                        say(f"  {done}/{len(flat)} runs done on {pool.description}")
+            return [layout.stack(flat[i * n:(i + 1) * n], tests) for i in range(len(vehicles))]
+
+        say(f"baseline {vehicle.name} on {len(data.tests)} recordings, {len(layout.tests)} tests "
+            f"({int(heldout.sum())} held out)")
+        (base,) = rows([vehicle], every)
+        scorer = Scorer(layout, base, heldout)
+        before = scorer.heldout_error(base)
+        say(f"held-out error of the baseline: {before:.3f} (1 = the measurement noise); one run of each of "
+            f"{len(candidates)} hypotheses at mid-range magnitude on the {len(training)} training tests")
+        signatures = rows([extended_vehicle(vehicle, [h]) for h in candidates], training)
+        screened = _best_per_place(fit(h, sig - base, base, scorer) for h, sig in zip(candidates, signatures))
+        for c in screened[:VERIFIED]:
+            say(f"  {c.hypothesis.label}: training error {c.screened_error:.3f} with {_fmt(c.hypothesis.values)}")
+        top = screened[:VERIFIED]
+        say(f"the best {len(top)} on every test with their fitted magnitudes, then refitted along the effect they gave")
+        verify(top, rows([extended_vehicle(vehicle, [c.hypothesis]) for c in top], every), scorer)
+        shaped = sum(len(parameters(c.hypothesis.cause)) > 1 for c in top)
+        if shaped:
+            say(f"  {shaped} with a second parameter: run with it moved, to fit it too")
+        slopes = _slopes(top, lambda hs: rows([extended_vehicle(vehicle, [h]) for h in hs], training))
+        refit = [fit(c.hypothesis, c.simulated - base, base, scorer, s) for c, s in zip(top, slopes)]
+        top = kept(top, refit, rows([extended_vehicle(vehicle, [c.hypothesis]) for c in refit], every), scorer)
+        best = top[0]
+        found = located_misfits(layout, scorer, base)
+        left = located_misfits(layout, scorer, best.simulated)
+        pairs: list[Candidate] = []
+        second, alone = None, math.nan
+        # the tests not fitted by the best single cause, or by the baseline if that cause makes things worse
+        unfitted = left if best.heldout_error < before else found
+        if second_cause_wanted(before, best.heldout_error, 1.0, bool(unfitted)):
+            say(f"{best.hypothesis.label} leaves {best.heldout_error:.3f} × the noise"
+                f"{' and tests it does not fit' if left else ''}: every other hypothesis beside it")
+            others = [(h, sig) for h, sig in zip(candidates, signatures)
+                      if (h.cause, h.location) != (best.hypothesis.cause, best.hypothesis.location)]
+            pairs = _second_stage(best, others, base, scorer,
+                                  lambda hs, tests: rows([extended_vehicle(vehicle, h) for h in hs], tests), every,
+                                  training)
+            # a second cause whose magnitude is not told from none is the first's joint refit, not a cause
+            k = next((i for i, c in enumerate(pairs) if significant(c)), len(pairs))
+            for c in pairs[:k]:
+                say(f"  beside it, {c.hypothesis.label} is not told from no effect: {_fmt(c.hypothesis.values)}")
+            if k < len(pairs) and pair_named(before, best.heldout_error, pairs[k].heldout_error, 1.0):
+                second = pairs[k]
+                single = _alone(second.hypothesis, top + screened[VERIFIED:])
+                if not single.verified:   # its single fit, run on every test as the first cause's was
+                    single = replace(single)
+                    verify([single], rows([extended_vehicle(vehicle, [single.hypothesis])], every), scorer)
+                alone = single.heldout_error
+        rivals: list[Candidate] = []
+        apart: list[Separation | None] = []
+        extra: list = []
+        if second is None and decide(before, best.heldout_error, 1.0) == "named":
+            rivals = alike(best, top, before)
+        if rivals:   # the shipped scenarios read only then
+            extra = extra_scenarios({t.job.scenario.name for t in layout.tests})
+            say(f"{best.hypothesis.label} cannot be told apart on these tests from "
+                f"{', '.join(c.hypothesis.label for c in rivals)}: both run on the {len(extra)} shipped tests the "
+                f"dataset lacks")
+            apart = separations([extended_vehicle(vehicle, [c.hypothesis]) for c in (best, *rivals)], extra,
+                                layout.channels, scorer.noise,
+                                float(np.median([t.job.duration_scale for t in layout.tests])),
+                                lambda jobs: pool.map(run_unless_diverged, jobs))
+    errors = scorer.test_errors(base)
+    for m in found:
+        say(f"the baseline does not fit {m.test}{' (held out)' if m.heldout else ''}: {m.error:.2f} × the noise, "
+            f"most between {m.start_s:.2f} and {m.end_s:.2f} s of its input, in {m.channel}")
+    if second is not None:
+        verdict = "named"
+        say(f"{best.hypothesis.label} + {second.hypothesis.label}: held-out error {before:.3f} -> "
+            f"{best.heldout_error:.3f} -> {second.heldout_error:.3f}: both named")
+        left = located_misfits(layout, scorer, second.simulated)
+    else:
+        verdict = single_verdict(before, best.heldout_error, 1.0, bool(found))
+        say(f"{best.hypothesis.label}: held-out error {before:.3f} -> {best.heldout_error:.3f}: {verdict}")
+    left = left if verdict == "named" else []
+    for m in left:
+        say(f"  with it, {m.test} is still not fitted: {m.error:.2f} × the noise")
+    out = KCDiagnosis(verdict, best, top + screened[VERIFIED:], heldout, [t.name for t in layout.tests], errors,
+                      before, layout, scorer.noise, base, None, found, left, time.perf_counter() - started, pairs,
+                      second, alone, rivals, apart, len(extra))
+    if verdict == "named":
+        named = [c.hypothesis for c in out.causes]
+        out.verdict = PAIR_SEPARATOR.join(h.cause for h in named)
+        out.extended = extended_vehicle(vehicle, named)
+    return out
+
+
+def _second_stage(best: Candidate, others: list[tuple[Hypothesis, np.ndarray]], base: np.ndarray, scorer: Scorer,
+                  rows: Callable[[list[list[Hypothesis]], Sequence[int]], list[np.ndarray]],
+                  every: Sequence[int], training: Sequence[int]) -> list[Candidate]:
+    """Every other hypothesis beside ``best``: its magnitude fitted on what ``best``'s run leaves, its
+    effect taken from its own screening run (``others``: hypothesis, rows); the best VERIFIED run
+    beside ``best`` on every test (``rows`` of the vehicles with the hypotheses listed), both
+    magnitudes refitted together along the effects those runs gave (:func:`fit_pair`), run again and
+    scored on the held-out tests (a refit worse than its start once more at half its step,
+    :func:`halfway`); the candidates carry the pair's errors and rows, best first."""
+    screened = _best_per_place(fit(h, sig - base, best.simulated, scorer) for h, sig in others)
+    top = screened[:VERIFIED]
+    verify(top, rows([[best.hypothesis, c.hypothesis] for c in top], every), scorer)
+    slopes = _slopes(top, lambda hs: rows([[best.hypothesis, h] for h in hs], training))   # beside the first
+    refits = [(c, fit_pair(best, c, base, scorer, s)) for c, s in zip(top, slopes)]
+    moved = [(c, r) for c, r in refits if r is not None]
+
+    def run(pairs: list[Candidate]) -> list[np.ndarray]:
+        return rows([[r.beside.hypothesis, r.hypothesis] for r in pairs], every)
+
+    # two magnitudes and a shape moved at once along their linearised effects can overshoot (a Mullins
+    # softening's magnitude and shape trade): a refit worse than its start is tried at half its step
+    halves = [halfway(best, c, r) for c, r in moved]   # with the fit's own uncertainties, before kept widens them
+    better = kept([c for c, _ in moved], [r for _, r in moved], run([r for _, r in moved]), scorer) if moved else []
+    over = [(c, half) for (c, _), half in zip(moved, halves) if any(b is c for b in better)]   # its start kept
+    if over:
+        tried = kept([c for c, _ in over], [h for _, h in over], run([h for _, h in over]), scorer)
+        better = [b for b in better if all(b is not c for c, _ in over)] + tried
+    return sorted(better + [c for c, r in refits if r is None], key=lambda c: c.score)
+
+
+def _slopes(top: list[Candidate], run_moved: Callable[[list[Hypothesis]], list[np.ndarray]]
+            ) -> list[np.ndarray | None]:
+    """Per candidate, its rows' slope along its cause's second parameter, from one more run on the
+    training tests with that parameter moved (:func:`elastokin.diagnosis.kc_fits.nudged`; ``run_moved``
+    gives the rows of those hypotheses' runs); None for a cause with one parameter."""
+    moves = [nudged(c.hypothesis) if len(parameters(c.hypothesis.cause)) > 1 else None for c in top]
+    moved = iter(run_moved([m[0] for m in moves if m]) if any(moves) else [])
+    return [None if m is None else (next(moved) - c.simulated) / m[1] for c, m in zip(top, moves)]
+
+
+def _alone(h: Hypothesis, ranking: list[Candidate]) -> Candidate:
+    """The single stage's candidate of ``h``'s cause at its place (:func:`_place`), fitted alone."""
+    return next(c for c in ranking if _place(c.hypothesis) == _place(h))
+
+
+def _place(h: Hypothesis) -> tuple:
+    """What a hypothesis names: its cause, its place and, for a sided cause, its side (the sign of its
+    first parameter); not the screening sign of a cause whose effect is not odd, fitted either way."""
+    first = parameters(h.cause)[0]
+    return h.cause, h.location, math.copysign(1.0, h.values[first.name]) if first.sided else 1.0
+
+
+def _best_per_place(candidates: Iterable[Candidate]) -> list[Candidate]:
+    """The candidates best first, only the best of those naming one thing (:func:`_place`: a cause
+    screened on both signs is fitted from each)."""
+    out, seen = [], set()
+    for c in sorted(candidates, key=lambda c: c.score):
+        if _place(c.hypothesis) not in seen:
+            seen.add(_place(c.hypothesis))
+            out.append(c)
+    return out
+
+
+def located_misfits(layout: Layout, scorer: Scorer, predicted: np.ndarray) -> list[Misfit]:
+    """The tests ``predicted`` does not fit (:func:`elastokin.diagnosis.verdict.misfit`: the RMS error
+    over a test or a stretch of it beyond the noise; every test, training or held out), each with
+    where; each recording's zeros taken as its medians, so that one misfit does not shift the tests
+    beside it."""
+    residual = scorer.residual(predicted, np.ones(len(predicted), dtype=bool), np.median)
+    out = []
+    for i, t in enumerate(layout.tests):
+        error = float(np.sqrt(np.mean(residual[t.rows] ** 2)))
+        chance, first, last, channel = misfit_stretch(residual[t.rows])
+        if misfit(error, chance):
+            out.append(Misfit(t.name, bool(scorer.heldout[i]), error, chance, float(layout.input_time[t.rows[first]]),
+                              float(layout.input_time[t.rows[last]]), layout.channels[channel]))
+    return out
+
+
+def _fmt(values: dict[str, float]) -> str:
+    return ", ".join(f"{k} = {v:.4g}" for k, v in values.items())
+

@@ -1,0 +1,296 @@
+"""Scoring and fitting hypotheses on a K&C campaign's compared rows (:mod:`elastokin.diagnosis.kc_diagnosis`):
+residuals in units of the measured noise, each recording's zero errors removed; a hypothesis's
+magnitude fitted with its effect taken proportional to it from a vehicle run (one cause, a second
+parameter along one more run, or two causes together); candidates verified by full runs."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+from typing import Callable
+
+import numpy as np
+
+from elastokin.diagnosis.catalogue import Parameter
+from elastokin.diagnosis.kc_catalogue import Hypothesis, parameters
+from elastokin.diagnosis.kc_layout import Layout
+
+#: Relative increase of the held-out score per fitted parameter.
+PARAMETER_PENALTY = 0.02
+#: Standard uncertainties by which a fitted magnitude must stand off no effect to be a cause found.
+SIGNIFICANT = 2.0
+
+
+@dataclass
+class Candidate:
+    """A hypothesis fitted on the training tests and scored on the held-out ones."""
+
+    hypothesis: Hypothesis
+    heldout_error: float                      #: noise-normalised RMS on held-out tests (1 = the noise)
+    std: dict[str, float] = field(default_factory=dict)
+    screened_error: float = math.nan          #: RMS on the training tests after the screening's fit (NaN
+    #: for a candidate no linearised fit gave: :func:`halfway`)
+    test_errors: np.ndarray | None = None     #: per test, from the full vehicle run
+    simulated: np.ndarray | None = None       #: the full vehicle run's rows (verified candidates)
+    #: a second cause's: the first cause as refitted together with it (:func:`fit_pair`, or halfway
+    #: there: :func:`halfway`); the run and errors above are then the pair's
+    beside: "Candidate | None" = None
+    #: its magnitude's distance from no effect in the fit's own standard uncertainty (:func:`separation`),
+    #: before :func:`kept` widens the uncertainty to the refit's shift
+    z: float = math.nan
+
+    @property
+    def verified(self) -> bool:
+        """Scored on the held-out tests by a full vehicle run."""
+        return self.simulated is not None
+
+    def penalised(self, error: float) -> float:
+        """``error`` raised by the parameter penalty of this hypothesis's cause."""
+        return error * (1.0 + PARAMETER_PENALTY * len(parameters(self.hypothesis.cause)))
+
+    @property
+    def score(self) -> float:
+        """Penalised held-out error (verified) or training error (screened only); lower is better."""
+        return self.penalised(self.heldout_error if self.verified else self.screened_error)
+
+
+class Scorer:
+    """Residuals in noise units, each channel's zero error in each recording removed; errors per test."""
+
+    def __init__(self, layout: Layout, baseline: np.ndarray, heldout: np.ndarray):
+        self.layout, self.heldout = layout, heldout
+        self.held_rows = heldout[layout.test]
+        self.noise = self._noise(layout.measured - baseline)
+
+    def _noise(self, residual: np.ndarray) -> np.ndarray:
+        """Per channel: the white noise of the residual from its sample-to-sample differences within
+        each test (robust: median absolute deviation), which a smooth model error hardly affects;
+        channels of one quantity share their median."""
+        d = np.vstack([np.diff(residual[t.rows], axis=0) for t in self.layout.tests])
+        per = 1.4826 * np.median(np.abs(d - np.median(d, axis=0)), axis=0) / math.sqrt(2.0)
+        family = [c.rsplit("_", 1)[0] for c in self.layout.channels]
+        out = np.array([np.median([p for p, g in zip(per, family) if g == f]) for f in family])
+        return np.maximum(out, 1e-9)
+
+    def residual(self, predicted: np.ndarray, rows: np.ndarray, zero: Callable[..., np.ndarray] = np.mean
+                 ) -> np.ndarray:
+        """(measured − predicted) / noise on the selected rows (a boolean mask), each channel's
+        ``zero`` over the selected rows of each recording removed (its zero error): the mean, in
+        which the residual stays affine in the prediction (the fits), or the median, which a misfit
+        confined to a stretch does not move for the rest of its recording (the misfits' search)."""
+        r = self.layout.measured[rows] - predicted[rows]
+        rec = self.layout.recording[rows]
+        for k in np.unique(rec):
+            r[rec == k] -= zero(r[rec == k], axis=0)
+        return r / self.noise
+
+    def test_errors(self, predicted: np.ndarray) -> np.ndarray:
+        """Per test, the RMS residual (1 = the noise)."""
+        r2 = (self.residual(predicted, np.ones(len(predicted), dtype=bool)) ** 2).mean(axis=1)
+        return np.array([math.sqrt(r2[t.rows].mean()) for t in self.layout.tests])
+
+    def heldout_error(self, predicted: np.ndarray) -> float:
+        """The RMS residual on the held-out tests (1 = the noise)."""
+        r = self.residual(predicted, np.ones(len(predicted), dtype=bool))[self.held_rows]
+        return float(math.sqrt(np.mean(r ** 2)))
+
+
+def nominal(cause: str) -> dict[str, float]:
+    """Mid-range values of a cause's parameters (geometric mean for log parameters); a family's shape
+    parameter at its first form (its default), so that a screening run is the first parameter's
+    effect alone, scaled with it, and the second-parameter refit finds the shape."""
+    return {p.name: (p.default if p.default is not None else
+                     math.sqrt(p.draw[0] * p.draw[1]) if p.log else 0.5 * (p.draw[0] + p.draw[1]))
+            for p in parameters(cause)}
+
+
+def fit(h: Hypothesis, signature: np.ndarray, base: np.ndarray, scorer: Scorer,
+        slope: np.ndarray | None = None) -> Candidate:
+    """Fit ``h`` on the training tests: its first parameter with the effect taken proportional to it
+    (to its logarithm for a factor) from the ``signature`` (the rows of a vehicle run with
+    ``h.values`` minus the baseline's); given ``slope`` (the rows' derivative with respect to the
+    second parameter at ``h.values``), the second too, linearly along it. Each parameter fitted gets
+    its uncertainty in ``std``; the candidate is scored by its training error (``screened_error``)."""
+    params = parameters(h.cause)
+    first = params[0]
+    at = dict(h.values)
+    train = ~scorer.held_rows
+    mismatch = scorer.residual(base, train).ravel()
+    # the signature and the slope in noise units (the residual is affine in the prediction)
+    columns = [mismatch - scorer.residual(base + d, train).ravel() for d in (signature, slope) if d is not None]
+    gram = _gram(columns)
+    if len(columns) == 2 and _alike(gram):
+        columns, gram = columns[:1], gram[:1, :1]   # the second parameter changes nothing the first does not
+    coef = np.linalg.solve(gram, [float(np.dot(c, mismatch)) for c in columns]) if gram[0, 0] > 0.0 \
+        else np.zeros(len(columns))
+    std = {}
+    if len(columns) == 2:
+        second = params[1]
+        moved = float(np.clip(at[second.name] + coef[1], *_side_bounds(second, at[first.name])))
+        coef[1] = moved - at[second.name]
+        coef[0] = float(np.dot(columns[0], mismatch - coef[1] * columns[1])) / gram[0, 0]
+        at[second.name] = moved
+    var = _variances(mismatch - sum(c * x for c, x in zip(coef, columns)), gram)
+    if len(columns) == 2:
+        std[params[1].name] = math.sqrt(var[1])
+    value, std[first.name], scale = _magnitude(first, at[first.name], coef[0], math.sqrt(var[0]))
+    rest = sum(c * x for c, x in zip(coef[1:], columns[1:]))
+    trained = float(math.sqrt(np.mean((mismatch - scale * columns[0] - rest) ** 2)))
+    return Candidate(replace(h, values={**at, first.name: value}), math.nan, std, screened_error=trained,
+                     z=separation(first, value, std[first.name]))
+
+
+def fit_pair(first: Candidate, second: Candidate, base: np.ndarray, scorer: Scorer,
+             slope: np.ndarray | None = None) -> Candidate | None:
+    """Both causes' magnitudes (first parameters) refitted together on the training tests, each effect
+    taken proportional to its magnitude from the runs (``first``'s alone, ``second``'s beside it);
+    given ``slope`` (the pair's rows' derivative with respect to the second cause's second parameter),
+    that parameter too, linearly along it, as :func:`fit` does: the second cause with the first, as
+    refitted, ``beside`` it; None when the two effects are alike on the campaign (nothing to refit)."""
+    train = ~scorer.held_rows
+    mismatch = scorer.residual(base, train).ravel()
+    columns = [mismatch - scorer.residual(rows, train).ravel() for rows in (first.simulated, second.simulated)]
+    columns[1] = columns[1] - columns[0]     # the second's own effect
+    gram = _gram(columns)
+    if _alike(gram):
+        return None                          # the two act alike on the campaign: nothing to refit
+    at = dict(second.hypothesis.values)
+    extra = {}
+    if slope is not None:
+        shape = mismatch - scorer.residual(base + slope, train).ravel()
+        wide = _gram([*columns, shape])
+        if not _alike(wide):   # else it changes nothing the two do not
+            coef = np.linalg.solve(wide, [float(np.dot(c, mismatch)) for c in (*columns, shape)])
+            magnitude, shape_p = parameters(second.hypothesis.cause)[:2]
+            moved = float(np.clip(at[shape_p.name] + coef[2], *_side_bounds(shape_p, at[magnitude.name])))
+            mismatch = mismatch - (moved - at[shape_p.name]) * shape   # the magnitudes refitted given it
+            extra = {shape_p.name: math.sqrt(_variances(mismatch - coef[:2] @ np.array(columns), wide)[2])}
+            at[shape_p.name] = moved
+    coef = np.linalg.solve(gram, [float(np.dot(c, mismatch)) for c in columns])
+    sd = np.sqrt(_variances(mismatch - coef @ np.array(columns), gram))
+    out, scales = [], []
+    for c, k, s in zip((first, second), coef, sd):
+        p = parameters(c.hypothesis.cause)[0]
+        values = at if c is second else c.hypothesis.values
+        value, std, scale = _magnitude(p, values[p.name], float(k), float(s))
+        # the first's uncertainty at least its shift (the second's: :func:`kept`)
+        out.append(Candidate(replace(c.hypothesis, values={**values, p.name: value}), math.nan,
+                             {**c.std, **(extra if c is second else {}),
+                              p.name: max(std, abs(value - values[p.name])) if c is first else std},
+                             z=separation(p, value, std)))
+        scales.append(scale)
+    left = mismatch - scales[0] * columns[0] - scales[1] * columns[1]
+    out[1].screened_error = float(math.sqrt(np.mean(left ** 2)))
+    out[1].beside = out[0]
+    return out[1]
+
+
+def halfway(first: Candidate, start: Candidate, refit: Candidate) -> Candidate:
+    """A pair refit's step halved: every parameter of the second cause halfway from ``start`` (its
+    screening fit, beside ``first`` as fitted alone) to ``refit`` (:func:`fit_pair`), and the first
+    cause's halfway from ``first`` to ``refit.beside``, each on the scale the fit moved it along (a
+    magnitude on its effect's, a factor's logarithm; a second parameter linearly); the refit's
+    uncertainties (taken before :func:`kept` widens them)."""
+    def mid(a: Candidate, b: Candidate) -> Candidate:
+        magnitude, *rest = parameters(a.hypothesis.cause)
+        x, y = a.hypothesis.values, b.hypothesis.values
+        values = {**y, **{p.name: 0.5 * (x[p.name] + y[p.name]) for p in rest if p.name in x and p.name in y},
+                  magnitude.name: magnitude.from_effect(0.5 * (magnitude.effect(x[magnitude.name])
+                                                               + magnitude.effect(y[magnitude.name])))}
+        return Candidate(replace(b.hypothesis, values=values), math.nan, dict(b.std),
+                         z=separation(magnitude, values[magnitude.name], b.std[magnitude.name]))
+
+    out = mid(start, refit)
+    out.beside = mid(first, refit.beside)
+    return out
+
+
+def _gram(columns: list[np.ndarray]) -> np.ndarray:
+    """The columns' dot products with each other (the normal equations' matrix)."""
+    return np.array([[float(np.dot(a, b)) for b in columns] for a in columns])
+
+
+def _alike(gram: np.ndarray) -> bool:
+    """Whether columns (their ``gram`` matrix) are dependent to within round-off: the last changes
+    nothing the others do not, and they cannot be fitted apart."""
+    return bool(np.linalg.det(gram) <= 1e-9 * np.prod(np.diag(gram)))
+
+
+def _variances(residual: np.ndarray, gram: np.ndarray) -> np.ndarray:
+    """The fitted coefficients' variances from the ``residual`` left and the columns' ``gram`` matrix,
+    the residual variance inflated for sample-to-sample correlation (a smooth model error is not
+    white noise: n samples are worth n(1 − ρ)/(1 + ρ))."""
+    r = residual
+    rho = float(np.clip(np.dot(r[1:], r[:-1]) / max(np.dot(r, r), 1e-300), 0.0, 0.999))
+    s2 = float(np.dot(r, r)) / max(len(r) - len(gram), 1) * (1.0 + rho) / (1.0 - rho)
+    return np.diag(np.linalg.inv(gram)) * s2 if gram[0, 0] > 0.0 else np.full(len(gram), math.inf)
+
+
+def _side_bounds(second: Parameter, first_value: float) -> tuple[float, float]:
+    """A second parameter's bounds; a sided one's on the side of the family's first (one side per
+    family, as the virtual rig draws it)."""
+    lo, hi = second.bounds
+    if second.sided:
+        return (max(lo, 0.0), hi) if first_value >= 0.0 else (lo, min(hi, 0.0))
+    return lo, hi
+
+
+def _magnitude(p: Parameter, at: float, coef: float, sd: float) -> tuple[float, float, float]:
+    """A first parameter's value when its effect at ``at`` is scaled by ``coef`` (standard deviation
+    ``sd``), kept within its bounds and on its side: the value, its uncertainty, and the scale of the
+    effect it gives."""
+    x0 = p.effect(at)
+    lo, hi = p.bounds
+    if not p.signed or (p.sided and x0 > 0.0):
+        lo = max(lo, 0.0)
+    if p.sided and x0 < 0.0:
+        hi = min(hi, 0.0)
+    # clipped before from_effect: a hypothesis with almost no effect gets a huge coefficient (a factor's exp overflowed)
+    value = float(np.clip(p.from_effect(min(coef * x0, p.effect(hi))), lo, hi))
+    scale = p.effect(value) / x0 if x0 != 0.0 else 0.0   # at no effect (clipped to it): none from here
+    return value, (abs(value * x0) if p.factor else abs(x0)) * sd, scale
+
+
+def separation(p: Parameter, value: float, std: float) -> float:
+    """How many standard uncertainties ``std`` a magnitude ``value`` of ``p`` stands off no effect, on
+    the scale its effect grows with (a factor's logarithm); NaN for a null or unbounded uncertainty
+    (a hypothesis fitted from no effect at all), which does not tell."""
+    std = std / value if p.factor else std
+    return abs(p.effect(value)) / std if 0.0 < std < math.inf else math.nan
+
+
+def significant(c: Candidate) -> bool:
+    """Whether a candidate's magnitude (its first parameter) stands over SIGNIFICANT of its fit's
+    standard uncertainties off no effect (``c.z``). Not the uncertainty :func:`kept` reports: the
+    shift from a screening value that a second parameter, fitted since, has moved says nothing of
+    whether the effect is there."""
+    return c.z > SIGNIFICANT
+
+
+def nudged(h: Hypothesis) -> tuple[Hypothesis, float]:
+    """``h`` with its second parameter moved by a quarter of its realistic range (inwards from a
+    bound), and the move: the run that gives the rows' slope along that parameter."""
+    first, second = parameters(h.cause)[:2]
+    value, step = h.values[second.name], 0.25 * (second.draw[1] - second.draw[0])
+    lo, hi = _side_bounds(second, h.values[first.name])
+    if value + step > hi:
+        step = -step
+    return replace(h, values={**h.values, second.name: value + step}), step
+
+
+def kept(first: list[Candidate], refit: list[Candidate], simulated: list[np.ndarray], scorer: Scorer
+         ) -> list[Candidate]:
+    """Of each candidate and its refit (whose runs are ``simulated``), the better, best first; a
+    refit's uncertainty at least its shift (the linearised one ignores the model's nonlinearity)."""
+    for a, b in zip(first, refit):
+        b.std = {k: max(s, abs(b.hypothesis.values[k] - a.hypothesis.values[k])) for k, s in b.std.items()}
+    verify(refit, simulated, scorer)
+    return sorted((min(a, b, key=lambda c: c.score) for a, b in zip(first, refit)), key=lambda c: c.score)
+
+
+def verify(candidates: list[Candidate], simulated: list[np.ndarray], scorer: Scorer) -> None:
+    """Give each candidate its full vehicle run's rows (``simulated``) and their errors."""
+    for c, rows in zip(candidates, simulated):
+        c.simulated = rows
+        c.heldout_error = scorer.heldout_error(rows)
+        c.test_errors = scorer.test_errors(rows)

@@ -1,0 +1,276 @@
+"""What a K&C diagnosis tells an engineer: the JSON verdict, the extended vehicle file, and a
+one-page markdown report with overlays before/after, the error per test against its amplitude and
+static load, and the ranking with its evidence."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from elastokin.vehicle.model.definition import VehicleDefinition
+from elastokin.core.files import atomic_output
+from elastokin.diagnosis.catalogue import PAIR_SEPARATOR
+from elastokin.diagnosis.kc_catalogue import Hypothesis, extended_vehicle_yaml, parameters
+from elastokin.diagnosis.kc_diagnosis import KCDiagnosis, Misfit
+from elastokin.diagnosis.kc_fits import Candidate
+from elastokin.diagnosis.verdict import MISFIT_CHANCE, NOISE_FACTOR, Separation
+from elastokin.presentation.diagnosis_report import Report, partly_explained, ranking_chart, separation_clause
+from elastokin.presentation.figures import save_figure
+
+#: Channels overlaid in the report (the largest baseline mismatch on held-out tests first).
+OVERLAYS = 4
+
+
+def _parameters(d: KCDiagnosis, c: Candidate | None = None) -> dict[str, Any]:
+    """A named cause's parameters (the first's, or ``c``'s), each with its uncertainty if it was
+    fitted: the screening fits only the first, with a second held at mid-range (``"fitted": false``,
+    no uncertainty); the refit fits both."""
+    if not d.named:
+        return {}
+    c = c or d.best
+    return {p.name: {"value": c.hypothesis.values[p.name], "std": c.std.get(p.name), "unit": p.unit,
+                     "fitted": p.name in c.std} for p in parameters(c.hypothesis.cause)}
+
+
+def _candidate(c: Candidate) -> dict[str, Any]:
+    return {"cause": c.hypothesis.cause, "location": c.hypothesis.location_json(),
+            "heldout_error": c.heldout_error if c.verified else None, "training_error": _training_error(c),
+            "score": c.score, "n_parameters": len(parameters(c.hypothesis.cause)),
+            "parameters": dict(c.hypothesis.values)}
+
+
+def _training_error(c: Candidate) -> float | None:
+    """The linearised fit's RMS on the training tests; None for a candidate no such fit gave (a pair
+    refit's halved step, :func:`elastokin.diagnosis.kc_fits.halfway`), which only its runs scored."""
+    return c.screened_error if math.isfinite(c.screened_error) else None
+
+
+def _run_with(d: KCDiagnosis, c: Candidate) -> list[Hypothesis]:
+    """The hypotheses a second-stage candidate was run with: the first cause (refitted with it, if it
+    was) and its own."""
+    return [(c.beside or d.best).hypothesis, c.hypothesis]
+
+
+def _pair(d: KCDiagnosis, c: Candidate) -> dict[str, Any]:
+    """A second-stage candidate: the pair run, both causes with the values it was run with."""
+    both = _run_with(d, c)
+    return {"cause": PAIR_SEPARATOR.join(h.cause for h in both), "heldout_error": c.heldout_error,
+            "training_error": _training_error(c), "score": c.score,
+            "causes": [{"cause": h.cause, "location": h.location_json(), "parameters": dict(h.values)} for h in both]}
+
+
+def summary(d: KCDiagnosis) -> dict[str, Any]:
+    """The machine-readable verdict (``vsim diagnose --json``)."""
+    after = d.final.test_errors if d.named else d.baseline_errors
+    return {
+        "cause": d.verdict,
+        "location": d.causes[0].hypothesis.location_json() if d.named else None,
+        "parameters": _parameters(d, d.causes[0]) if d.named else {},
+        "heldout_error_before": d.heldout_error_before,
+        "heldout_error_after": d.heldout_error_after,
+        "noise_floor": 1.0,
+        "ranking": [_candidate(c) for c in d.ranking],
+        "pairs": [_pair(d, c) for c in d.pairs],
+        "tests": [{"name": n, "heldout": bool(h), "error_before": float(b), "error_after": float(a),
+                   "excess_before": excess(float(b))}
+                  for n, h, b, a in zip(d.test_names, d.heldout, d.baseline_errors, after)],
+        "explained": d.explained[0],
+        "share_explained": d.explained[1],
+        "causes": [{"cause": c.hypothesis.cause, "location": c.hypothesis.location_json(),
+                    "parameters": _parameters(d, c), "share_explained": share} for c, share in zip(d.causes, d.shares)],
+        "alike": [_alike(c, sep) for c, sep in zip(d.alike, d.separations)],
+        "misfits": [_misfit(m) for m in d.misfits],
+        "misfits_after": [_misfit(m) for m in d.misfits_after],
+        "noise": {c: float(s) for c, s in zip(d.layout.channels, d.noise)},
+        "wall_s": d.wall_s,
+    }
+
+
+def _alike(c: Candidate, sep: Separation | None) -> dict[str, Any]:
+    """A rival the campaign cannot tell from the named cause, and the shipped test that separates them."""
+    return {"cause": c.hypothesis.cause, "location": c.hypothesis.location_json(),
+            "parameters": dict(c.hypothesis.values), "heldout_error": c.heldout_error,
+            "separated_by": None if sep is None else {"scenario": sep.test, "file": str(sep.path),
+                                                      "difference": sep.difference, "separates": sep.separates}}
+
+
+def _alike_sentence(d: KCDiagnosis) -> str:
+    """What the campaign cannot tell apart, and the test that would."""
+    out = ""
+    for c, sep in zip(d.alike, d.separations):
+        values = ", ".join(f"{k} = {v:.4g} {p.unit}" for (k, v), p in zip(c.hypothesis.values.items(),
+                                                                           parameters(c.hypothesis.cause)))
+        out += (f" These tests cannot tell it from **{c.hypothesis.cause}** at {_where(c)} ({values}; held-out error "
+                f"{c.heldout_error:.2f}): ")
+        if sep is None:
+            out += ("the dataset holds every shipped rig test." if not d.extra_tests else
+                    f"none of the {d.extra_tests} shipped rig tests the dataset lacks ran on both (the car left "
+                    f"its valid range).")
+        else:
+            out += separation_clause(sep, "rig test")
+    return out
+
+
+def _misfit(m: Misfit) -> dict[str, Any]:
+    return {"test": m.test, "heldout": m.heldout, "error": m.error, "excess": excess(m.error),
+            "noise_chance": m.chance, "start_s": m.start_s, "end_s": m.end_s, "channel": m.channel}
+
+
+def excess(error: float) -> float:
+    """The model error in excess of the noise, from an error in units of the noise (1: perfect)."""
+    return math.sqrt(max(error ** 2 - 1.0, 0.0))
+
+
+def _where(c: Candidate) -> str:
+    loc = c.hypothesis.location_json() or {}
+    return ", ".join(f"{k} {'/'.join(v) if isinstance(v, list) else v}" for k, v in loc.items())
+
+
+def verdict_sentence(d: KCDiagnosis) -> str:
+    """One sentence for people."""
+    before, after = d.heldout_error_before, d.heldout_error_after
+    if d.verdict == "none":
+        return (f"Nothing significant is missing: the baseline's held-out error ({before:.2f} × the measurement "
+                f"noise) is at the noise or no cause of the catalogue reduces it.")
+    best = d.ranking[0]
+    if d.verdict == "unexplained" and before <= NOISE_FACTOR and d.misfits:
+        worst = min(d.misfits, key=lambda m: (m.chance, -m.error))
+        tests = f"{len(d.misfits)} tests on their own" if len(d.misfits) > 1 else "one test on its own"
+        return (f"A local misfit: the baseline fits the held-out tests taken together ({before:.2f} × the noise) "
+                f"but not {tests}, most of all {worst.test} ({worst.error:.2f} × the noise, most between "
+                f"{worst.start_s:.2f} and {worst.end_s:.2f} s of its input, in {worst.channel}); no catalogue cause "
+                f"can be judged on it.")
+    if d.verdict == "unexplained":
+        return (f"The mismatch is real ({before:.2f} × the noise on held-out tests) but no catalogue cause explains "
+                f"it; the best, {best.hypothesis.label}, only brings it to {best.heldout_error:.2f}.")
+    named = " and ".join(
+        f"**{c.hypothesis.cause}** at {_where(c)} (" + ", ".join(
+            f"{k} = {v['value']:.4g} ± {v['std']:.2g} {v['unit']}" if v["fitted"] else
+            f"{k} = {v['value']:.4g} {v['unit']} (held at mid-range)" for k, v in _parameters(d, c).items()) + ")"
+        for c in d.causes)
+    sentence = (f"Cause{'s' if len(d.causes) > 1 else ''}: {named}; held-out error {before:.2f} → {after:.2f} "
+                f"× the measurement noise.")
+    how, share = d.explained
+    if how == "partial":
+        sentence += partly_explained(share, ", ".join(m.test for m in d.misfits_after))
+    return sentence + _alike_sentence(d)
+
+
+def _test_features(d: KCDiagnosis, measured: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per test: peak-to-peak wheel travel [mm] (largest wheel) and mean static pad load [N]."""
+    cols = d.layout.channels
+    travel = [i for i, c in enumerate(cols) if c.startswith("wheel_travel_")]
+    load = [i for i, c in enumerate(cols) if c.startswith("pad_fz_")]
+    amp = np.array([np.ptp(measured[t.rows][:, travel], axis=0).max() for t in d.layout.tests])
+    static = np.array([measured[t.rows][:, load].mean() for t in d.layout.tests])
+    return amp, static
+
+
+def _overlays(d: KCDiagnosis, out: Path) -> Path:
+    held = d.heldout[d.layout.test]
+    mismatch = np.std((d.layout.measured - d.baseline)[held], axis=0) / d.noise   # a zero error does not count
+    worst = [int(i) for i in np.argsort(-mismatch)[:OVERLAYS]]
+    k = max((i for i in range(len(d.layout.tests)) if d.heldout[i]), key=lambda i: d.baseline_errors[i])
+    rows = d.layout.tests[k].rows
+    fig = Figure(figsize=(4.2 * len(worst), 3.6))
+    for j, c in enumerate(worst):
+        ax = fig.add_subplot(1, len(worst), j + 1)
+        m = d.layout.measured[rows, c]
+        x = np.arange(len(rows))
+        ax.plot(x, m, "k.", ms=1.5, label="measured")
+        for sim, style, label in ((d.baseline, "C3-", "baseline"),
+                                  (d.final.simulated if d.named else None, "C0-", f"+ {d.verdict}")):
+            if sim is not None:
+                ax.plot(x, sim[rows, c] + np.median(m - sim[rows, c]), style, lw=0.8, label=label)
+        ax.set_xlabel("sample of the input phase")
+        ax.set_ylabel(d.layout.channels[c])
+        ax.set_title(f"{d.layout.tests[k].name} (held out)", fontsize=8)
+        ax.legend(fontsize=7)
+    return save_figure(fig, out)
+
+
+def _residuals(d: KCDiagnosis, out: Path) -> Path:
+    amp, static = _test_features(d, d.layout.measured)
+    fig = Figure(figsize=(8.5, 3.6))
+    for i, (x, label) in enumerate(((amp, "peak-to-peak wheel travel [mm]"), (static, "mean pad load [N]"))):
+        ax = fig.add_subplot(1, 2, i + 1)
+        ax.scatter(x, d.baseline_errors, c="C3", s=14, label="baseline")
+        if d.named:
+            ax.scatter(x, d.final.test_errors, c="C0", marker="s", s=14, label=f"+ {d.verdict}")
+        ax.axhline(1.0, color="k", ls="--", lw=0.8, label="noise")
+        ax.set_xlabel(label)
+        ax.set_ylabel("RMS error [× noise]")
+        ax.legend(fontsize=7)
+    return save_figure(fig, out)
+
+
+def _ranking(d: KCDiagnosis, out: Path) -> Path:
+    return ranking_chart(d.heldout_error_before, [(c.hypothesis.label, c.heldout_error) for c in d.ranking if c.verified],
+                         (1.0, "noise"), "held-out RMS error [× noise]", out)
+
+
+def write_report(d: KCDiagnosis, baseline: VehicleDefinition, out_dir: Path, dataset: str) -> list[Path]:
+    """Write report.md, its PNGs, diagnosis.json and (for a named cause) extended_vehicle.yaml."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    written = [_overlays(d, out_dir / "overlays.png"), _residuals(d, out_dir / "residuals.png"),
+               _ranking(d, out_dir / "ranking.png")]
+    result = summary(d)
+    report = Report(f"K&C diagnosis of {dataset}", verdict_sentence(d),
+                    f"Baseline: `{baseline.path}`; {len(d.test_names)} tests (recorded cases), {int(d.heldout.sum())} "
+                    f"held out from every fit (every other one). Errors are RMS of measured − simulated over every "
+                    f"measured channel but the rig inputs, each in units of its own measurement noise (estimated from "
+                    f"the data), each channel's zero in each recording removed: 1 is a perfect model.")
+    if d.named:
+        model = out_dir / "extended_vehicle.yaml"
+        hypotheses = [c.hypothesis for c in d.causes]
+        note = (f"{baseline.path} extended by " + " and ".join(f"{h.label} {dict(h.values)}" for h in hypotheses)
+                + f", fitted by vsim diagnose on {dataset}.")
+        with atomic_output(model) as tmp:
+            tmp.write_text(extended_vehicle_yaml(baseline, hypotheses, note))
+        written.append(model)
+        report.paragraph(f"Extended model: [`{model.name}`]({model.name}) (a vehicle file: `vsim run` uses it "
+                         f"through a scenario's `vehicle:` key).")
+    report.section("Ranking")
+    report.paragraph("Every cause at every place it can sit was run once on the training tests and its magnitude "
+                     "fitted; the best were run on every test and scored on the held-out ones.")
+    report.table(("hypothesis", "parameters", "held-out error", "training error", "fitted values"),
+                 [("baseline", "0", f"{d.heldout_error_before:.3f}", "", "")]
+                 + [(c.hypothesis.label, str(len(parameters(c.hypothesis.cause))),
+                     f"{c.heldout_error:.3f}" if c.verified else "(not run)", f"{c.screened_error:.3f}",
+                     ", ".join(f"{k} = {v:.4g}" for k, v in c.hypothesis.values.items())) for c in d.ranking[:12]])
+    if d.pairs:
+        report.paragraph(f"Second stage: {d.best.hypothesis.label} left a mismatch beyond the noise or a test it "
+                         f"does not fit; every other hypothesis was fitted beside it, the best run with it on every "
+                         f"test, both magnitudes (and the second's shape) refitted together, a refit that did worse "
+                         f"than where it started once more at half its step (two causes are named "
+                         f"when the pair removes most of what the first left and the second's magnitude stands over "
+                         f"two of its fit's standard uncertainties off no effect):")
+        report.table(("pair", "held-out error", "fitted values"),
+                     [(" + ".join(h.label for h in both), f"{c.heldout_error:.3f}",
+                       "; ".join(", ".join(f"{k} = {v:.4g}" for k, v in h.values.items()) for h in both))
+                      for c, both in ((c, _run_with(d, c)) for c in d.pairs)])
+    report.picture("ranking.png")
+    report.section("Tests")
+    report.paragraph("Every test is checked, training ones included (the baseline fitted nothing): a test is "
+                     f"misfit when the baseline's error on it exceeds {NOISE_FACTOR:g} × the noise, or when one "
+                     f"channel over a stretch of it departs more than the noise would with a chance of "
+                     f"{MISFIT_CHANCE:g} anywhere in the test.")
+    report.table(("test", "held out", "error before", "excess over noise", "error after"),
+                 [(t["name"], "yes" if t["heldout"] else "", f"{t['error_before']:.3f}", f"{t['excess_before']:.3f}",
+                   f"{t['error_after']:.3f}") for t in result["tests"]])
+    for title, misfits in ((f"Tests the baseline with {d.verdict} does not fit", d.misfits_after),
+                           ("Tests the baseline does not fit", d.misfits)):
+        if misfits:
+            report.section(title)
+            report.table(("test", "held out", "error", "chance from noise", "where (s of its input)", "worst channel"),
+                         [(m.test, "yes" if m.heldout else "", f"{m.error:.3f}", f"{m.chance:.1e}",
+                           f"{m.start_s:.2f} – {m.end_s:.2f}", m.channel) for m in misfits])
+    report.section("Channels with the largest mismatch (held-out test with the largest baseline error)")
+    report.picture("overlays.png")
+    report.section("Error against amplitude and static load")
+    report.picture("residuals.png")
+    return written + report.write(out_dir, result)
