@@ -20,6 +20,7 @@ from elastokin.core.provenance import software_version
 if TYPE_CHECKING:
     from elastokin.api.built_ins import built_ins, copy_built_in, dataset
     from elastokin.api.diagnosis import diagnose
+    from elastokin.api.kernels import compile_kernels
     from elastokin.api.verdicts import Diagnosis
     from elastokin.api.runs import Run, load_run
     from elastokin.api.scenarios import load_scenario, scenario_from
@@ -38,6 +39,7 @@ _API = {
     "load_scenario": "elastokin.api.scenarios", "scenario_from": "elastokin.api.scenarios",
     "Diagnosis": "elastokin.api.verdicts", "diagnose": "elastokin.api.diagnosis",
     "sweep": "elastokin.api.sweeps",
+    "compile_kernels": "elastokin.api.kernels",
     "built_ins": "elastokin.api.built_ins", "copy_built_in": "elastokin.api.built_ins", "dataset": "elastokin.api.built_ins",
     "BushingBank": "elastokin.bushings", "ParameterSet": "elastokin.bushings", "load_parameter_set": "elastokin.bushings",
 }

@@ -5,18 +5,24 @@ says, and the built-ins can be listed, copied and run from anywhere."""
 from __future__ import annotations
 
 import doctest
+import io
+import json
 import math
+import re
 import subprocess
 import sys
 from pathlib import Path
 
+import numba
 import numpy as np
 import pytest
 
 import elastokin
 from elastokin.api import built_ins, diagnosis, runs, scenarios, simulation, sweeps, vehicles
+from elastokin.api.kernels import compile_kernels
 from elastokin.cli.main import main
 from elastokin.core.errors import InputError
+from elastokin.presentation.compile_notice import compile_notice
 from elastokin.recordings.run_reader import load_run
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -65,6 +71,7 @@ def test_the_metrics_are_those_vsim_run_prints(pumping: elastokin.Run) -> None:
     # bump camber of a McPherson front: negative (camber-top-out positive, ISO 8855), tens of deg/m
     assert -60.0 < front["bump_camber_deg_per_m"] < -5.0
     assert f"{front['bump_camber_deg_per_m']:.5g}" in pumping.summary()
+    assert json.loads(json.dumps(metrics)) == {str(k): v for k, v in metrics.items()}   # plain numbers
 
 
 def test_figures_are_returned_not_written(pumping: elastokin.Run, tmp_path: Path, monkeypatch) -> None:
@@ -183,3 +190,37 @@ def test_the_five_lines_of_the_readme_run_from_an_empty_folder(tmp_path: Path) -
     assert done.returncode == 0, done.stderr[-3000:]
     assert load_run(tmp_path / "pumping.mcap").complete
     assert "rad" in done.stdout and "bump_camber_deg_per_m" not in done.stderr
+
+
+def test_a_compile_is_said_once_with_its_time() -> None:
+    """A kernel numba compiles is said on the stream with its time, a callee compiled into it not
+    again, and nothing when it is compiled already."""
+    stream = io.StringIO()
+
+    @numba.njit
+    def inner(x):
+        return x + 1.0
+
+    @numba.njit
+    def outer(x):
+        return inner(x) * 2.0
+
+    with compile_notice(stream) as notice:
+        assert outer(1.0) == 4.0
+        assert outer(2.0) == 6.0
+    lines = stream.getvalue().splitlines()
+    assert lines[0].startswith("compiling the kernels for this machine") and len(lines) == 2, lines
+    assert re.fullmatch(r"  compiled tests\.test_api\..*outer in \d+\.\d s", lines[1]) and notice.count == 1
+
+
+def test_after_vsim_compile_a_first_run_compiles_nothing(tmp_path: Path) -> None:
+    """`vsim compile` leaves every kernel a rig run and a road run need in numba's cache: a fresh
+    process playing them compiles nothing (and so says nothing of it)."""
+    count, wall_s = compile_kernels()
+    assert count >= 0 and wall_s > 0
+    for scenario, scale in (("pumping", "0.02"), ("road/step_steer", "0.05")):
+        done = subprocess.run([sys.executable, "-m", "elastokin.cli", "run", scenario, "--duration-scale", scale,
+                               "-o", str(tmp_path / "run.mcap"), "--overwrite"], cwd=tmp_path, capture_output=True,
+                              text=True, timeout=600)
+        assert done.returncode == 0, done.stderr[-2000:]
+        assert "compiling the kernels" not in done.stderr and "  compiled " not in done.stderr, done.stderr[-2000:]

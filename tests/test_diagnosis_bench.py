@@ -82,6 +82,7 @@ def _check_pair(result: dict, effects: list[dict]) -> None:
                 (name, fitted, truth[name])
 
 
+@pytest.mark.slow   # two minutes on 2 cores: the pair stage runs after the screening
 @pytest.mark.parametrize("seed", SEEDS)
 def test_two_hidden_causes_are_both_named(tmp_path, seed):
     baseline, effects, measured = measure(tmp_path, PAIR, seed)
@@ -119,6 +120,7 @@ def test_noise_alone_names_no_cause(tmp_path, seed):
     assert result["location"] is None and result["causes"] == [] and result["explained"] == "full"
 
 
+@pytest.mark.slow   # 85 s on 2 cores
 def test_backlash_outside_the_catalogue_is_unexplained(tmp_path):
     baseline, _, measured = measure(tmp_path, "backlash", SEEDS[0])
     result = diagnose_fresh(measured, baseline)
@@ -395,8 +397,10 @@ def _named_as_family(result: dict, form: str) -> str:
 
 
 #: Other forms drawn in the default suite (all of truth_forms.FORMS in the slow one: the two-node
-#: heating's and the box spectrum's diagnoses take a minute each on 2 cores).
-DEFAULT_FORMS = ["asymmetry_smooth_kink", "asymmetry_exponential", "mullins_ogden", "dahl_parallel", "viscous_parallel"]
+#: heating's and the box spectrum's diagnoses take a minute each on 2 cores, and so does Dahl's
+#: friction, drawn here in the slow stage only).
+DEFAULT_FORMS = ["asymmetry_smooth_kink", "asymmetry_exponential", "mullins_ogden",
+                 pytest.param("dahl_parallel", marks=pytest.mark.slow), "viscous_parallel"]
 
 
 @pytest.mark.parametrize("form", DEFAULT_FORMS)

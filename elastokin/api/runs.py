@@ -152,7 +152,8 @@ class Run:
             ``{case: {axle: {metric: value}}}`` (the K&C metrics of ``vsim kc``,
             :data:`elastokin.analysis.kc_metrics.METRICS`), for the cases whose input gives them.
         """
-        return road_metrics(self.recorded) if is_road(self.recorded) else run_metrics(self.recorded)
+        metrics = road_metrics(self.recorded) if is_road(self.recorded) else run_metrics(self.recorded)
+        return _plain(metrics)
 
     def summary(self) -> str:
         """The text summary ``vsim run`` prints (gradients, loop widths, metrics, peak deflections)."""
@@ -201,6 +202,13 @@ class Run:
         frame = pandas.DataFrame({n: self[n] for n in self.names}, index=pandas.Index(self.t_s, name="t_s"))
         frame.attrs["units"] = self.units
         return frame
+
+
+def _plain(value: Any) -> Any:
+    """``value`` with NumPy scalars made Python floats, in nested mappings (JSON as it is)."""
+    if isinstance(value, dict):
+        return {k: _plain(v) for k, v in value.items()}
+    return float(value) if isinstance(value, np.floating) else value
 
 
 def load_run(path: str | Path) -> Run:

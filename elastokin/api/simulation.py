@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from contextlib import nullcontext
 from dataclasses import replace
 from pathlib import Path
 from typing import Callable
@@ -11,6 +12,7 @@ from elastokin.api.runs import Run, Timing
 from elastokin.api.scenarios import load_scenario
 from elastokin.api.vehicles import Vehicle, load_vehicle
 from elastokin.core.errors import InputError
+from elastokin.presentation.compile_notice import compile_notice
 from elastokin.presentation.progress_bar import ProgressBar
 from elastokin.recordings.recorder import play_in_memory, run_scenario
 from elastokin.vehicle.model.definition import BUSHING_MODELS
@@ -69,7 +71,8 @@ class Simulation:
         """Play every case of the scenario.
 
         Args:
-            progress: a progress line on stderr (True), or a function called with each
+            progress: a progress line on stderr (True: with a line for each kernel numba compiles,
+                on a first run after an install), or a function called with each
                 :class:`~elastokin.vehicle.scenarios.schedule.Progress`.
             output: record the run in this MCAP file while it runs (as ``vsim run`` does), with
                 the bodies' poses; None: keep it in memory (:meth:`Run.save` records it later,
@@ -87,6 +90,11 @@ class Simulation:
         scenario = self.scenario if self.bushings is None else replace(self.scenario, bushing_model=self.bushings)
         bar = ProgressBar() if progress is True else None
         call = bar if bar is not None else (progress or None)
+        with compile_notice() if bar is not None else nullcontext():
+            return self._play(scenario, call, bar, output, overwrite)
+
+    def _play(self, scenario: Scenario | RoadScenario, call: Callable[[Progress], None] | None, bar: ProgressBar | None,
+              output: str | Path | None, overwrite: bool) -> Run:
         try:
             if output is None:
                 result = play_in_memory(scenario, self.vehicle.definition, duration_scale=self.duration_scale,

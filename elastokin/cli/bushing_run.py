@@ -31,9 +31,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "bushing model; a sine with static_mm is played about that static offset. Time series write t_s,e_mm,F_N; a sweep writes amplitude_mm,frequency_hz,"
         "k_dyn_n_per_mm,tan_delta (first harmonic of the last, stabilised cycle). --plot draws the "
         "force-deflection loop and the time histories (log time for a step), or for a sweep |K*| and "
-        "tan delta against amplitude and frequency, with the equivalent-damping approximation (spec "
-        "5.16/5.17) dashed over the time-domain result.")
+        "tan delta against amplitude and frequency, with the equivalent-damping approximation (Bourgeteau "
+        "2009, §5.3.1, eqs. 5.16-5.17) dashed over the time-domain result.")
     run.add_argument("bench", metavar="BENCH", help="bench file, or the name of a built-in one (bisine, sweep, ...)")
     run.add_argument("-o", "--output", type=output_file, required=True, metavar="OUT.csv")
     run.add_argument("--plot", type=output_folder, metavar="DIR", help="also write PNG plots into this directory")
-    run.set_defaults(func=_run)
+    run.set_defaults(func=_run, compiles=True)

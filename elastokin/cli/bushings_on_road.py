@@ -50,4 +50,4 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                      help="where metrics.csv and the PNGs go (default out/bushings_on_road)")
     cmd.add_argument("--duration-scale", type=positive_scale, default=1.0, metavar="X",
                      help="multiply every duration by X for a quick look (rise times too)")
-    cmd.set_defaults(func=_bushings_on_road)
+    cmd.set_defaults(func=_bushings_on_road, compiles=True)

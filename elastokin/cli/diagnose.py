@@ -62,4 +62,4 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="write report.md, PNGs, diagnosis.json and extended_model.yaml here")
     p.add_argument("--json", action="store_true", help="print the verdict as one JSON object")
     add_scheduler_options(p, "K&C datasets: ")
-    p.set_defaults(func=_diagnose)
+    p.set_defaults(func=_diagnose, compiles=True)

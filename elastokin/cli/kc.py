@@ -22,13 +22,14 @@ def _kc(args: argparse.Namespace) -> int:
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``kc``."""
-    kc = subparsers.add_parser("kc", help="K&C metrics of a vehicle on the virtual rig (spec §4)",
+    kc = subparsers.add_parser("kc", help="K&C metrics of a vehicle on the virtual rig (ISO 8855 signs)",
                                description="Runs bump, roll, lateral-force, longitudinal-force and "
-                                           "aligning-torque triangles on both axles (vehicle/scenarios/kc_tests.py; "
-                                           "metrics: elastokin/analysis/kc_metrics.py).")
+                                           "aligning-torque triangles on both axles (elastokin/vehicle/scenarios/kc_tests.py "
+                                           "in the installed package) and prints each metric with its unit in its "
+                                           "name; definitions and signs: elastokin/analysis/kc_metrics.py (METRICS).")
     kc.add_argument("--vehicle", default=DEFAULT_VEHICLE.stem, metavar="VEHICLE",
                     help="vehicle file, or the name of a built-in one (default: %(default)s)")
     kc.add_argument("--bushing-model", choices=BUSHING_MODELS, default=None,
                     help="put this model on every bushing direction (models/vehicles/README.md)")
     kc.add_argument("--json", action="store_true", help="one JSON object keyed front and rear")
-    kc.set_defaults(func=_kc)
+    kc.set_defaults(func=_kc, compiles=True)

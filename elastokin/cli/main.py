@@ -1,7 +1,8 @@
 """`vsim`: the command-line entry point: the parser of every command, and input errors as one line.
 
 Each command lives in its own module exposing ``register(subparsers)``, which adds the command with
-``set_defaults(func=...)`` where ``func(args) -> int`` is the exit code. Commands import what they
+``set_defaults(func=...)`` where ``func(args) -> int`` is the exit code (and ``compiles=True`` for a
+command that simulates: it says so on stderr when numba compiles). Commands import what they
 run when they run, so that ``vsim --help`` loads neither MuJoCo nor matplotlib.
 """
 
@@ -11,8 +12,8 @@ import argparse
 import sys
 from types import ModuleType
 
-from elastokin.cli import (built_ins, bushing_fit, bushing_run, bushings_on_road, compare, diagnose, kc, model_export, plot,
-                           rig_import, rig_measure, run, sweep, view)
+from elastokin.cli import (built_ins, bushing_fit, bushing_run, bushings_on_road, compare, compile, diagnose, kc, model_export,
+                           plot, rig_import, rig_measure, run, sweep, view)
 from elastokin.core.provenance import software_version
 from elastokin.cli.interrupts import handle_sigterm, status
 from elastokin.core.errors import InputError
@@ -26,7 +27,7 @@ GROUPS: dict[str, tuple[str, str, tuple[ModuleType, ...]]] = {
             "Measured K&C rig data (data/README.md).", (rig_import, rig_measure)),
 }
 #: Commands and groups in the order of ``vsim --help``.
-ORDER: tuple[ModuleType | str, ...] = (built_ins, "bushing", view, plot, "model", kc, run, bushings_on_road, sweep,
+ORDER: tuple[ModuleType | str, ...] = (built_ins, compile, "bushing", view, plot, "model", kc, run, bushings_on_road, sweep,
                                         diagnose, "rig", compare)
 
 
@@ -56,6 +57,11 @@ def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     handle_sigterm()
     try:
+        if getattr(args, "compiles", False):   # a command that simulates says so when numba compiles
+            from elastokin.presentation.compile_notice import compile_notice
+
+            with compile_notice():
+                return int(args.func(args) or 0)
         return int(args.func(args) or 0)
     except InputError as exc:
         print(f"vsim: error: {exc}", file=sys.stderr)

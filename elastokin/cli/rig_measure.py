@@ -37,4 +37,4 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("truth", type=Path, metavar="TRUTH.yaml")
     p.add_argument("-o", "--output", type=output_folder, required=True, metavar="DIR", help="measured dataset to write")
     p.add_argument("--overwrite", action="store_true", help="replace an existing output directory")
-    p.set_defaults(func=_measure)
+    p.set_defaults(func=_measure, compiles=True)

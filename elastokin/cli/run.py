@@ -60,4 +60,4 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     run.add_argument("--overwrite", action="store_true", help="replace an existing output file")
     run.add_argument("--duration-scale", type=positive_scale, default=1.0, metavar="X",
                      help="multiply every duration (settle phases, periods, holds) by X, e.g. 0.1 for a quick run")
-    run.set_defaults(func=_run)
+    run.set_defaults(func=_run, compiles=True)

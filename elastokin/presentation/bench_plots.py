@@ -72,7 +72,7 @@ def plot_sweep(columns: Mapping[str, np.ndarray], channel: ChannelParams, out_di
             ax.grid(True, which="both", alpha=0.3)
             if row == 0:
                 ax.legend(fontsize=7, ncol=2)
-    note = "solid: time-domain first harmonic; dashed: equivalent damping (5.16/5.17)" if approx is not None \
+    note = "solid: time-domain first harmonic; dashed: equivalent damping (Bourgeteau 2009, eqs. 5.16-5.17)" if approx is not None \
         else "time-domain first harmonic"
     fig.suptitle(f"{stem}: dynamic stiffness and loss factor ({channel.model}); {note}", fontsize=10)
     return [_save(fig, out_dir / f"{stem}_sweep.png")]
