@@ -108,7 +108,7 @@ def measure(tmp: Path, cause: str, seed: int) -> tuple[str, list[dict], Path]:
 
 def diagnose_fresh(directory: Path, baseline: str, report: Path | None = None) -> dict:
     """``vsim diagnose DIR --bushing-set BASELINE --json`` in a fresh Python process."""
-    cmd = [sys.executable, "-m", "elastokin.cli", "diagnose", str(directory), "--bushing-set", baseline, "--json"]
+    cmd = [sys.executable, "-m", "elastokin", "diagnose", str(directory), "--bushing-set", baseline, "--json"]
     if report is not None:
         cmd += ["-o", str(report)]
     done = subprocess.run(cmd, capture_output=True, text=True, timeout=600, cwd=directory.parent)

@@ -219,8 +219,15 @@ def test_after_vsim_compile_a_first_run_compiles_nothing(tmp_path: Path) -> None
     count, wall_s = compile_kernels()
     assert count >= 0 and wall_s > 0
     for scenario, scale in (("pumping", "0.02"), ("road/step_steer", "0.05")):
-        done = subprocess.run([sys.executable, "-m", "elastokin.cli", "run", scenario, "--duration-scale", scale,
+        done = subprocess.run([sys.executable, "-m", "elastokin", "run", scenario, "--duration-scale", scale,
                                "-o", str(tmp_path / "run.mcap"), "--overwrite"], cwd=tmp_path, capture_output=True,
                               text=True, timeout=600)
         assert done.returncode == 0, done.stderr[-2000:]
         assert "compiling the kernels" not in done.stderr and "  compiled " not in done.stderr, done.stderr[-2000:]
+
+
+def test_a_run_as_a_pandas_frame_is_its_signals_in_si(pumping: elastokin.Run) -> None:
+    frame = pumping.to_pandas()
+    assert list(frame.columns) == pumping.names and frame.index.name == "t_s"
+    assert np.array_equal(frame.index.to_numpy(), pumping.t_s)
+    assert np.array_equal(frame["toe_fl"].to_numpy(), pumping["toe_fl"]) and frame.attrs["units"]["toe_fl"] == "rad"

@@ -452,7 +452,7 @@ def test_simulate_gives_the_recorded_run(tmp_path):
 
 def test_diagnose_refuses_a_bushing_model_for_a_kc_dataset(tmp_path):
     (tmp_path / "rig.yaml").write_text("level: kc\nvehicle: car\nrecordings: []\n")
-    done = subprocess.run([sys.executable, "-m", "elastokin.cli", "diagnose", str(tmp_path), "--bushing-set",
+    done = subprocess.run([sys.executable, "-m", "elastokin", "diagnose", str(tmp_path), "--bushing-set",
                            "fig5_9"], capture_output=True, text=True)
     assert done.returncode != 0
     assert "--vehicle" in done.stderr and "rig.yaml" in done.stderr
@@ -499,7 +499,7 @@ def measure_truth(tmp: Path, hs: list[Hypothesis], seed: int, *, duration_scale:
 
 def diagnose_fresh(directory: Path, *options: str) -> dict:
     """``vsim diagnose DIR --json [options]`` (the default car as baseline) in a fresh Python process."""
-    done = subprocess.run([sys.executable, "-m", "elastokin.cli", "diagnose", str(directory), "--json", *options],
+    done = subprocess.run([sys.executable, "-m", "elastokin", "diagnose", str(directory), "--json", *options],
                           capture_output=True, text=True, timeout=1800, cwd=directory.parent)
     assert done.returncode == 0, done.stderr
     return json.loads(done.stdout)

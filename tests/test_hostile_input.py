@@ -222,7 +222,7 @@ def test_a_read_only_output_folder_is_refused_before_the_run(tmp_path: Path, cap
 def test_sigterm_leaves_a_readable_incomplete_recording_and_status_143(tmp_path: Path) -> None:
     output = tmp_path / "run.mcap"
     # five times the main job's durations: a run of 20 s or so, never over before the signal (4 s at 1)
-    proc = subprocess.Popen([sys.executable, "-m", "elastokin.cli", "run", "pumping", "-o", str(output),
+    proc = subprocess.Popen([sys.executable, "-m", "elastokin", "run", "pumping", "-o", str(output),
                              "--duration-scale", "5"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             cwd=tmp_path)
     deadline = time.monotonic() + 120.0

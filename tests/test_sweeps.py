@@ -21,6 +21,8 @@ import numpy as np
 import pytest
 from distributed import KilledWorker
 
+import elastokin
+
 from elastokin.vehicle.model.file_overrides import PlaceError, file_value, vehicle_with
 from elastokin.vehicle.model.vehicle_file import load_vehicle
 from elastokin.vehicle.scenarios.scenario_file import load_scenario
@@ -373,3 +375,12 @@ def test_places_of_the_vehicle_file():
     assert "beam_bending_stiffness" not in text and base.rear.beam_bending_stiffness is None
     bent = vehicle_with(text, DEFAULT_VEHICLE, {"rear.beam_bending_stiffness": 5e4}, "test")
     assert bent.rear.beam_bending_stiffness == 5e4
+
+
+def test_the_apis_sweep_is_the_commands(serial_table, tmp_path):
+    """``elastokin.sweep`` makes the table ``run_sweep`` does, the same bits, and keeps its rows in
+    the report."""
+    sweep_path, folder = serial_table
+    report = elastokin.sweep(sweep_path, tmp_path / "api", scheduler="serial")
+    assert _table(tmp_path / "api") == _table(folder)
+    assert report.finished == report.runs == 3 and len(report.table) == 3

@@ -68,7 +68,7 @@ def main() -> int:
             runs = args.out if args.keep_runs else Path(scratch)
             for name, scenario, scale in RUNS:
                 mcap, rrd, png = runs / f"{name}.mcap", runs / f"{name}.rrd", args.out / f"{name}.png"
-                vsim = [sys.executable, "-m", "elastokin.cli"]
+                vsim = [sys.executable, "-m", "elastokin"]
                 _run([*vsim, "run", scenario, "--duration-scale", str(scale), "-o", str(mcap), "--overwrite"])
                 _run([*vsim, "view", str(mcap), "--save", str(rrd), "--overwrite"])
                 _screenshot(rrd, png)

@@ -38,7 +38,7 @@ KINDS = (
 
 def _names(kind: Kind) -> list[str]:
     if not kind.suffix:
-        return sorted(p.name for p in kind.folder.iterdir() if (p / "rig.yaml").is_file())
+        return sorted(p.parent.name for p in kind.folder.glob("*/rig.yaml"))
     if kind.folder == PARAMETER_SET_DIR:   # the bench programmes are a folder of their own
         return sorted(p.stem for p in kind.folder.glob("*.yaml"))
     return built_in(kind.folder, kind.suffix)

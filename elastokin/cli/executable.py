@@ -1,4 +1,4 @@
-"""The ``vsim`` executable (and ``python -m elastokin.cli``): :func:`elastokin.cli.main.main` in a process of
+"""The ``vsim`` executable (and ``python -m elastokin``): :func:`elastokin.cli.main.main` in a process of
 its own, with the interpreter's housekeeping set for a process that ends with its command.
 
 The imports (numba's compiler above all) make some 10^5 objects that live as long as the process:

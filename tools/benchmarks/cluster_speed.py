@@ -63,7 +63,7 @@ metrics: [front.toe_loop_width_deg, front.camber_loop_width_deg]
 def _diagnosis(figures: dict) -> None:
     verdicts = []
     for workers in (1, 2):
-        done = run_measured([sys.executable, "-m", "elastokin.cli", "diagnose", str(KC), "--workers", str(workers),
+        done = run_measured([sys.executable, "-m", "elastokin", "diagnose", str(KC), "--workers", str(workers),
                              "--json"])
         if done.returncode:
             raise SystemExit(done.stderr)

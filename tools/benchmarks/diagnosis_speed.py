@@ -34,7 +34,7 @@ def main() -> int:
             figures[f"{name}_wall_s"] = None
             figures[f"{name}_note"] = f"{path.relative_to(ROOT)} is not shipped yet"
             continue
-        done = run_measured([sys.executable, "-m", "elastokin.cli", "diagnose", str(path), *baseline, "--json"])
+        done = run_measured([sys.executable, "-m", "elastokin", "diagnose", str(path), *baseline, "--json"])
         if done.returncode:
             print(done.stderr, file=sys.stderr)
             return done.returncode

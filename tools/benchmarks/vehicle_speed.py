@@ -130,7 +130,7 @@ def end_to_end(scale: float, runs: int = 3) -> dict[str, float]:
 
 def _end_to_end_once(scale: float) -> dict[str, float]:
     with tempfile.TemporaryDirectory() as folder:
-        done = run_measured([sys.executable, "-m", "elastokin.cli", "run", "pumping", "--duration-scale", str(scale),
+        done = run_measured([sys.executable, "-m", "elastokin", "run", "pumping", "--duration-scale", str(scale),
                              "-o", str(Path(folder) / "run.mcap")])
         samples = load_run(Path(folder) / "run.mcap").t_s.size if not done.returncode else 0
     if done.returncode:

@@ -1,4 +1,4 @@
-"""``python -m elastokin.cli``: the ``vsim`` command."""
+"""``python -m elastokin``: the ``vsim`` command."""
 
 import sys
 
