@@ -78,10 +78,15 @@ def test_the_wheel_runs_a_built_in_scenario_from_an_empty_folder(tmp_path: Path)
     # one top-level import package (and its metadata): nothing of ours stands beside another project's modules
     tops = {name.split("/")[0] for name in zipfile.ZipFile(wheel).namelist()}
     assert {top for top in tops if not top.endswith(".dist-info")} == {"elastokin"}, tops
-    # another project's top-level `vehicle` and `bushings` installed first are still there after ours
-    for other in ("vehicle", "bushings"):
-        (target / other).mkdir(parents=True)
-        (target / other / "__init__.py").write_text(f"WHO = 'the other {other}'\n")
+    # another distribution's top-level `vehicle` and `bushings`, installed first, are still there after ours
+    other = tmp_path / "other"
+    for name in ("vehicle", "bushings"):
+        (other / name).mkdir(parents=True)
+        (other / name / "__init__.py").write_text(f"WHO = 'the other {name}'\n")
+    (other / "pyproject.toml").write_text('[project]\nname = "other-vehicle"\nversion = "1.0"\n'
+                                          '[tool.setuptools]\npackages = ["vehicle", "bushings"]\n')
+    subprocess.run([sys.executable, "-m", "pip", "install", "-q", "--no-deps", "--no-build-isolation", "--target",
+                    str(target), str(other)], check=True, capture_output=True, timeout=300, cwd=tmp_path)
     subprocess.run([sys.executable, "-m", "pip", "install", "-q", "--no-deps", "--target", str(target), str(wheel)],
                    check=True, capture_output=True, timeout=300)
     env = {**os.environ, "PYTHONPATH": str(target)}
@@ -124,3 +129,11 @@ def test_the_executable_runs_the_command_with_the_collector_on(monkeypatch, pres
         gc.enable()
     assert seen["enabled"] and seen["frozen"] > 0
     assert seen["gl"] == (preset or "disable")
+
+
+def test_a_reader_that_leaves_ends_the_command_quietly(tmp_path: Path) -> None:
+    """`vsim list | true`: the reader is gone before the command writes; the command ends with
+    SIGPIPE's status and no traceback."""
+    done = subprocess.run(["bash", "-c", f"{sys.executable} -m elastokin list 2>err.txt | true; echo ${{PIPESTATUS[0]}}"],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert done.stdout.split()[-1] == "141" and (tmp_path / "err.txt").read_text() == ""

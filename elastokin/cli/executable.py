@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import gc
 import os
+import signal
 
 
 def main() -> int:
@@ -27,6 +28,11 @@ def main() -> int:
     gc.enable()
     try:
         return vsim()
+    except BrokenPipeError:
+        # the reader of stdout left (`vsim list | head`): nothing more to say to it, no traceback, and
+        # the status of a process ended by SIGPIPE, as the shell's tools give
+        os.dup2(os.open(os.devnull, os.O_WRONLY), 1)
+        return 128 + signal.SIGPIPE
     finally:
         # what is left is freed by the process's exit, not walked by the teardown's collections (so a
         # __del__ in a reference cycle does not run then: every file and cluster is closed by now)
