@@ -231,3 +231,17 @@ def test_a_run_as_a_pandas_frame_is_its_signals_in_si(pumping: elastokin.Run) ->
     assert list(frame.columns) == pumping.names and frame.index.name == "t_s"
     assert np.array_equal(frame.index.to_numpy(), pumping.t_s)
     assert np.array_equal(frame["toe_fl"].to_numpy(), pumping["toe_fl"]) and frame.attrs["units"]["toe_fl"] == "rad"
+
+
+def test_the_kc_metrics_of_a_vehicle_are_those_of_vsim_kc(monkeypatch) -> None:
+    """``Vehicle.kc_metrics`` builds the car as its file says, or with one model on every bushing,
+    and refuses a model it does not know."""
+    built = []
+    monkeypatch.setattr(vehicles, "vehicle_kc", lambda vehicle, options: built.append((vehicle, options)) or {})
+    car = elastokin.load_vehicle()
+    car.kc_metrics()
+    car.kc_metrics("stvs")
+    assert [b[0] for b in built] == [car.definition] * 2
+    assert [b[1].bushing_model for b in built] == [None, "stvs"]
+    with pytest.raises(InputError, match="bushings.*linear, sts, rt, stvs"):
+        car.kc_metrics("magic")

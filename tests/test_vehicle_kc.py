@@ -74,10 +74,10 @@ def test_metric_in_plausible_range(metrics, axle, key):
 def test_vsim_kc_json_has_the_issue_keys(metrics, monkeypatch, capsys):
     import json
 
-    from elastokin.analysis import kc_test
+    from elastokin.api import vehicles
     from elastokin.cli.main import main
 
-    monkeypatch.setattr(kc_test, "vehicle_kc", lambda vehicle, options: metrics)
+    monkeypatch.setattr(vehicles, "vehicle_kc", lambda vehicle, options: metrics)
     assert main(["kc", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert set(out) == {"front", "rear"}

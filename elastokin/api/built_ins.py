@@ -91,21 +91,20 @@ def _find(name: str) -> tuple[Kind, Path]:
     return kind, (kind.folder / bare if not kind.suffix else kind.folder / f"{bare}{kind.suffix}")
 
 
-def _named(text: str, key: str, folder: Path, suffix: str, base: Path) -> tuple[str, Path | None]:
+def _named(text: str, key: str, folder: Path, suffix: str, base: Path) -> str:
     """``text`` with the top-level ``key``'s value replaced by a built-in's name where it is a path
-    into the shipped ``folder`` (a copy elsewhere keeps finding it); and that file."""
+    into the shipped ``folder`` (a copy elsewhere keeps finding it)."""
     match = re.search(rf"^({re.escape(key)}:\s*)([^\s#]+)", text, flags=re.M)
     if match is None:
-        return text, None
-    value = match.group(2).strip("'\"")
+        return text
     try:
-        target = resolve(value, folder, key, base=base, suffix=suffix).resolve()
+        target = resolve(match.group(2).strip("'\""), folder, key, base=base, suffix=suffix).resolve()
     except InputError:
-        return text, None
+        return text
     if folder.resolve() not in target.parents:
-        return text, None
+        return text
     name = target.relative_to(folder.resolve()).with_suffix("").as_posix()
-    return text[:match.start(2)] + name + text[match.end(2):], target
+    return text[:match.start(2)] + name + text[match.end(2):]
 
 
 def copy_built_in(name: str, folder: str | Path, *, overwrite: bool = False) -> list[Path]:
@@ -136,7 +135,7 @@ def copy_built_in(name: str, folder: str | Path, *, overwrite: bool = False) -> 
     else:
         text = read_text(source)
         if kind.folder in (SCENARIO_DIR, SWEEP_DIR):
-            text, _ = _named(text, "vehicle", VEHICLE_DIR, ".yaml", source.parent)
+            text = _named(text, "vehicle", VEHICLE_DIR, ".yaml", source.parent)
         if kind.folder == VEHICLE_DIR:
             match = re.search(r"^(\s+property_file:\s*)([^\s#]+)", text, flags=re.M)
             if match is not None:

@@ -10,12 +10,11 @@ from typing import Callable
 
 from elastokin.api.runs import Run, Timing
 from elastokin.api.scenarios import load_scenario
-from elastokin.api.vehicles import Vehicle, load_vehicle
+from elastokin.api.vehicles import Vehicle, check_bushing_model, load_vehicle
 from elastokin.core.errors import InputError
 from elastokin.presentation.compile_notice import compile_notice
 from elastokin.presentation.progress_bar import ProgressBar
 from elastokin.recordings.recorder import play_in_memory, run_scenario
-from elastokin.vehicle.model.definition import BUSHING_MODELS
 from elastokin.vehicle.scenarios.road_scenario import RoadScenario
 from elastokin.vehicle.scenarios.scenario import Scenario
 from elastokin.vehicle.scenarios.schedule import Progress
@@ -55,8 +54,7 @@ class Simulation:
         if vehicle is None:
             vehicle = load_vehicle(self.scenario.vehicle)
         self.vehicle = vehicle if isinstance(vehicle, Vehicle) else load_vehicle(vehicle)
-        if bushings is not None and bushings not in BUSHING_MODELS:
-            raise InputError(f"expected one of {', '.join(BUSHING_MODELS)} or None, got {bushings!r}", key="bushings")
+        check_bushing_model(bushings)
         if isinstance(duration_scale, bool) or not isinstance(duration_scale, (int, float)) \
                 or not math.isfinite(duration_scale) or duration_scale <= 0:
             raise InputError(f"expected a positive number, got {duration_scale!r}", key="duration_scale")

@@ -9,13 +9,21 @@ from pathlib import Path
 from elastokin.core.errors import InputError
 from elastokin.core.files import atomic_output
 from elastokin.core.shipped import DEFAULT_VEHICLE
-from elastokin.vehicle.model.definition import VehicleDefinition
+from elastokin.analysis.kc_test import vehicle_kc
+from elastokin.vehicle.model.definition import BUSHING_MODELS, VehicleDefinition
+from elastokin.vehicle.model.elements import BuildOptions
 from elastokin.vehicle.model.file_overrides import PlaceError, file_value, vehicle_with
 from elastokin.vehicle.model import vehicle_file
 from elastokin.core.documents import Document
 
 #: What the errors of :meth:`Vehicle.with_values` name as their source.
 VALUES_SOURCE = "with_values"
+
+
+def check_bushing_model(bushings: str | None) -> None:
+    """InputError unless ``bushings`` is a bushing model to put on every direction, or None."""
+    if bushings is not None and bushings not in BUSHING_MODELS:
+        raise InputError(f"expected one of {', '.join(BUSHING_MODELS)} or None, got {bushings!r}", key="bushings")
 
 
 @dataclass(frozen=True)
@@ -96,6 +104,25 @@ class Vehicle:
         except PlaceError as exc:
             raise InputError(str(exc), source=VALUES_SOURCE) from None
         return Vehicle(changed)
+
+    def kc_metrics(self, bushings: str | None = None) -> dict[str, dict[str, float]]:
+        """The standard K&C metrics of the car on the virtual rig (``vsim kc``): bump, roll,
+        lateral-force, longitudinal-force and aligning-torque triangles on both axles.
+
+        Args:
+            bushings: one bushing model on every direction (``linear``, ``sts``, ``rt``, ``stvs``);
+                None: as the vehicle file says.
+
+        Returns:
+            ``{"front": {metric: value}, "rear": {...}}``, the unit in each metric's name
+            (``bump_camber_deg_per_m``; ISO 8855 signs: toe-in and camber top-out positive;
+            definitions in :data:`elastokin.analysis.kc_metrics.METRICS`).
+
+        Raises:
+            InputError: an unknown bushing model.
+        """
+        check_bushing_model(bushings)
+        return vehicle_kc(self.definition, BuildOptions(bushing_model=bushings))
 
     def save(self, path: str | Path, *, overwrite: bool = False) -> Path:
         """Write the vehicle file (as changed) to ``path``; its relative references (the tyre's

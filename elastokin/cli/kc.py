@@ -10,12 +10,10 @@ from elastokin.core.shipped import DEFAULT_VEHICLE
 
 
 def _kc(args: argparse.Namespace) -> int:
-    from elastokin.vehicle.model.elements import BuildOptions
-    from elastokin.vehicle.model.vehicle_file import load_vehicle
-    from elastokin.analysis import kc_test
+    from elastokin.api.vehicles import load_vehicle
     from elastokin.presentation.kc_table import format_table
 
-    metrics = kc_test.vehicle_kc(load_vehicle(args.vehicle), BuildOptions(bushing_model=args.bushing_model))
+    metrics = load_vehicle(args.vehicle).kc_metrics(args.bushing_model)
     print(json.dumps(metrics, indent=2) if args.json else format_table(metrics))
     return 0
 

@@ -9,12 +9,13 @@ from elastokin.cli.arguments import output_folder
 
 
 def _plot(args: argparse.Namespace) -> int:
-    from elastokin.presentation.run_plots import plot_run
-    from elastokin.recordings.run_reader import load_run
+    from elastokin.api.runs import load_run
+    from elastokin.presentation.figures import save_figure
 
-    run = load_run(args.run)
-    for path in plot_run(run, args.output, log_time=args.log_time, t0_s=args.t0):
-        print(f"wrote {path}")
+    figures = load_run(args.run).plot("all", log_time=args.log_time, t0_s=args.t0)
+    args.output.mkdir(parents=True, exist_ok=True)
+    for name, figure in figures.items():
+        print(f"wrote {save_figure(figure, args.output / f'{name}.png', dpi=110)}")
     return 0
 
 
