@@ -85,18 +85,52 @@ def test_a_repeated_key_is_refused_rather_than_the_last_one_winning(tmp_path: Pa
         load_vehicle(file)
 
 
+#: A "billion laughs": nine levels of ten-fold expansion (10^9 values) in nine lines.
+BOMB = "".join(f"b{i}: &b{i} [" + ", ".join([f"*b{i - 1}" if i > 1 else "lol"] * 10) + "]\n" for i in range(1, 10))
+
+
 @pytest.mark.parametrize("text,expected", [
-    ("a: &x [1, 2]\nb: *x\n", r"t\.yaml:2: YAML aliases \(\*x\) are not accepted"),
+    (BOMB, r"t\.yaml:6: YAML aliases here expand to more than 200000 values"),   # 10^6 values at b6
+    ("a: &x [1, *x]\n", r"t\.yaml:1: a YAML alias refers to a value from inside it"),
+    ("a: 1\n1e3: x\n1000.0: y\n", r"t\.yaml:3: 1000\.0: duplicate key '1000\.0' \(the key '1e3' of line 2\)"),
+    ("a: &x 3\nb:\n  <<: *x\n", r"t\.yaml:1: a merge key \(<<\) takes a mapping"),
     (b"name: caf\xe9\n", r"t\.yaml: .*UTF-8"),
     ("a: " + "[" * 5000 + "]" * 5000 + "\n", r"t\.yaml: not valid here: nested too deeply"),
     ("a: " + "1" * 5000 + "\n", r"t\.yaml:1: '1+' cannot be read as a value \(Exceeds the limit \(4300 digits\)"),
-], ids=["alias", "latin-1", "deep", "huge-integer"])
-def test_aliases_undecodable_bytes_and_unparsable_yaml_are_refused(tmp_path: Path, text: str | bytes,
-                                                                  expected: str) -> None:
+], ids=["alias-bomb", "alias-cycle", "same-key-spelt-twice", "merge-of-a-number", "latin-1", "deep", "huge-integer"])
+def test_alias_bombs_undecodable_bytes_and_unparsable_yaml_are_refused(tmp_path: Path, text: str | bytes,
+                                                                       expected: str) -> None:
     file = tmp_path / "t.yaml"
     file.write_bytes(text if isinstance(text, bytes) else text.encode())
+    started = time.perf_counter()
     with pytest.raises(InputError, match=expected):
         Document.read(file)
+    assert time.perf_counter() - started < 0.5   # a bomb is counted, not expanded
+
+
+def test_anchors_aliases_and_merge_keys_are_yamls() -> None:
+    """A damper curve shared between the axles by an anchor, a mapping merged and overridden: the
+    data YAML gives, each place its own copy, the lines of the places where the values are written."""
+    text = ("front:\n  damper: &damper {curve: [[-1.0, -900.0], [1.0, 3000.0]]}\n  spring: &spring {rate: 28000.0, preload: auto}\n"
+            "rear:\n  damper: *damper\n  spring:\n    <<: *spring\n    rate: 36000.0\n")
+    doc = Document(text, "car.yaml")
+    assert doc.data == {"front": {"damper": {"curve": [[-1.0, -900.0], [1.0, 3000.0]]},
+                                  "spring": {"rate": 28000.0, "preload": "auto"}},
+                        "rear": {"damper": {"curve": [[-1.0, -900.0], [1.0, 3000.0]]},
+                                 "spring": {"rate": 36000.0, "preload": "auto"}}}
+    assert doc.data["rear"]["damper"] is not doc.data["front"]["damper"]   # changing one leaves the other
+    assert doc.lines[("rear", "spring", "rate")] == 8 and doc.lines[("rear", "spring", "preload")] == 3
+    assert doc.where(("rear", "damper", "curve")) == "car.yaml:2"
+
+
+def test_what_yaml_safe_dump_writes_reads_back_as_the_same_data() -> None:
+    """A scenario of 300 cases built in Python from one mapping: safe_dump writes it with an anchor
+    and 299 aliases, and the reader gives back the data."""
+    case = {"amplitude_mm": 20.0, "frequency_hz": 0.5}
+    data = {"name": "many", "type": "pumping", "vehicle": "c_segment", "cases": [case] * 300}
+    text = yaml.safe_dump(data)
+    assert text.count("*id") == 299
+    assert Document(text, "s.yaml").data == data
 
 
 def test_exponents_without_a_dot_are_numbers_as_in_yaml_1_2_and_written_back_quoted_as_text() -> None:
@@ -261,3 +295,19 @@ def test_a_cut_recording_is_read_as_far_as_it_goes_and_marked_incomplete(short_r
     cut.write_bytes(data[:8])   # the magic bytes only
     with pytest.raises(InputError, match=r"cut\.mcap"):
         load_run(cut)
+
+
+def test_a_vehicle_file_may_share_its_damper_curve_between_the_axles(tmp_path: Path) -> None:
+    """The rear damper written as an alias of the front one is the vehicle with the front's curve
+    written out at the rear, and its errors still name the place."""
+    text = DEFAULT_VEHICLE.read_text()
+    shared = text.replace("  damper:                           #", "  damper: &damper                  #", 1)
+    shared = shared.replace("  damper:\n    curve: [[-1.0, -3000.0], [0.0, 0.0], [1.0, 1200.0]]  # [m/s, N]  # assumption\n",
+                            "  damper: *damper\n", 1)
+    written = text.replace("    curve: [[-1.0, -3000.0], [0.0, 0.0], [1.0, 1200.0]]",
+                           "    curve: [[-1.0, -3600.0], [0.0, 0.0], [1.0, 1400.0]]", 1)
+    assert shared.count("*damper") == 1 and written != text
+    (tmp_path / "shared.yaml").write_text(shared)
+    (tmp_path / "written.yaml").write_text(written)
+    a, b = load_vehicle(tmp_path / "shared.yaml"), load_vehicle(tmp_path / "written.yaml")
+    assert a.rear.damper == b.rear.damper == a.front.damper and (a.front, a.rear, a.bushings) == (b.front, b.rear, b.bushings)

@@ -56,14 +56,23 @@ except ImportError:   # PyYAML built without libyaml
     _SafeLoader = yaml.SafeLoader
 
 
+#: The most values (nodes) and characters of text a document may hold once its aliases are
+#: expanded: a vehicle file holds some 2000 values, a sweep of 300 cases some 5000; a few lines of
+#: anchors and aliases can otherwise stand for gigabytes (a "billion laughs").
+MAX_EXPANDED_NODES = 200_000
+MAX_EXPANDED_CHARS = 20_000_000
+_MERGE = "tag:yaml.org,2002:merge"
+
+
 class _Loader(_SafeLoader):
-    """YAML's safe loader without aliases: a few lines of anchors and aliases can expand to any size."""
+    """YAML's safe loader; anchors, aliases and merge keys (``<<: *base``) are YAML's, their
+    expansion bounded (:func:`_check_expansion`)."""
+
+    aliased = False
 
     def compose_node(self, parent: yaml.Node | None, index: Any) -> yaml.Node:
         if self.check_event(yaml.AliasEvent):
-            event = self.peek_event()
-            raise _Refused(f"YAML aliases (*{event.anchor}) are not accepted; write the value out",
-                           event.start_mark.line + 1)
+            self.aliased = True
         return super().compose_node(parent, index)
 
     def construct_object(self, node: yaml.Node, deep: bool = False) -> Any:
@@ -94,20 +103,90 @@ def dump_yaml(data: Any, **options: Any) -> str:
     return yaml.dump(data, Dumper=_Dumper, **options)
 
 
+def _check_expansion(root: yaml.Node) -> None:
+    """Refuse, at its line, the first value whose aliases expand beyond the bounds, or that an alias
+    inside it refers back to (the sizes are counted over the node graph, not expanded)."""
+    sizes: dict[int, tuple[int, int]] = {}
+    open_: set[int] = set()
+
+    def size(node: yaml.Node) -> tuple[int, int]:
+        if id(node) in sizes:
+            return sizes[id(node)]
+        if id(node) in open_:
+            raise _Refused("a YAML alias refers to a value from inside it", node.start_mark.line + 1)
+        open_.add(id(node))
+        if isinstance(node, yaml.ScalarNode):
+            nodes, chars = 1, len(node.value)
+        else:
+            children = [n for pair in node.value for n in pair] if isinstance(node, yaml.MappingNode) else node.value
+            counted = [size(child) for child in children]
+            nodes, chars = 1 + sum(n for n, _ in counted), sum(c for _, c in counted)
+        open_.discard(id(node))
+        if nodes > MAX_EXPANDED_NODES or chars > MAX_EXPANDED_CHARS:
+            raise _Refused(f"YAML aliases here expand to more than {MAX_EXPANDED_NODES} values or "
+                           f"{MAX_EXPANDED_CHARS} characters; write less of it, or share less", node.start_mark.line + 1)
+        sizes[id(node)] = nodes, chars
+        return nodes, chars
+
+    size(root)
+
+
+def _pairs(loader: _Loader, node: yaml.MappingNode, source: str, path: KeyPath) -> list[tuple[Any, yaml.Node]]:
+    """The (key as the data holds it, value node) pairs of a mapping, its merge keys' mappings
+    (``<<: *base`` or ``<<: [*a, *b]``) giving the keys it does not set itself; InputError at a key
+    written twice (``1e3`` and ``1000.0`` are one key, as they are in the data)."""
+    own: dict[Any, tuple[yaml.ScalarNode, yaml.Node]] = {}
+    merged: list[yaml.Node] = []
+    for key, value in node.value:
+        if not isinstance(key, yaml.ScalarNode):
+            raise _Refused(f"keys must be plain names (at {dotted(path) or 'the top'})", key.start_mark.line + 1)
+        if key.tag == _MERGE:
+            merged += value.value if isinstance(value, yaml.SequenceNode) else [value]
+            continue
+        name = loader.construct_object(key)
+        if name in own:
+            first = own[name][0]
+            also = "" if first.value == key.value else f" (the key {first.value!r} of line {first.start_mark.line + 1})"
+            raise InputError(f"duplicate key {key.value!r}{also}", source=f"{source}:{key.start_mark.line + 1}",
+                             key=dotted(path + (name,)))
+        own[name] = key, value
+    pairs = {name: value for name, (_, value) in own.items()}
+    for base in merged:
+        if not isinstance(base, yaml.MappingNode):
+            raise _Refused("a merge key (<<) takes a mapping or a list of mappings", base.start_mark.line + 1)
+        for name, value in _pairs(loader, base, source, path):
+            pairs.setdefault(name, value)
+    return list(pairs.items())
+
+
+def _unshared(data: Any) -> Any:
+    """``data`` with every mapping and list its own (aliases make one object stand in two places)."""
+    if isinstance(data, dict):
+        return {key: _unshared(value) for key, value in data.items()}
+    if isinstance(data, list):
+        return [_unshared(value) for value in data]
+    return data
+
+
 class Document:
     """A YAML document as plain data plus the line of every key path (from the composed nodes)."""
 
     def __init__(self, text: str, source: str):
-        """Parse ``text``; InputError naming ``source`` when it is not valid YAML, repeats a key, uses
-        an alias or a key that is not a plain scalar, or nests beyond Python's recursion limit."""
+        """Parse ``text``; InputError naming ``source`` when it is not valid YAML, repeats a key
+        (as the data holds it: ``1e3`` and ``1000.0`` are one key), uses a key that is not a plain
+        scalar, expands its aliases beyond :data:`MAX_EXPANDED_NODES` values, refers to a value from
+        inside it, or nests beyond Python's recursion limit."""
         self.source, self.text = source, text
         self.lines: dict[KeyPath, int] = {}
         loader = _Loader(text)
         try:
             node = loader.get_single_node()
-            self.data = loader.construct_document(node) if node is not None else None
             if node is not None:
-                self._index(node, ())
+                _check_expansion(node)
+                self._index(loader, node, ())
+            data = loader.construct_document(node) if node is not None else None
+            # values an alias shares are copies, as if written out: a change to one is not a change to the other
+            self.data = _unshared(data) if loader.aliased else data
         except yaml.YAMLError as exc:
             if "maximum nesting depth" in str(exc):   # libyaml's own limit, before Python's recursion limit
                 raise InputError("not valid here: nested too deeply", source=source) from None
@@ -134,21 +213,14 @@ class Document:
         doc.source, doc.text, doc.data, doc.lines = source, "", data, {}
         return doc
 
-    def _index(self, node: yaml.Node, path: KeyPath) -> None:
+    def _index(self, loader: _Loader, node: yaml.Node, path: KeyPath) -> None:
         self.lines[path] = node.start_mark.line + 1
         if isinstance(node, yaml.MappingNode):
-            seen = set()
-            for key, value in node.value:
-                if not isinstance(key, yaml.ScalarNode):
-                    raise _Refused(f"keys must be plain names (at {dotted(path) or 'the top'})", key.start_mark.line + 1)
-                if key.value in seen:
-                    raise InputError(f"duplicate key {key.value!r}", source=f"{self.source}:{key.start_mark.line + 1}",
-                                     key=dotted(path + (key.value,)))
-                seen.add(key.value)
-                self._index(value, path + (key.value,))
+            for key, value in _pairs(loader, node, self.source, path):
+                self._index(loader, value, path + (key,))
         elif isinstance(node, yaml.SequenceNode):
             for i, item in enumerate(node.value):
-                self._index(item, path + (i,))
+                self._index(loader, item, path + (i,))
 
     def where(self, path: KeyPath) -> str:
         """``file:line`` of ``path`` (or of its closest enclosing node that has a line), else the file."""
