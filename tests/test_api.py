@@ -96,6 +96,8 @@ def test_a_run_saved_later_is_the_recording_made_while_it_ran(pumping: elastokin
     assert back.recorded.body_names and back.recorded.body_pos.shape[0] == len(back)
     with pytest.raises(InputError, match="exists"):
         pumping.save(later)
+    with pytest.raises(InputError, match="/proc: no file can be made here"):
+        pumping.save("/proc/run.mcap")
 
 
 def _spring_rate(run: elastokin.Run, case: int) -> float:

@@ -311,3 +311,45 @@ def test_a_vehicle_file_may_share_its_damper_curve_between_the_axles(tmp_path: P
     (tmp_path / "written.yaml").write_text(written)
     a, b = load_vehicle(tmp_path / "shared.yaml"), load_vehicle(tmp_path / "written.yaml")
     assert a.rear.damper == b.rear.damper == a.front.damper and (a.front, a.rear, a.bushings) == (b.front, b.rear, b.bushings)
+
+
+#: Every command that writes, with what it reads (none of it read before the output is refused)
+#: and whether its output is a folder: (argv before the output option, the option, folder).
+WRITERS = [
+    (["run", "pumping"], "-o", False),
+    (["plot", "run.mcap"], "-o", True),
+    (["view", "run.mcap"], "--save", False),
+    (["compare", "a.mcap", "b.mcap"], "-o", True),
+    (["bushing", "run", "bisine"], "-o", False),
+    (["bushing", "run", "bisine", "-o", "ok.csv"], "--plot", True),
+    (["bushing", "fit", "r.csv"], "-o", False),
+    (["bushings-on-road", "road/step_steer"], "-o", True),
+    (["diagnose", "kc"], "-o", True),
+    (["sweep", "e2_front_kr_co"], "-o", True),
+    (["rig", "import", "d.csv", "--meta", "m.yaml"], "-o", False),
+    (["rig", "measure", "truth.yaml"], "-o", True),
+    (["model", "export", "c_segment"], "-o", False),
+    (["copy", "c_segment"], None, True),
+]
+
+
+@pytest.mark.parametrize("argv, option, folder, place", [
+    (argv, option, folder, place) for argv, option, folder in WRITERS
+    for place in ("proc", "file_for_folder" if folder else "folder_for_file", "under_a_file")],
+    ids=lambda w: w if isinstance(w, str) else None)
+def test_an_output_no_file_can_be_made_at_is_refused_before_any_work(tmp_path: Path, capsys, monkeypatch, argv, option,
+                                                                     folder, place) -> None:
+    """Where no file can be made (/proc, even as root), a file given for a folder and the reverse,
+    a path under a file: refused by the command line with the path and the reason, before anything
+    is read or run (the inputs named here do not exist)."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "a_file").write_text("x")
+    (tmp_path / "a_folder").mkdir()
+    target, words = {"proc": ("/proc/vsim_out", ["/proc", "no file can be made here"]),
+                     "file_for_folder": ("a_file", ["a_file", "is a file; expected a folder"]),
+                     "folder_for_file": ("a_folder", ["a_folder", "is a folder; expected a file"]),
+                     "under_a_file": ("a_file/out", ["a_file", "is a file; it cannot hold"])}[place]
+    code, err = _vsim(capsys, *argv, *([option] if option else []), target)
+    assert code == 2 and "Traceback" not in err, err
+    for word in words:
+        assert word in err, err

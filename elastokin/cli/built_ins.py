@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
+
+from elastokin.cli.arguments import output_folder
 
 
 def _list(args: argparse.Namespace) -> int:
@@ -42,6 +43,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     "vehicle with its tyre's property file; a scenario or sweep naming its vehicle by name; a "
                     "dataset whole. Write `KIND:NAME` where two kinds share a name.")
     copy.add_argument("name", metavar="NAME")
-    copy.add_argument("folder", type=Path, metavar="DIR")
+    copy.add_argument("folder", type=output_folder, metavar="DIR")
     copy.add_argument("--overwrite", action="store_true", help="replace files of the same names in DIR")
     copy.set_defaults(func=_copy)

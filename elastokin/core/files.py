@@ -48,6 +48,13 @@ def check_output(path: str | os.PathLike[str], *, folder: bool = False) -> Path:
         raise InputError(f"is a file; it cannot hold {path}", source=str(ancestor))
     if not os.access(ancestor, os.W_OK | os.X_OK):
         raise InputError(f"cannot write here (permission denied), so not {path}", source=str(ancestor))
+    # permissions do not tell it all (/proc, /sys, a read-only mount, a full disk): make a file there
+    try:
+        fd, probe = tempfile.mkstemp(prefix=".vsim-probe.", dir=ancestor)
+    except OSError as exc:
+        raise InputError(f"no file can be made here ({exc.strerror or exc}), so not {path}", source=str(ancestor)) from None
+    os.close(fd)
+    os.unlink(probe)
     return path
 
 
@@ -84,8 +91,11 @@ def exclusive_folder(folder: Path, writer: str) -> Iterator[None]:
 def atomic_output(path: Path) -> Iterator[Path]:
     """Yield a temporary path beside ``path``; rename it to ``path`` only if the block succeeds,
     so that a reader never sees a half-written file."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=path.suffix, dir=path.parent)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=path.suffix, dir=path.parent)
+    except OSError as exc:
+        raise InputError(f"cannot be written ({exc.strerror or exc})", source=str(path)) from None
     os.close(fd)
     _usual_permissions(tmp, 0o666)
     try:

@@ -18,6 +18,7 @@ from foxglove.messages import (Color, CubePrimitive, CylinderPrimitive, Pose, Qu
                                SpherePrimitive, Vector3)
 
 from elastokin.core.errors import InputError
+from elastokin.core.files import check_output
 from elastokin.recordings.message_layouts import JOINT_STATE_SCHEMA, FrameTransformsLayout, JointStateLayout, timestamp_field
 from elastokin.recordings.run_format import (FORMAT_VERSION, GEOM_KINDS, GEOMETRY_TOPIC, NAME_PATTERN, PARTIAL_SUFFIX,
                                         RUN_RECORD, SIGNAL_TOPIC_PREFIX, SOURCES, STATUS_RECORD, TF_TOPIC, GeomSpec,
@@ -105,7 +106,7 @@ class RunWriter:
         metadata: RunMetadata,
         overwrite: bool = False,
     ):
-        self.path = Path(path)
+        self.path = check_output(path)
         if self.path.exists() and not overwrite:
             raise InputError(
                 "the output exists; pass --overwrite (overwrite=True) to replace it", source=str(self.path)
