@@ -91,6 +91,9 @@ def test_a_run_saved_later_is_the_recording_made_while_it_ran(pumping: elastokin
     streamed = elastokin.Simulation("c_segment", "pumping", duration_scale=QUICK).run(output=tmp_path / "while.mcap")
     assert later.read_bytes() == (tmp_path / "while.mcap").read_bytes()
     assert streamed.save(tmp_path / "again.mcap").read_bytes() == later.read_bytes()
+    # and vsim run's, whose scenario names its car by another spelling of the path
+    assert main(["run", "pumping", "--duration-scale", str(QUICK), "-o", str(tmp_path / "cli.mcap")]) == 0
+    assert (tmp_path / "cli.mcap").read_bytes() == later.read_bytes()
     back = elastokin.load_run(later)
     assert back.complete and np.array_equal(back["camber_fl"], pumping["camber_fl"])
     assert back.recorded.body_names and back.recorded.body_pos.shape[0] == len(back)
@@ -122,6 +125,10 @@ def test_a_value_set_by_its_place_changes_the_car_as_physics_says(pumping: elast
     ({"front.spring.rte": 1.0}, ["front.spring.rte", "rte"]),
     ({"bushings.e2_frnt.y.Kr": 1.0}, ["no bushing 'e2_frnt'"]),
     ({"front.spring.rate": -5.0}, ["front.spring.rate", "-5"]),
+    ({"front.spring.rate": "26000"}, ["with_values: front.spring.rate: expected a finite number, got '26000'"]),
+    ({"front.spring.rate": True}, ["with_values: front.spring.rate: expected a finite number, got True"]),
+    ({"front.spring.rate": None}, ["expected a finite number, got None"]),
+    ({"front.spring.rate": float("nan")}, ["expected a finite number, got nan"]),
 ])
 def test_a_bad_value_is_named_by_its_place(values, words) -> None:
     with pytest.raises(InputError) as error:
@@ -156,7 +163,15 @@ def test_the_built_ins_are_listed_copied_and_run_from_the_copy(tmp_path: Path, c
     assert copy.definition.tyre.property_file == tmp_path / "mine" / "195_65R15.tir"
     built = elastokin.load_vehicle().definition
     assert (copy.definition.front, copy.definition.rear, copy.definition.bushings) == (built.front, built.rear, built.bushings)
-    assert elastokin.load_scenario(tmp_path / "mine" / "pumping.yaml").vehicle == elastokin.load_vehicle().path
+    # the scenario copied beside the copied car runs on it: an edit of the copy is the car the run plays
+    assert elastokin.load_scenario(tmp_path / "mine" / "pumping.yaml").vehicle == tmp_path / "mine" / "c_segment.yaml"
+    edited = (tmp_path / "mine" / "c_segment.yaml").read_text().replace("rate: 28000.0", "rate: 42000.0", 1)
+    (tmp_path / "mine" / "c_segment.yaml").write_text(edited)
+    sim = elastokin.Simulation(None, tmp_path / "mine" / "pumping.yaml", duration_scale=QUICK)
+    assert sim.vehicle.value("front.spring.rate") == 42000.0
+    # copied alone, a scenario names the built-in car
+    assert main(["copy", "pumping", "alone"]) == 0
+    assert elastokin.load_scenario(tmp_path / "alone" / "pumping.yaml").vehicle == elastokin.load_vehicle().path
     assert main(["copy", "pumping", "mine"]) == 2
     assert "already there" in capsys.readouterr().err
     assert main(["copy", "pumpin", "mine"]) == 2
@@ -168,6 +183,8 @@ def test_the_shipped_datasets_are_found_by_name(tmp_path: Path, monkeypatch) -> 
     assert elastokin.dataset("kc") == ROOT / "data" / "rig" / "kc"
     with pytest.raises(InputError, match="shipped ones: bench, kc"):
         elastokin.dataset("kc_exampel")
+    (tmp_path / "kc").mkdir()   # a folder of that name that is no dataset does not hide the shipped one
+    assert elastokin.dataset("kc") == ROOT / "data" / "rig" / "kc"
     with pytest.raises(InputError, match="--bushing-set"):
         elastokin.diagnose("bench")
     with pytest.raises(InputError, match="not a bushing set"):
@@ -247,3 +264,21 @@ def test_the_kc_metrics_of_a_vehicle_are_those_of_vsim_kc(monkeypatch) -> None:
     assert [b[1].bushing_model for b in built] == [None, "stvs"]
     with pytest.raises(InputError, match="bushings.*linear, sts, rt, stvs"):
         car.kc_metrics("magic")
+
+
+def test_a_rig_recordings_roll_metrics_take_the_measured_car(tmp_path: Path) -> None:
+    """A measured roll recording carries no vehicle: its roll metrics need the car's tyre radius,
+    given as the vehicle, and then are those of the run's own base."""
+    run = elastokin.load_run(ROOT / "data" / "rig" / "kc" / "02_kc_roll.mcap")
+    with pytest.raises(InputError, match=r"give the vehicle \(Run.metrics\(vehicle=...\)\)"):
+        run.metrics()
+    metrics = run.metrics(elastokin.load_vehicle())
+    assert {"roll_steer_deg_per_deg", "roll_camber_deg_per_deg"} <= set(metrics[1]["front"])
+    assert "roll_camber_deg_per_deg" in run.summary(elastokin.load_vehicle())
+
+
+def test_the_front_doors_objects_say_briefly_what_they_are(pumping: elastokin.Run) -> None:
+    car = elastokin.load_vehicle()
+    assert repr(car) == f"<Vehicle 'c_segment' from {car.path}>" and len(repr(car)) < 200
+    assert repr(car.with_values({"front.spring.rate": 30000.0})).endswith(", changed in code>")
+    assert repr(pumping).startswith("<Run pumping (pumping): 6 case(s)")

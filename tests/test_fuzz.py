@@ -22,6 +22,7 @@ import os
 import resource
 import shutil
 import signal
+import warnings
 from collections import Counter
 from pathlib import Path
 from typing import Any, Callable, Iterator
@@ -44,7 +45,7 @@ from elastokin.core.errors import InputError
 from elastokin.core.shipped import BENCH_DIR, DEFAULT_VEHICLE, PARAMETER_SET_DIR, SCENARIO_DIR, SWEEP_DIR
 from elastokin.recordings.bench_dataset import read_bench_dataset
 from elastokin.recordings.csv_import import import_csv
-from elastokin.recordings.run_reader import load_run
+from elastokin.recordings.run_reader import DamagedRecording, load_run
 from elastokin.sweeps.sweep_file import load_sweep
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -366,12 +367,34 @@ def recording(tmp_path_factory: pytest.TempPathFactory) -> bytes:
     return import_csv(EXAMPLE / "kc_pumping.csv", meta, folder / "rig.mcap").read_bytes()
 
 
+def _chunk_spans(recording: bytes) -> list[tuple[int, int]]:
+    """(start, end) byte offsets of each chunk record of an MCAP file (opcode 0x06: 1 + 8 + length bytes)."""
+    spans, at = [], 8
+    while at + 9 <= len(recording):
+        opcode, length = recording[at], int.from_bytes(recording[at + 1:at + 9], "little")
+        if opcode == 0x06:
+            spans.append((at, at + 9 + length))
+        if opcode == 0x0F:   # the data section's end
+            break
+        at += 9 + length
+    return spans
+
+
+def load_run_quietly(recording: bytes, folder: Path):
+    """The original recording, read."""
+    path = folder / "original.mcap"
+    path.write_bytes(recording)
+    return load_run(path)
+
+
 @fuzz("mcap")
 @given(st.data())
 def test_mcap_runs(recording: bytes, folder: Path, data: st.DataObject) -> None:
-    """Truncated, flipped, zeroed or spliced recordings: a result (maybe marked incomplete) or an error."""
+    """Truncated, flipped, zeroed, spliced recordings, or with a chunk dropped: an error, or a run
+    read as far as it goes with a DamagedRecording warning for each part missing; never a run that
+    differs from the original without a word."""
     raw = bytearray(recording)
-    action = data.draw(st.sampled_from(["truncate", "flip", "zero", "splice", "empty"]))
+    action = data.draw(st.sampled_from(["truncate", "flip", "zero", "splice", "drop_chunk", "empty"]))
     at = data.draw(st.integers(0, len(raw) - 1))
     if action == "truncate":
         raw = raw[:at]
@@ -382,14 +405,26 @@ def test_mcap_runs(recording: bytes, folder: Path, data: st.DataObject) -> None:
         raw[at:end] = bytes(end - at)
     elif action == "splice":
         raw = raw[:at] + raw[data.draw(st.integers(0, len(raw) - 1)):]
+    elif action == "drop_chunk":
+        spans = _chunk_spans(recording)
+        start, end = spans[data.draw(st.integers(0, len(spans) - 1))]
+        raw = raw[:start] + raw[end:]
     else:
         raw = bytearray()
     path = folder / "run.mcap"
     path.write_bytes(bytes(raw))
+    original = load_run_quietly(recording, folder)
 
     def use() -> None:
-        run = load_run(path)
+        with warnings.catch_warnings(record=True) as said:
+            warnings.simplefilter("always")
+            run = load_run(path)
+        damaged = [w for w in said if issubclass(w.category, DamagedRecording)]
         if action == "truncate" and at < len(recording) - 64:
-            assert not run.complete and "ends" in run.reason, run.reason
+            assert not run.complete and damaged and "cut" in run.reason, run.reason
         assert all(v.shape == run.t_s.shape for v in run.signals.values())
+        assert bool(damaged) == bool(run.damage)
+        if not damaged:   # read as a whole file: then it is the original's data
+            assert np.array_equal(run.t_s, original.t_s) and run.metadata == original.metadata
+            assert all(np.array_equal(run.signals[k], original.signals[k], equal_nan=True) for k in original.signals)
     check("mcap", outcome(use), False, "")

@@ -5,7 +5,9 @@ test (test_fuzz.py) draws many more; these pin the classes the issue lists."""
 from __future__ import annotations
 
 import copy
+import json
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -17,6 +19,7 @@ import numpy as np
 import pytest
 import yaml
 
+import elastokin
 from elastokin.bushings.bench.bench_file import load_bench
 from elastokin.bushings.bench.records import read_bench_csv
 from elastokin.vehicle.model.builder import build
@@ -353,3 +356,77 @@ def test_an_output_no_file_can_be_made_at_is_refused_before_any_work(tmp_path: P
     assert code == 2 and "Traceback" not in err, err
     for word in words:
         assert word in err, err
+
+
+@pytest.fixture(scope="module")
+def chunked_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A pumping run of a few MB: a dozen chunks of 1 MiB."""
+    output = tmp_path_factory.mktemp("chunked") / "run.mcap"
+    assert main(["run", "pumping", "--duration-scale", "0.25", "-o", str(output)]) == 0
+    return output
+
+
+def _first_chunk(data: bytes) -> int:
+    """The byte offset of an MCAP file's first chunk record (opcode 0x06, after 1 + 8 + length bytes each)."""
+    at = 8
+    while data[at] != 0x06:
+        at += 9 + int.from_bytes(data[at + 1:at + 9], "little")
+    return at
+
+
+def _damaged(source: Path, folder: Path, kind: str) -> Path:
+    data = source.read_bytes()
+    middle = len(data) // 2
+    damaged = {"cut_half": data[:middle], "inverted": data[:middle] + bytes(b ^ 0xFF for b in data[middle:middle + 64])
+               + data[middle + 64:], "cut_last_byte": data[:-1], "cut_at_start": data[:_first_chunk(data) + 1000]}[kind]
+    path = folder / f"{kind}.mcap"
+    path.write_bytes(damaged)
+    return path
+
+
+@pytest.mark.parametrize("kind, words, whole", [
+    ("cut_half", [r"recording cut at \d+\.\d s of its 33\.\d s \(it ends early: no summary section\): read as far as it goes"],
+     False),
+    ("inverted", [r"chunk \d+ of \d+ failed its CRC: \d\.\d s missing \(t = \d+\.\d to \d+\.\d s\)"], False),
+    ("cut_last_byte", [r"its summary section is cut \(the file ends inside a record\); its data is whole"], True),
+])
+def test_a_damaged_recording_is_said_damaged_by_every_reader(chunked_run: Path, tmp_path: Path, capsys, kind, words,
+                                                            whole) -> None:
+    """Cut short, 64 bytes inverted, its summary cut: read as far as it goes, the part missing said on
+    stderr by plot, view, compare, in the run (reason, damage) and the comparison; --strict refuses it."""
+    original = load_run(chunked_run)
+    path = _damaged(chunked_run, tmp_path, kind)
+    with pytest.warns(UserWarning) as said:
+        run = load_run(path)
+    message = str(said[0].message)
+    assert all(re.search(w, message) for w in words), message
+    assert run.complete == whole and run.damage == (message.removeprefix(f"{path}: "),)
+    if whole:
+        assert np.array_equal(run.t_s, original.t_s)
+    else:   # what is read is the original's, less what is said missing
+        assert 0 < len(run.t_s) < len(original.t_s) and np.all(np.isin(run.t_s, original.t_s))
+        kept = np.isin(original.t_s, run.t_s)
+        assert np.array_equal(run.signals["camber_fl"], original.signals["camber_fl"][kept])
+    for argv in (["plot", str(path), "-o", str(tmp_path / "p")], ["view", str(path), "--save", str(tmp_path / "v.rrd")],
+                 ["compare", str(path), str(chunked_run), "-o", str(tmp_path / "c")]):
+        code, err = _vsim(capsys, *argv)
+        # a run cut in half lacks the cases a comparison needs: compared, it is refused, the cut said first
+        refused = argv[0] == "compare" and kind == "cut_half"
+        assert code == (2 if refused else 0) and f"vsim: warning: {message}" in err, (argv, err)
+        code, err = _vsim(capsys, *argv, "--strict", *(["--overwrite"] if argv[0] == "view" else []))
+        assert code == 2 and "damaged, and refused as strict reading asks" in err, (argv, err)
+    if kind != "cut_half":
+        comparison = json.loads((tmp_path / "c" / "comparison.json").read_text())
+        assert comparison["damage"] == {str(path): [message.removeprefix(f"{path}: ")]}
+    with pytest.raises(InputError, match="damaged"):
+        elastokin.load_run(path, strict=True)
+
+
+def test_a_recording_cut_before_its_first_sample_is_refused_by_plot_and_view(chunked_run: Path, tmp_path: Path,
+                                                                            capsys) -> None:
+    path = _damaged(chunked_run, tmp_path, "cut_at_start")
+    for argv, what in ((["plot", str(path), "-o", str(tmp_path / "p")], "plot"),
+                       (["view", str(path), "--save", str(tmp_path / "v.rrd")], "replay")):
+        code, err = _vsim(capsys, *argv)
+        assert code == 2 and "recording cut before its first whole sample" in err and "Traceback" not in err, err
+        assert f"holds no whole sample: nothing to {what}" in err

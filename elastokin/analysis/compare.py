@@ -28,7 +28,7 @@ Differences are simulation minus rig.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
 
@@ -96,12 +96,13 @@ class Comparison:
     scenario: str
     x_quantity: str | None
     cases: list[CaseComparison]
+    damage: dict[str, list[str]] = field(default_factory=dict)   #: by file: what a damaged one could not give
 
     def to_json(self) -> dict[str, Any]:
         """The comparison as plain JSON data (``comparison.json``)."""
         return {
             "sim": str(self.sim), "rig": str(self.rig), "scenario": self.scenario, "x_quantity": self.x_quantity,
-            "difference": "simulation - rig",
+            "difference": "simulation - rig", "damage": self.damage,
             "cases": [{"case": c.case, "label": c.label, "not_applicable": c.not_applicable,
                        "channels": [{"channel": ch.channel, "unit": ch.unit, "rms_error": ch.rms_error,
                                      **{name: m.to_json() for name, m in ch.metrics.items()}}
@@ -237,4 +238,5 @@ def compare_runs(sim: Run, rig: Run) -> Comparison:
             metrics = {m: Metric(unit, value, theirs[m][1]) for m, (unit, value) in mine.items() if m in theirs}
             channels.append(ChannelComparison(name, sim.units[name], rms_error(a, b) if a.size else math.nan, metrics))
         out.append(CaseComparison(sim_case["case"], sim_case["label"], channels, _not_applicable(sim, sim_case)))
-    return Comparison(sim.path, rig.path, sim.metadata.extra["scenario"], sim.metadata.extra["x_quantity"], out)
+    damage = {str(run.path): list(run.damage) for run in (sim, rig) if run.damage}
+    return Comparison(sim.path, rig.path, sim.metadata.extra["scenario"], sim.metadata.extra["x_quantity"], out, damage)

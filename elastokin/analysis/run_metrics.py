@@ -194,16 +194,19 @@ def case_dynamic_stiffness(run: Run, case: Mapping[str, Any], force: str, displa
 
 
 # -- the named K&C metrics -------------------------------------------------------------------------
-def contact_base_m(run: Run) -> dict[str, float]:
+def contact_base_m(run: Run, radius_m: float | None = None) -> dict[str, float]:
     """Lateral distance between the left and right contact points of each axle at design [m]
     (`vsim kc`'s roll base), from the first sample's wheel centres and cambers (the runner records
-    the design pose first) and the tyre radius of the run's vehicle: contact = centre − r × the
-    wheel plane's up direction. InputError for a run without a vehicle (a rig recording)."""
+    the design pose first) and the tyre radius ``radius_m`` (default: that of the run's vehicle):
+    contact = centre − r × the wheel plane's up direction. InputError for a run without a vehicle
+    (a rig recording) and no radius given."""
     try:
-        radius = float(Document(run.metadata.vehicle_yaml, str(run.path)).data["tyre"]["radius"])
+        radius = float(Document(run.metadata.vehicle_yaml, str(run.path)).data["tyre"]["radius"]) \
+            if radius_m is None else float(radius_m)
     except (TypeError, KeyError, ValueError) as exc:  # an InputError (not YAML) is a ValueError
-        raise InputError("roll metrics need the design contact-point base, from the tyre radius of the run's "
-                         "vehicle, and this run has none (pass contact_base)", source=str(run.path)) from exc
+        raise InputError("roll metrics need the design contact-point base, from the tyre radius of the measured "
+                         "vehicle, and a rig recording holds no vehicle: give the vehicle (Run.metrics(vehicle=...))",
+                         source=str(run.path)) from exc
     out = {}
     for axle in ("front", "rear"):
         left, right = (CORNER_TAGS[f"{axle}_{side}"] for side in ("left", "right"))

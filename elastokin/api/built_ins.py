@@ -58,8 +58,8 @@ def built_ins() -> dict[str, list[str]]:
 
 
 def dataset(name_or_path: str | Path) -> Path:
-    """The folder of a measured dataset: ``name_or_path`` if it is a folder, else the shipped
-    example of that name (``kc``: a K&C campaign; ``bench``: a bushing bench's tests).
+    """The folder of a measured dataset: ``name_or_path`` if it is a folder with a ``rig.yaml``, else
+    the shipped example of that name (``kc``: a K&C campaign; ``bench``: a bushing bench's tests).
 
     Raises:
         InputError: neither (the shipped names listed).
@@ -69,12 +69,13 @@ def dataset(name_or_path: str | Path) -> Path:
     True
     """
     path = Path(name_or_path)
-    if path.is_dir():
+    if (path / "rig.yaml").is_file():
         return path
     names = _names(KINDS[-1])
     if str(name_or_path) in names:
         return DATASET_DIR / str(name_or_path)
-    raise InputError(f"no such dataset folder, and no shipped example of that name; shipped ones: {', '.join(names)}",
+    raise InputError(f"no dataset folder (with a rig.yaml) there, and no shipped example of that name; shipped ones: "
+                     f"{', '.join(names)}",
                      source=str(path))
 
 
@@ -91,9 +92,10 @@ def _find(name: str) -> tuple[Kind, Path]:
     return kind, (kind.folder / bare if not kind.suffix else kind.folder / f"{bare}{kind.suffix}")
 
 
-def _named(text: str, key: str, folder: Path, suffix: str, base: Path) -> str:
-    """``text`` with the top-level ``key``'s value replaced by a built-in's name where it is a path
-    into the shipped ``folder`` (a copy elsewhere keeps finding it)."""
+def _named(text: str, key: str, folder: Path, suffix: str, base: Path, into: Path) -> str:
+    """``text`` with the top-level ``key``'s value replaced, where it is a path into the shipped
+    ``folder``, by the copy of that file in ``into`` when there is one (a copied vehicle, to edit),
+    else by the built-in's name (a copy elsewhere keeps finding it)."""
     match = re.search(rf"^({re.escape(key)}:\s*)([^\s#]+)", text, flags=re.M)
     if match is None:
         return text
@@ -104,6 +106,8 @@ def _named(text: str, key: str, folder: Path, suffix: str, base: Path) -> str:
     if folder.resolve() not in target.parents:
         return text
     name = target.relative_to(folder.resolve()).with_suffix("").as_posix()
+    if (into / target.name).is_file():
+        name = target.name
     return text[:match.start(2)] + name + text[match.end(2):]
 
 
@@ -111,8 +115,9 @@ def copy_built_in(name: str, folder: str | Path, *, overwrite: bool = False) -> 
     """An editable copy of the built-in ``name`` in ``folder``, that runs from there as it is.
 
     A vehicle comes with its tyre's property file (the copy's ``property_file`` names it); a
-    scenario's or sweep's ``vehicle`` that points into the shipped vehicles becomes the built-in's
-    name; a dataset is copied whole. Bushing sets named by a vehicle stay built-ins (copy one with
+    scenario's or sweep's ``vehicle`` that points into the shipped vehicles names the copy of that
+    vehicle in ``folder`` when there is one (copy the vehicle first, to run the scenario on your
+    edits), else the built-in by its name; a dataset is copied whole. Bushing sets named by a vehicle stay built-ins (copy one with
     its name, then name the copy's path in the vehicle file).
 
     Args:
@@ -135,7 +140,7 @@ def copy_built_in(name: str, folder: str | Path, *, overwrite: bool = False) -> 
     else:
         text = read_text(source)
         if kind.folder in (SCENARIO_DIR, SWEEP_DIR):
-            text = _named(text, "vehicle", VEHICLE_DIR, ".yaml", source.parent)
+            text = _named(text, "vehicle", VEHICLE_DIR, ".yaml", source.parent, folder)
         if kind.folder == VEHICLE_DIR:
             match = re.search(r"^(\s+property_file:\s*)([^\s#]+)", text, flags=re.M)
             if match is not None:

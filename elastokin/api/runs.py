@@ -12,11 +12,13 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from elastokin.analysis.road_metrics import road_metrics
-from elastokin.analysis.run_metrics import cases, is_road, run_metrics
+from elastokin.analysis.run_metrics import cases, contact_base_m, is_road, run_metrics
+from elastokin.api.vehicles import Vehicle
 from elastokin.core.units import in_si
 from elastokin.presentation.run_plots import pair_figures, time_figures
 from elastokin.presentation.run_summary import summary
 from elastokin.recordings import run_reader
+from elastokin.recordings.run_reader import check_samples
 from elastokin.recordings.run_format import Run as RecordedRun
 from elastokin.recordings.run_writer import write_run
 
@@ -143,21 +145,33 @@ class Run:
                 return (self.t_s >= c["start_s"] - 1e-9) & (self.t_s <= c["end_s"] + 1e-9)
         raise KeyError(f"no case {number}; the run has cases 1 to {len(self.cases)}")
 
-    def metrics(self) -> dict[int, dict[str, Any]]:
+    def metrics(self, vehicle: Vehicle | None = None) -> dict[int, dict[str, Any]]:
         """The metrics ``vsim run`` prints, as data, by case number.
+
+        Args:
+            vehicle: the car a rig recording measured: its tyre radius gives the design
+                contact-point base that defines the roll angle (a simulated run carries its own).
 
         Returns:
             On the road, ``{case: {metric: value}}`` (ISO 7401 / 4138 definitions,
             :data:`elastokin.analysis.road_metrics.METRICS` names their units); on the rig,
             ``{case: {axle: {metric: value}}}`` (the K&C metrics of ``vsim kc``,
             :data:`elastokin.analysis.kc_metrics.METRICS`), for the cases whose input gives them.
-        """
-        metrics = road_metrics(self.recorded) if is_road(self.recorded) else run_metrics(self.recorded)
-        return _plain(metrics)
 
-    def summary(self) -> str:
-        """The text summary ``vsim run`` prints (gradients, loop widths, metrics, peak deflections)."""
-        return summary(self.recorded)
+        Raises:
+            InputError: roll metrics of a rig recording without its ``vehicle``.
+        """
+        if is_road(self.recorded):
+            return _plain(road_metrics(self.recorded))
+        return _plain(run_metrics(self.recorded, self._contact_base(vehicle)))
+
+    def summary(self, vehicle: Vehicle | None = None) -> str:
+        """The text summary ``vsim run`` prints (gradients, loop widths, metrics, peak deflections);
+        ``vehicle`` as for :meth:`metrics`."""
+        return summary(self.recorded, self._contact_base(vehicle))
+
+    def _contact_base(self, vehicle: Vehicle | None) -> dict[str, float] | None:
+        return None if vehicle is None else contact_base_m(self.recorded, vehicle.definition.tyre.radius)
 
     def plot(self, what: str = "pairs", *, log_time: bool = False, t0_s: float = 0.0) -> dict[str, Figure]:
         """Matplotlib figures of the run, in the recording's units (as ``vsim plot`` draws them).
@@ -173,11 +187,13 @@ class Run:
 
         Raises:
             ValueError: ``what`` is none of :data:`PLOTS`.
+            InputError: the run holds no sample (a recording cut before its first).
         """
         if what not in PLOTS:
             raise ValueError(f"what={what!r}; expected one of {', '.join(PLOTS)}")
-        pairs = pair_figures(self.recorded) if what in ("pairs", "all") else {}
-        times = time_figures(self.recorded, log_time=log_time, t0_s=t0_s) if what in ("time", "all") else {}
+        check_samples(self.recorded, "plot")
+        pairs = dict(pair_figures(self.recorded)) if what in ("pairs", "all") else {}
+        times = dict(time_figures(self.recorded, log_time=log_time, t0_s=t0_s)) if what in ("time", "all") else {}
         return {**pairs, **times}
 
     def save(self, path: str | Path, *, overwrite: bool = False) -> Path:
@@ -211,12 +227,19 @@ def _plain(value: Any) -> Any:
     return float(value) if isinstance(value, np.floating) else value
 
 
-def load_run(path: str | Path) -> Run:
+def load_run(path: str | Path, *, strict: bool = False) -> Run:
     """Read a recorded run (an MCAP file of ``vsim run``, ``vsim rig import`` or :meth:`Run.save`).
 
+    A damaged file (cut short, a chunk failing its CRC) is read as far as it goes, with a
+    :class:`~elastokin.recordings.run_reader.DamagedRecording` warning for each part missing, and
+    the run marked incomplete (:attr:`Run.reason` says what is missing).
+
+    Args:
+        path: the MCAP file.
+        strict: refuse a damaged file instead.
+
     Raises:
-        InputError: the file is missing, unreadable or not a run file. A file cut short is read as
-            far as it goes and the run marked incomplete (:attr:`Run.reason` says why).
+        InputError: the file is missing, unreadable or not a run file; with ``strict``, damaged.
     """
-    return Run(run_reader.load_run(path))
+    return Run(run_reader.load_run(path, strict=strict))
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -35,6 +36,10 @@ class Vehicle:
     """
 
     definition: VehicleDefinition
+
+    def __repr__(self) -> str:
+        changed = "" if vehicle_file.as_filed(self.definition) else ", changed in code"
+        return f"<Vehicle {self.name!r} from {self.path}{changed}>"
 
     @property
     def name(self) -> str:
@@ -87,8 +92,8 @@ class Vehicle:
             The changed vehicle, validated as a file is.
 
         Raises:
-            InputError: a place that is not a number of the file, or a value the file refuses
-                (named by its place).
+            InputError: a place that is not a number of the file, a value that is not a finite
+                number, or one the file refuses (named by its place; source ``with_values``).
 
         >>> import elastokin
         >>> car = elastokin.load_vehicle("c_segment")
@@ -97,8 +102,13 @@ class Vehicle:
         >>> car.value("bushings.e2_front.y.Kr")       # the original is unchanged
         2935.0
         """
-        for place in values:
-            self.value(place)   # the place named before any value is set
+        for place, number in values.items():
+            try:
+                file_value(Document(self.text, str(self.path)).data, place)
+            except PlaceError as exc:
+                raise InputError(str(exc), source=VALUES_SOURCE, key=place) from None
+            if isinstance(number, bool) or not isinstance(number, (int, float)) or not math.isfinite(number):
+                raise InputError(f"expected a finite number, got {number!r}", source=VALUES_SOURCE, key=place)
         try:
             changed = vehicle_with(self.text, self.path, dict(values), VALUES_SOURCE)
         except PlaceError as exc:

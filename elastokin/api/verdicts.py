@@ -24,6 +24,9 @@ class Diagnosis:
     data: Callable[[Any], dict[str, Any]] = field(repr=False)
     report: Callable[[Path], list[Path]] = field(repr=False)
 
+    def __repr__(self) -> str:
+        return f"<Diagnosis of {self.dataset} ({self.level}): {self.verdict}>"
+
     @property
     def verdict(self) -> str:
         """The verdict in one sentence (the cause, its place and value, or why none is named)."""

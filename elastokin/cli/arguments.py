@@ -54,3 +54,10 @@ def positive_count(text: str) -> int:
     if not text.strip().isdigit() or int(text) < 1:
         raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}")
     return int(text)
+
+
+def add_strict_option(parser: argparse.ArgumentParser) -> None:
+    """``--strict``: a damaged recording refused rather than read as far as it goes."""
+    parser.add_argument("--strict", action="store_true",
+                        help="refuse a damaged recording (cut short, a chunk failing its CRC) instead of reading it "
+                             "as far as it goes with a warning")

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from elastokin.cli.arguments import output_folder
+from elastokin.cli.arguments import add_strict_option, output_folder
 
 
 def _compare(args: argparse.Namespace) -> int:
@@ -13,7 +13,7 @@ def _compare(args: argparse.Namespace) -> int:
     from elastokin.presentation.comparison_report import format_table, write_outputs
     from elastokin.recordings.run_reader import load_run
 
-    sim, rig = load_run(args.sim), load_run(args.rig)
+    sim, rig = load_run(args.sim, strict=args.strict), load_run(args.rig, strict=args.strict)
     comparison = compare_runs(sim, rig)
     print(format_table(comparison))
     if args.output is not None:
@@ -34,4 +34,5 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     compare.add_argument("rig", type=Path, metavar="RIG.mcap", help="measured rig recording of the same scenario")
     compare.add_argument("-o", "--output", type=output_folder, metavar="DIR",
                          help="also write DIR/comparison.json and loop and time-history overlays (PNG)")
+    add_strict_option(compare)
     compare.set_defaults(func=_compare)

@@ -59,7 +59,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     group.add_argument("--bushing-set", metavar="SET",
                        help="baseline bushing parameter set, a name (`vsim list`) or a YAML path (bench datasets)")
     p.add_argument("-o", "--output", type=output_folder, metavar="REPORT_DIR",
-                   help="write report.md, PNGs, diagnosis.json and extended_model.yaml here")
+                   help="write report.md, PNGs, diagnosis.json and the extended model here (extended_model.yaml for a bench, "
+                        "extended_vehicle.yaml for K&C)")
     p.add_argument("--json", action="store_true", help="print the verdict as one JSON object")
     add_scheduler_options(p, "K&C datasets: ")
     p.set_defaults(func=_diagnose, compiles=True)

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import warnings
 from types import ModuleType
 
 from elastokin.cli import (built_ins, bushing_fit, bushing_run, bushings_on_road, compare, compile, diagnose, kc, model_export,
@@ -36,7 +37,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="vsim", description="Full-vehicle transient simulation with hysteretic, "
                                                               "viscoelastic rubber bushings.",
                                      epilog="Built-in vehicles, scenarios and data: `vsim list`. From Python: "
-                                            "`import elastokin` (README: the Python API).")
+                                            "`import elastokin` (README: From Python).")
     parser.add_argument("--version", action="version", version=f"vsim (elastokin) {software_version()}")
     sub = parser.add_subparsers(dest="command", required=True)
     for entry in ORDER:
@@ -51,9 +52,22 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """A damaged recording's warning as one line of vsim's own (``vsim: warning: FILE: what is
+    missing``); any other as Python shows it."""
+    if category.__name__ == "DamagedRecording":
+        print(f"vsim: warning: {message}", file=sys.stderr, flush=True)
+    else:
+        _python_warning(message, category, filename, lineno, file, line)
+
+
+_python_warning = warnings.showwarning
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run ``vsim`` with ``argv``; input errors print one clear line and exit with status 2, Ctrl-C
-    and SIGTERM one line and 128 + the signal's number."""
+    and SIGTERM one line and 128 + the signal's number; a damaged recording's warnings one line each."""
+    warnings.showwarning = _show_warning
     args = build_parser().parse_args(argv)
     handle_sigterm()
     try:

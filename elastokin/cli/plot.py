@@ -5,17 +5,17 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from elastokin.cli.arguments import output_folder
+from elastokin.cli.arguments import add_strict_option, output_folder
 
 
 def _plot(args: argparse.Namespace) -> int:
-    from elastokin.api.runs import load_run
-    from elastokin.presentation.figures import save_figure
+    from elastokin.presentation.run_plots import plot_run
+    from elastokin.recordings.run_reader import check_samples, load_run
 
-    figures = load_run(args.run).plot("all", log_time=args.log_time, t0_s=args.t0)
-    args.output.mkdir(parents=True, exist_ok=True)
-    for name, figure in figures.items():
-        print(f"wrote {save_figure(figure, args.output / f'{name}.png', dpi=110)}")
+    run = load_run(args.run, strict=args.strict)
+    check_samples(run, "plot")
+    for path in plot_run(run, args.output, log_time=args.log_time, t0_s=args.t0):   # a figure at a time
+        print(f"wrote {path}")
     return 0
 
 
@@ -31,4 +31,5 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     plot.add_argument("-o", "--output", type=output_folder, required=True, metavar="DIR", help="directory for the PNGs")
     plot.add_argument("--log-time", action="store_true", help="time axis in log scale (relaxations), from --t0 on")
     plot.add_argument("--t0", type=float, default=0.0, metavar="SECONDS", help="time origin (e.g. of the step)")
+    add_strict_option(plot)
     plot.set_defaults(func=_plot)

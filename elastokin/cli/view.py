@@ -5,17 +5,18 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from elastokin.cli.arguments import output_file
+from elastokin.cli.arguments import add_strict_option, output_file
 from elastokin.core.errors import InputError
 
 
 def _view(args: argparse.Namespace) -> int:
     from elastokin.presentation.replay import replay
-    from elastokin.recordings.run_reader import load_run
+    from elastokin.recordings.run_reader import check_samples, load_run
 
     if args.save is not None and args.save.exists() and not args.overwrite:
         raise InputError("the output exists; pass --overwrite to replace it", source=str(args.save))
-    run = load_run(args.run)
+    run = load_run(args.run, strict=args.strict)
+    check_samples(run, "replay")
     replay(run, save=args.save, spawn=args.spawn or args.save is None)
     if args.save is not None:
         print(f"wrote {args.save}")
@@ -33,4 +34,5 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     view.add_argument("--save", type=output_file, metavar="RUN.rrd", help="write the recording (with its layout) to this file")
     view.add_argument("--spawn", action="store_true", help="also show it in a Rerun viewer when saving")
     view.add_argument("--overwrite", action="store_true", help="replace an existing --save file")
+    add_strict_option(view)
     view.set_defaults(func=_view)

@@ -27,6 +27,7 @@ def format_table(c: Comparison) -> str:
     metric's simulation, rig and difference (simulation − rig), and the RMS error."""
     x = f", x = {c.x_quantity}" if c.x_quantity else ""
     lines = [f"{c.sim} (simulation) against {c.rig} (rig), scenario {c.scenario}{x}; diff = simulation − rig"]
+    lines += [f"DAMAGED {path}: {item}" for path, items in c.damage.items() for item in items]
     for case in c.cases:
         lines.append(f"case {case.case} '{case.label}'")
         why: dict[str, list[str]] = {}

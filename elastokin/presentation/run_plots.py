@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import itertools
 import math
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -33,14 +35,13 @@ def _title(run: Run, what: str) -> str:
     return f"{run.path.name}: {what}{status}"
 
 
-def pair_figures(run: Run) -> dict[str, Figure]:
-    """One figure per group of the y signal, a panel per (x, y) pair; a dot marks the start. Keyed by
+def pair_figures(run: Run) -> Iterator[tuple[str, Figure]]:
+    """One figure per group of the y signal, a panel per (x, y) pair; a dot marks the start; each with
     the file name :func:`plot_run` gives it (``loops_bushing_e2_front_left``, ``pairs_camber``)."""
     by_group: dict[tuple[str, str], list[tuple[str, str]]] = {}
     for x, y in run.pairs():
         kind = "loops" if y.endswith("_force") and x.endswith("_deflection") else "pairs"
         by_group.setdefault((kind, run.groups[y]), []).append((x, y))
-    figures = {}
     for (kind, group), pairs in by_group.items():
         fig, axes = _grid(len(pairs), 3, PAIR_PANEL_IN)
         for ax, (x, y) in zip(axes, pairs):
@@ -51,17 +52,15 @@ def pair_figures(run: Run) -> dict[str, Figure]:
             ax.grid(True, alpha=0.3)
         what = "force-deflection loops" if kind == "loops" else "signal pairs"
         fig.suptitle(_title(run, f"{group}, {what}"))
-        figures[f"{kind}_{group}"] = fig
-    return figures
+        yield f"{kind}_{group}", fig
 
 
-def time_figures(run: Run, *, log_time: bool = False, t0_s: float = 0.0) -> dict[str, Figure]:
+def time_figures(run: Run, *, log_time: bool = False, t0_s: float = 0.0) -> Iterator[tuple[str, Figure]]:
     """One figure per signal group, a panel per unit; ``log_time`` plots against log10(t - t0).
-    Keyed by the file name :func:`plot_run` gives it (``time_camber``, ``time_camber_logt``)."""
+    Each with the file name :func:`plot_run` gives it (``time_camber``, ``time_camber_logt``)."""
     t = run.t_s - t0_s
     shown = t > 0 if log_time else np.ones_like(t, dtype=bool)
     groups = list(dict.fromkeys(s.group for s in run.specs))
-    figures = {}
     for group in groups:
         names = [s.name for s in run.specs if s.group == group]
         units = list(dict.fromkeys(run.units[n] for n in names))
@@ -77,15 +76,15 @@ def time_figures(run: Run, *, log_time: bool = False, t0_s: float = 0.0) -> dict
             ax.grid(True, which="both", alpha=0.3)
             ax.legend(fontsize="small", ncols=max(1, len(names) // 8))
         fig.suptitle(_title(run, f"{group} against time"))
-        figures[f"time_{group}{'_logt' if log_time else ''}"] = fig
-    return figures
+        yield f"time_{group}{'_logt' if log_time else ''}", fig
 
 
 def plot_run(run: Run, out_dir: Path, *, log_time: bool = False, t0_s: float = 0.0) -> list[Path]:
-    """Every picture of ``run`` into ``out_dir`` (created) as PNGs; returns the files written."""
+    """Every picture of ``run`` into ``out_dir`` (created) as PNGs, one figure made at a time; returns
+    the files written."""
     out_dir.mkdir(parents=True, exist_ok=True)
     written = []
-    for name, fig in {**pair_figures(run), **time_figures(run, log_time=log_time, t0_s=t0_s)}.items():
+    for name, fig in itertools.chain(pair_figures(run), time_figures(run, log_time=log_time, t0_s=t0_s)):
         save_figure(fig, out_dir / f"{name}.png", dpi=110)
         written.append(out_dir / f"{name}.png")
     return written

@@ -6,6 +6,8 @@ and axle (periodic inputs, :mod:`elastokin.analysis.run_metrics`), the toe drift
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
 
 from elastokin.analysis.kc_metrics import BUMP_WINDOW_M, FIT_FRACTION, METRICS
@@ -46,8 +48,8 @@ def _loop_table(run: Run) -> list[str]:
     return rows
 
 
-def _kc_table(run: Run) -> list[str]:
-    metrics = run_metrics(run)
+def _kc_table(run: Run, contact_base: Mapping[str, float] | None) -> list[str]:
+    metrics = run_metrics(run, contact_base)
     labels = {case["case"]: case["label"][:16] for case in cases(run)}
     keys = [(key, unit) for key, unit, _ in METRICS if any(key in m for c in metrics.values() for m in c.values())]
     if not keys:
@@ -110,8 +112,9 @@ def _peak_table(run: Run) -> list[str]:
     return rows
 
 
-def summary(run: Run) -> str:
-    """The text summary of a recorded run (simulated, or measured on a rig)."""
+def summary(run: Run, contact_base: Mapping[str, float] | None = None) -> str:
+    """The text summary of a recorded run (simulated, or measured on a rig: its roll metrics need
+    the design ``contact_base`` [m] per axle, :func:`elastokin.analysis.run_metrics.contact_base_m`)."""
     extra = run.metadata.extra
     status = "complete" if run.complete else f"INCOMPLETE ({run.reason})"
     origin = f"bushings: {extra['bushing_model']}" if "bushing_model" in extra else "measured on a rig"
@@ -123,7 +126,7 @@ def summary(run: Run) -> str:
     if is_road(run):
         lines += _road_table(run)
     elif extra["x_quantity"] is not None:
-        lines += _loop_table(run) + _kc_table(run)
+        lines += _loop_table(run) + _kc_table(run, contact_base)
     else:
         lines += _drift_table(run)
     return "\n".join(lines + _peak_table(run))

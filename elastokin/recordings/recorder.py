@@ -19,9 +19,8 @@ from typing import Callable
 import mujoco
 import numpy as np
 
-from elastokin.core.files import is_file, read_text
 from elastokin.vehicle.model.definition import VehicleDefinition
-from elastokin.vehicle.model.vehicle_file import load_vehicle
+from elastokin.vehicle.model.vehicle_file import as_filed, load_vehicle
 from elastokin.vehicle.scenarios.road_scenario import RoadScenario
 from elastokin.vehicle.scenarios.scenario import Scenario
 from elastokin.vehicle.scenarios.schedule import Progress
@@ -79,8 +78,8 @@ def _play(scenario: Scenario | RoadScenario, vehicle: VehicleDefinition, duratio
 def _vehicle_file(vehicle: VehicleDefinition) -> str:
     """What a run's metadata names as its vehicle file: the file, or, for a vehicle changed in code,
     the file it was changed from (the recording carries the changed text itself)."""
-    unchanged = vehicle.text and is_file(vehicle.path) and read_text(vehicle.path) == vehicle.text
-    return str(vehicle.path) if unchanged else f"{vehicle.path} (changed in code)"
+    path = vehicle.path.resolve()   # one spelling of the file, however it was named
+    return str(path) if as_filed(vehicle) else f"{path} (changed in code)"
 
 
 def run_scenario(scenario: Scenario | RoadScenario, output: Path, *, bushing_model: str | None = None, overwrite: bool = False,

@@ -115,7 +115,7 @@ class Run:
     ``t_s`` (N,) simulation time in s, at the MCAP resolution of 1 ns; ``signals[name]`` (N,) in
     ``units[name]``; ``body_pos`` (N, B, 3) world positions in m; ``body_quat_wxyz`` (N, B, 4).
     ``complete`` is false for a run stopped early (divergence, Ctrl-C, exception), with the cause
-    in ``reason``.
+    in ``reason``, and for a file read in part, what it could not give in ``damage`` (and ``reason``).
     """
 
     path: Path
@@ -131,6 +131,7 @@ class Run:
     metadata: RunMetadata
     complete: bool
     reason: str
+    damage: tuple[str, ...] = ()   #: what a damaged file could not give (a chunk's CRC, a cut)
 
     def label(self, name: str) -> str:
         """``"name [unit]"`` for axis labels and legends."""

@@ -4,14 +4,18 @@
 
 from __future__ import annotations
 
+import functools
 import json
 import os
+import struct
+import warnings
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from mcap.reader import make_reader
-from mcap.records import Channel, Message, Metadata
-from mcap.stream_reader import StreamReader
+from mcap.records import Channel, Chunk, DataEnd, Message, Metadata
+from mcap.exceptions import EndOfFile
+from mcap.stream_reader import CRCValidationError, StreamReader, breakup_chunk
 
 from elastokin.core.errors import InputError
 from elastokin.core.files import is_file
@@ -20,33 +24,69 @@ from elastokin.recordings.run_format import (FORMAT_VERSION, PARTIAL_SUFFIX, RUN
                                         TF_TOPIC, GeomSpec, Run, RunMetadata, SignalSpec, signal_label)
 
 
-def _read(path: Path) -> tuple[dict[str, dict[str, str]], dict[str, list[tuple[int, bytes]]], str]:
-    """The metadata records and the messages (log time, bytes) by topic of an MCAP file, and why it
-    was cut short ("" for a whole file): read through its summary, else record by record as far as
-    it goes (a killed run's file has complete chunks but no summary)."""
+class DamagedRecording(UserWarning):
+    """A run file read in part: cut short, or with chunks that failed their CRC (the message says
+    what is missing). :func:`load_run` warns with it, or raises it as an InputError when strict."""
+
+
+@dataclass(frozen=True)
+class _Lost:
+    """A chunk that could not be read: its number (1-based), its messages' time span [ns], why."""
+
+    number: int
+    start_ns: int
+    end_ns: int
+    why: str
+
+
+def _read(path: Path) -> tuple[dict[str, dict[str, str]], dict[str, list[tuple[int, bytes]]], list[_Lost], int, str]:
+    """The metadata records and the messages (log time, bytes) by topic of an MCAP file, read record
+    by record, each chunk checked against its CRC and left out when it fails (or does not
+    decompress); the chunks lost, the number of chunks, and why the file ends early ("" for a
+    whole file: its data section ended, and checked against its own CRC)."""
+    records: dict[str, dict[str, str]] = {}
+    topics: dict[int, str] = {}
+    by_channel: dict[int, list[tuple[int, bytes]]] = {}
+    lost: list[_Lost] = []
+    chunks, cut = 0, ""
+
+    def take(rec: object) -> None:
+        if isinstance(rec, Metadata):
+            records[rec.name] = dict(rec.metadata)
+        elif isinstance(rec, Channel):
+            topics[rec.id] = rec.topic
+        elif isinstance(rec, Message):
+            by_channel.setdefault(rec.channel_id, []).append((rec.log_time, rec.data))
+
+    data_end = False
     with open(path, "rb") as stream:
         try:
-            reader = make_reader(stream)
-            records = {m.name: dict(m.metadata) for m in reader.iter_metadata()}
-            messages: dict[str, list[tuple[int, bytes]]] = {}
-            for _, channel, message in reader.iter_messages(log_time_order=False):
-                messages.setdefault(channel.topic, []).append((message.log_time, message.data))
-            return records, messages, ""
-        except Exception:  # noqa: BLE001 - a damaged file can fail the decoder in any way: read it record by record
-            pass
-    records, messages, topics = {}, {}, {}
-    with open(path, "rb") as stream:
-        try:
-            for rec in StreamReader(stream).records:
-                if isinstance(rec, Metadata):
-                    records[rec.name] = dict(rec.metadata)
-                elif isinstance(rec, Channel):
-                    topics[rec.id] = rec.topic
-                elif isinstance(rec, Message) and rec.channel_id in topics:
-                    messages.setdefault(topics[rec.channel_id], []).append((rec.log_time, rec.data))
+            for rec in StreamReader(stream, emit_chunks=True, validate_crcs=True).records:
+                if isinstance(rec, Chunk):
+                    chunks += 1
+                    try:
+                        inner = breakup_chunk(rec, validate_crc=True)
+                    except CRCValidationError:
+                        lost.append(_Lost(chunks, rec.message_start_time, rec.message_end_time, "failed its CRC"))
+                        continue
+                    except Exception as exc:  # noqa: BLE001 - damaged bytes can fail the decoder in any way
+                        lost.append(_Lost(chunks, rec.message_start_time, rec.message_end_time,
+                                          f"cannot be read ({type(exc).__name__})"))
+                        continue
+                    for record in inner:
+                        take(record)
+                elif not data_end:   # the summary after the data repeats what the data held
+                    take(rec)
+                data_end = data_end or isinstance(rec, DataEnd)
+        except CRCValidationError:   # the data section's own CRC: a record outside the chunks changed
+            if not lost:
+                cut = "its data section failed its CRC"
         except Exception as exc:  # noqa: BLE001 - where the readable part ends
-            return records, messages, f"it ends early ({exc or type(exc).__name__})"
-    return records, messages, "it has no summary"
+            why = ("no summary section" if isinstance(exc, EndOfFile) else "the file ends inside a record"
+                   if isinstance(exc, struct.error) else f"{type(exc).__name__}: {exc}")
+            cut = f"its summary section is cut ({why}); its data is whole" if data_end else f"it ends early: {why}"
+    messages = {topics[c]: m for c, m in by_channel.items() if c in topics}
+    return records, messages, lost, chunks, cut
 
 
 def _run_record(records: dict[str, dict[str, str]], path: Path, cut: str) -> dict[str, str]:
@@ -57,17 +97,19 @@ def _run_record(records: dict[str, dict[str, str]], path: Path, cut: str) -> dic
     return run
 
 
-def load_run(path: str | os.PathLike[str]) -> Run:
+def load_run(path: str | os.PathLike[str], *, strict: bool = False) -> Run:
     """Read a run file; raises :class:`InputError` if it is missing, unreadable or not a vsim run.
 
-    A file cut short (a killed run: no summary, a last chunk unfinished) is read as far as it goes
-    and marked incomplete."""
+    A damaged file is read as far as it goes, without the chunks that fail their CRC, and the run
+    marked incomplete with what is missing in ``reason`` and ``damage``: a :class:`DamagedRecording`
+    warning says so (with ``strict``, an InputError). A run stopped early but closed (divergence,
+    Ctrl-C) is incomplete without damage."""
     path = Path(path)
     if not is_file(path):
         partial = path.with_name(path.name + PARTIAL_SUFFIX)
         hint = f" (an unfinished run left {partial.name}: name it to read what it holds)" if partial.exists() else ""
         raise InputError(f"no such run file{hint}", source=str(path))
-    records, messages, cut = _read(path)
+    records, messages, lost, chunks, cut = _read(path)
     run = _run_record(records, path, cut)
     try:
         specs = [SignalSpec(**s) for s in json.loads(run["signals"])]
@@ -91,16 +133,26 @@ def load_run(path: str | os.PathLike[str]) -> Run:
     layouts = {SIGNAL_TOPIC_PREFIX + g: JointStateLayout([signal_label(s) for s in members])
                for g, members in group_specs.items()}
     topics = [TF_TOPIC, *layouts] if bodies else list(layouts)
-    times = {topic: [t for t, _ in messages.get(topic, [])] for topic in topics}
-    payloads = {topic: [d for _, d in messages.get(topic, [])] for topic in topics}
 
-    # A run stopped inside RunWriter.write may lack the last step on some channels: keep whole steps.
-    # (Log times are unsigned 64-bit in MCAP: a damaged one may not fit int64.)
-    n_steps = min((len(t) for t in times.values()), default=0)
-    t_ns = np.array(next(iter(times.values()), [])[:n_steps], dtype=np.uint64)
+    # The steps every channel holds: a run stopped inside RunWriter.write may lack its last step on
+    # some channels, and a chunk left out may have held part of a step. (Log times are unsigned 64-bit
+    # in MCAP: a damaged one may not fit int64.)
+    times = {topic: np.array([t for t, _ in messages.get(topic, [])], dtype=np.uint64) for topic in topics}
+    payloads = {topic: [d for _, d in messages.get(topic, [])] for topic in topics}
     for topic, topic_times in times.items():
-        if not np.array_equal(np.asarray(topic_times[:n_steps], dtype=np.uint64), t_ns):
+        if topic_times.size > 1 and not np.all(topic_times[1:] > topic_times[:-1]):
+            raise InputError(f"channel {topic}: its times do not increase", source=str(path))
+    t_ns = functools.reduce(np.intersect1d, times.values()) if times else np.empty(0, np.uint64)
+    kept = {topic: np.isin(topic_times, t_ns) for topic, topic_times in times.items()}
+    for topic, topic_times in times.items():   # a step left out must be a lost chunk's or after the last whole one
+        dropped = topic_times[~kept[topic]]
+        explained = dropped > (t_ns[-1] if t_ns.size else 0)
+        for c in lost:
+            explained |= (dropped >= c.start_ns) & (dropped <= c.end_ns)
+        if not np.all(explained) or (t_ns.size == 0 and dropped.size and not (lost or cut)):
             raise InputError(f"channel {topic} is not on the same time steps as the others", source=str(path))
+    payloads = {topic: [d for d, keep in zip(payloads[topic], kept[topic]) if keep] for topic in topics}
+    n_steps = t_ns.size
 
     signals: dict[str, np.ndarray] = {}
     for topic, layout in layouts.items():
@@ -125,9 +177,17 @@ def load_run(path: str | os.PathLike[str]) -> Run:
             raise InputError(f"{TF_TOPIC} message {i} does not match the recorded body list", source=str(path))
         poses[i] = decoded
 
+    damage = _damage(lost, chunks, cut, t_ns, metadata)
     status = records.get(STATUS_RECORD) or {"complete": "false", "reason": "no status record: the run was not closed"}
-    if cut:
-        status = {"complete": "false", "reason": f"{status['reason']}; {cut}: read as far as it goes".lstrip("; ")}
+    whole = not lost and (not cut or cut.startswith("its summary section"))   # every sample is there
+    if damage:
+        if strict:
+            raise InputError(f"damaged, and refused as strict reading asks: {'; '.join(damage)}", source=str(path))
+        for item in damage:
+            warnings.warn(DamagedRecording(f"{path}: {item}"), stacklevel=2)
+        if not whole:
+            status = {"complete": "false", "reason": "; ".join([*damage, status["reason"]] if status.get("complete") != "true"
+                                                              else damage)}
     return Run(
         path=path,
         t_s=t_ns / 1e9,
@@ -142,4 +202,28 @@ def load_run(path: str | os.PathLike[str]) -> Run:
         metadata=metadata,
         complete=status.get("complete") == "true",
         reason=str(status.get("reason", "")),
+        damage=tuple(damage),
     )
+
+
+def _damage(lost: list[_Lost], chunks: int, cut: str, t_ns: np.ndarray, metadata: RunMetadata) -> list[str]:
+    """What a damaged file could not give, in a reader's words: each chunk left out with the time it
+    held, and where a cut file ends against where its run was to end."""
+    out = [f"chunk {c.number} of {chunks} {c.why}: {(c.end_ns - c.start_ns) / 1e9:.1f} s missing "
+           f"(t = {c.start_ns / 1e9:.1f} to {c.end_ns / 1e9:.1f} s)" for c in lost]
+    if cut.startswith("its summary section"):
+        out.append(cut)
+    elif cut:
+        cases = metadata.extra.get("cases") or [{}]
+        planned = cases[-1].get("end_s") if isinstance(cases[-1], dict) else None
+        of = f" of its {planned:.1f} s" if isinstance(planned, (int, float)) else ""
+        at = f"at {t_ns[-1] / 1e9:.1f} s{of}" if t_ns.size else f"before its first whole sample{of and ' (' + of[1:] + ')'}"
+        out.append(f"recording cut {at} ({cut}): read as far as it goes")
+    return out
+
+
+def check_samples(run: Run, what: str) -> None:
+    """InputError unless ``run`` holds a sample to ``what`` (plot, replay): a recording cut before its
+    first whole sample holds none."""
+    if run.t_s.size == 0:
+        raise InputError(f"holds no whole sample: nothing to {what}", source=str(run.path))

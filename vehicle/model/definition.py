@@ -31,7 +31,7 @@ SIDES = (("left", 1.0), ("right", -1.0))
 CORNERS = ("front_left", "front_right", "rear_left", "rear_right")
 #: +1 for a left corner, −1 for a right one (a right part is the mirror image of the left: y → −y).
 SIDE_SIGN = {c: 1.0 if c.endswith("left") else -1.0 for c in CORNERS}
-#: Models ``--bushings`` may put on every bushing direction (:meth:`DirectionDef.channel`).
+#: Models ``--bushing-model`` may put on every bushing direction (:meth:`DirectionDef.channel`).
 BUSHING_MODELS = ("linear", "sts", "rt", "stvs")
 #: Bushing directions: translations along, then rotations about, the bushing's own x, y, z axes.
 DIRECTIONS = ("x", "y", "z", "rx", "ry", "rz")
@@ -81,7 +81,7 @@ class Damper:
 
 @dataclass(frozen=True)
 class Families:
-    """Laws read when ``--bushings`` names a model a direction's own law has no parameters for.
+    """Laws read when ``--bushing-model`` names a model a direction's own law has no parameters for.
 
     ``sets`` maps a model to a translation parameter set of models/bushings/ (``stvs: fig5_9``);
     the set is scaled to the direction's own large-amplitude stiffness K0 (:func:`scaled_like`),
@@ -137,7 +137,7 @@ class DirectionDef:
     def channel(self, override_model: str | None = None) -> ChannelParams:
         """SI :class:`bushings.ChannelParams` of this direction, optionally read as another model.
 
-        ``override_model`` (run-time ``--bushings``) reads the direction's own set or inline
+        ``override_model`` (run-time ``--bushing-model``) reads the direction's own set or inline
         parameters as that model when they hold its parameters (an STVS set read as ``sts``
         drops Co and pw; anything read as ``linear`` keeps K0); otherwise the vehicle's family
         set of that model is scaled to the direction's own K0 (:class:`Families`). Read as its own

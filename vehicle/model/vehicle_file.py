@@ -27,6 +27,7 @@ from elastokin.vehicle.model.plausibility import (MAX_BODY_MASS_KG, MAX_CAMBER_D
                                         MAX_TORSION_NM_PER_RAD, check_geometry)
 from elastokin.core.documents import Document, Fields, KeyPath, check_number, check_vector, dotted
 from elastokin.core.errors import InputError
+from elastokin.core.files import is_file, read_text
 from elastokin.core.shipped import DEFAULT_VEHICLE, TYRE_DIR, VEHICLE_DIR, resolve
 
 #: Source named in the errors of :func:`with_extensions`.
@@ -39,6 +40,11 @@ def load_vehicle(path: str | Path = DEFAULT_VEHICLE) -> VehicleDefinition:
     :class:`InputError` naming file:line, key and value."""
     path = resolve(path, VEHICLE_DIR, "vehicle")
     return parse_vehicle(Document.read(path, "no such vehicle file").text, path)
+
+
+def as_filed(vehicle: VehicleDefinition) -> bool:
+    """Whether ``vehicle`` is its file as it stands (not changed in code since it was read)."""
+    return bool(vehicle.text) and is_file(vehicle.path) and read_text(vehicle.path) == vehicle.text
 
 
 def parse_vehicle(text: str, path: Path, source: str | None = None) -> VehicleDefinition:
