@@ -48,7 +48,7 @@ def _read(path: Path) -> tuple[dict[str, dict[str, str]], dict[str, list[tuple[i
     topics: dict[int, str] = {}
     by_channel: dict[int, list[tuple[int, bytes]]] = {}
     lost: list[_Lost] = []
-    chunks, cut = 0, ""
+    cut = ""
 
     def take(rec: object) -> None:
         if isinstance(rec, Metadata):
@@ -58,33 +58,47 @@ def _read(path: Path) -> tuple[dict[str, dict[str, str]], dict[str, list[tuple[i
         elif isinstance(rec, Message):
             by_channel.setdefault(rec.channel_id, []).append((rec.log_time, rec.data))
 
-    data_end = False
+    state = {"chunks": 0, "data_end": False}
+
+    def read(rec: object) -> None:
+        if isinstance(rec, Chunk):
+            state["chunks"] += 1
+            try:
+                inner = breakup_chunk(rec, validate_crc=True)
+            except CRCValidationError:
+                lost.append(_Lost(state["chunks"], rec.message_start_time, rec.message_end_time, "failed its CRC"))
+                return
+            except Exception as exc:  # noqa: BLE001 - damaged bytes can fail the decoder in any way
+                lost.append(_Lost(state["chunks"], rec.message_start_time, rec.message_end_time,
+                                  f"cannot be read ({type(exc).__name__})"))
+                return
+            for record in inner:
+                take(record)
+        elif not state["data_end"] or isinstance(rec, Channel):
+            # the summary after the data repeats what the data held; its channels name the messages
+            # of a chunk whose own channel records were in a chunk left out
+            take(rec)
+        state["data_end"] = state["data_end"] or isinstance(rec, DataEnd)
+
     with open(path, "rb") as stream:
         try:
-            for rec in StreamReader(stream, emit_chunks=True, validate_crcs=True).records:
-                if isinstance(rec, Chunk):
-                    chunks += 1
-                    try:
-                        inner = breakup_chunk(rec, validate_crc=True)
-                    except CRCValidationError:
-                        lost.append(_Lost(chunks, rec.message_start_time, rec.message_end_time, "failed its CRC"))
-                        continue
-                    except Exception as exc:  # noqa: BLE001 - damaged bytes can fail the decoder in any way
-                        lost.append(_Lost(chunks, rec.message_start_time, rec.message_end_time,
-                                          f"cannot be read ({type(exc).__name__})"))
-                        continue
-                    for record in inner:
-                        take(record)
-                elif not data_end:   # the summary after the data repeats what the data held
-                    take(rec)
-                data_end = data_end or isinstance(rec, DataEnd)
-        except CRCValidationError:   # the data section's own CRC: a record outside the chunks changed
-            if not lost:
-                cut = "its data section failed its CRC"
+            try:
+                for rec in StreamReader(stream, emit_chunks=True, validate_crcs=True).records:
+                    read(rec)
+            except CRCValidationError as exc:   # the data section's own CRC, checked at its end record
+                if not isinstance(exc.record, DataEnd):
+                    raise
+                state["data_end"] = True
+                if not lost:   # a record outside the chunks changed
+                    cut = "its data section failed its CRC"
+                for rec in StreamReader(stream, skip_magic=True, emit_chunks=True).records:   # the summary
+                    read(rec)
         except Exception as exc:  # noqa: BLE001 - where the readable part ends
             why = ("no summary section" if isinstance(exc, EndOfFile) else "the file ends inside a record"
                    if isinstance(exc, struct.error) else f"{type(exc).__name__}: {exc}")
-            cut = f"its summary section is cut ({why}); its data is whole" if data_end else f"it ends early: {why}"
+            if not cut:
+                cut = f"its summary section is cut ({why}); its data is whole" if state["data_end"] else why
+    chunks = state["chunks"]
     messages = {topics[c]: m for c, m in by_channel.items() if c in topics}
     return records, messages, lost, chunks, cut
 
@@ -213,6 +227,9 @@ def _damage(lost: list[_Lost], chunks: int, cut: str, t_ns: np.ndarray, metadata
            f"(t = {c.start_ns / 1e9:.1f} to {c.end_ns / 1e9:.1f} s)" for c in lost]
     if cut.startswith("its summary section"):
         out.append(cut)
+    elif cut.startswith("its data section"):
+        out.append(f"{cut}: a record outside its chunks (an index, or its metadata) changed; its samples are read, "
+                   f"what it says of itself may be wrong")
     elif cut:
         cases = metadata.extra.get("cases") or [{}]
         planned = cases[-1].get("end_s") if isinstance(cases[-1], dict) else None
