@@ -22,7 +22,7 @@ WARM_UPS = (
 )
 
 
-def _warm_up(what: str, name: str, scale: float | None, show: bool) -> int:
+def _warm_up(name: str, scale: float | None, show: bool) -> int:
     """Play one warm-up (in a process of its own); the number of kernels it compiled."""
     with open(os.devnull, "w") as quiet, compile_notice(sys.stderr if show else quiet, why=False) as notice:
         if scale is None:
@@ -39,7 +39,8 @@ def compile_kernels(progress: Callable[[str], None] | None = None, workers: int 
     installed package.
 
     Args:
-        progress: called with a line as each part starts (and the compiles are shown on stderr).
+        progress: called with a line as each part is handed to a process (and the compiles are shown
+            on stderr).
         workers: processes at once (the rig's and the road's kernels take some 20 and 15 s each on
             one core).
 
@@ -52,6 +53,6 @@ def compile_kernels(progress: Callable[[str], None] | None = None, workers: int 
         for what, name, scale in WARM_UPS:
             if progress is not None:
                 progress(f"{what} ({name})")
-            jobs.append(pool.submit(_warm_up, what, name, scale, progress is not None))
+            jobs.append(pool.submit(_warm_up, name, scale, progress is not None))
         compiled = sum(job.result() for job in jobs)
     return compiled, time.perf_counter() - started

@@ -140,10 +140,9 @@ class Run:
         Raises:
             KeyError: no such case.
         """
-        for c in self.cases:
-            if c["case"] == number:
-                return (self.t_s >= c["start_s"] - 1e-9) & (self.t_s <= c["end_s"] + 1e-9)
-        raise KeyError(f"no case {number}; the run has cases 1 to {len(self.cases)}")
+        if number not in [c["case"] for c in self.cases]:
+            raise KeyError(f"no case {number}; the run has cases 1 to {len(self.cases)}")
+        return self.recorded.signals["case"] == number
 
     def metrics(self, vehicle: Vehicle | None = None) -> dict[int, dict[str, Any]]:
         """The metrics ``vsim run`` prints, as data, by case number.

@@ -102,9 +102,10 @@ class Vehicle:
         >>> car.value("bushings.e2_front.y.Kr")       # the original is unchanged
         2935.0
         """
+        data = Document(self.text, str(self.path)).data
         for place, number in values.items():
             try:
-                file_value(Document(self.text, str(self.path)).data, place)
+                file_value(data, place)
             except PlaceError as exc:
                 raise InputError(str(exc), source=VALUES_SOURCE, key=place) from None
             if isinstance(number, bool) or not isinstance(number, (int, float)) or not math.isfinite(number):

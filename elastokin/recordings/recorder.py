@@ -108,9 +108,8 @@ def run_scenario(scenario: Scenario | RoadScenario, output: Path, *, bushing_mod
             for block in blocks:
                 sink.put(block)
     # the times as the file holds them: whole nanoseconds
-    run = replace(_in_memory(output, np.concatenate(sink.times_ns) / 1e9, sink.values, layout, metadata),
-                  body_names=bodies, body_pos=np.concatenate(sink.body_pos),
-                  body_quat_wxyz=np.concatenate(sink.body_quat_wxyz), geometry=geometry)
+    run = _in_memory(output, np.concatenate(sink.times_ns) / 1e9, sink.values, layout, metadata,
+                     (bodies, sink.body_pos, sink.body_quat_wxyz, geometry))
     return RunResult(output, play.total_s, time.perf_counter() - started, play.stepping_s, run)
 
 
@@ -142,26 +141,26 @@ def play_in_memory(scenario: Scenario | RoadScenario, vehicle: VehicleDefinition
             positions.append(block.body_pos)
             quaternions.append(block.body_quat_wxyz)
     path = Path("(in memory)")
-    run = _in_memory(path, np.concatenate(times), rows, layout, metadata)
-    if poses:
-        bodies = play.bodies()
-        run = replace(run, body_names=bodies, body_pos=np.concatenate(positions),
-                      body_quat_wxyz=np.concatenate(quaternions), geometry=geometry_from_model(play.car.model, bodies))
+    bodies = play.bodies() if poses else []
+    kept = (bodies, positions, quaternions, geometry_from_model(play.car.model, bodies)) if poses else None
+    run = _in_memory(path, np.concatenate(times), rows, layout, metadata, kept)
     return RunResult(path, play.total_s, time.perf_counter() - started, play.stepping_s, run)
 
 
 def _in_memory(path: Path, t_s: np.ndarray, blocks: list[np.ndarray], layout: SignalLayout | RoadSignalLayout,
-               metadata: RunMetadata) -> Run:
-    """A complete :class:`Run` of the blocks of values ``blocks`` (one row per time in ``t_s``), without body poses
-    (the caller adds them)."""
+               metadata: RunMetadata,
+               poses: tuple[list[str], list[np.ndarray], list[np.ndarray], list[GeomSpec]] | None = None) -> Run:
+    """A complete :class:`Run` of the blocks of values ``blocks`` (one row per time in ``t_s``), with the
+    bodies' ``poses`` (their names, blocks of positions and of quaternions, geometry), or none."""
     specs = layout.specs
     values = np.concatenate(blocks).reshape(len(t_s), len(specs))
     signals = {s.name: values[:, i] for i, s in enumerate(specs)}
+    bodies, positions, quaternions, geometry = poses if poses is not None else ([], [], [], [])
     return Run(path=path, t_s=t_s, signals=signals, units={s.name: s.unit for s in specs},
-               groups={s.name: s.group for s in specs}, specs=specs, body_names=[],
-               body_pos=np.empty((len(values), 0, 3)), body_quat_wxyz=np.empty((len(values), 0, 4)), geometry=[],
-               metadata=metadata, complete=True, reason="")
-
+               groups={s.name: s.group for s in specs}, specs=specs, body_names=bodies,
+               body_pos=np.concatenate(positions) if bodies else np.empty((len(values), 0, 3)),
+               body_quat_wxyz=np.concatenate(quaternions) if bodies else np.empty((len(values), 0, 4)),
+               geometry=geometry, metadata=metadata, complete=True, reason="")
 
 
 def geometry_from_model(model: mujoco.MjModel, bodies: list[str]) -> list[GeomSpec]:

@@ -58,27 +58,28 @@ def _read(path: Path) -> tuple[dict[str, dict[str, str]], dict[str, list[tuple[i
         elif isinstance(rec, Message):
             by_channel.setdefault(rec.channel_id, []).append((rec.log_time, rec.data))
 
-    state = {"chunks": 0, "data_end": False}
+    chunks, data_end = 0, False
 
     def read(rec: object) -> None:
+        nonlocal chunks, data_end
         if isinstance(rec, Chunk):
-            state["chunks"] += 1
+            chunks += 1
             try:
                 inner = breakup_chunk(rec, validate_crc=True)
             except CRCValidationError:
-                lost.append(_Lost(state["chunks"], rec.message_start_time, rec.message_end_time, "failed its CRC"))
+                lost.append(_Lost(chunks, rec.message_start_time, rec.message_end_time, "failed its CRC"))
                 return
             except Exception as exc:  # noqa: BLE001 - damaged bytes can fail the decoder in any way
-                lost.append(_Lost(state["chunks"], rec.message_start_time, rec.message_end_time,
+                lost.append(_Lost(chunks, rec.message_start_time, rec.message_end_time,
                                   f"cannot be read ({type(exc).__name__})"))
                 return
             for record in inner:
                 take(record)
-        elif not state["data_end"] or isinstance(rec, Channel):
+        elif not data_end or isinstance(rec, Channel):
             # the summary after the data repeats what the data held; its channels name the messages
             # of a chunk whose own channel records were in a chunk left out
             take(rec)
-        state["data_end"] = state["data_end"] or isinstance(rec, DataEnd)
+        data_end = data_end or isinstance(rec, DataEnd)
 
     with open(path, "rb") as stream:
         try:
@@ -88,7 +89,7 @@ def _read(path: Path) -> tuple[dict[str, dict[str, str]], dict[str, list[tuple[i
             except CRCValidationError as exc:   # the data section's own CRC, checked at its end record
                 if not isinstance(exc.record, DataEnd):
                     raise
-                state["data_end"] = True
+                data_end = True
                 if not lost:   # a record outside the chunks changed
                     cut = "its data section failed its CRC"
                 for rec in StreamReader(stream, skip_magic=True, emit_chunks=True).records:   # the summary
@@ -97,8 +98,7 @@ def _read(path: Path) -> tuple[dict[str, dict[str, str]], dict[str, list[tuple[i
             why = ("no summary section" if isinstance(exc, EndOfFile) else "the file ends inside a record"
                    if isinstance(exc, struct.error) else f"{type(exc).__name__}: {exc}")
             if not cut:
-                cut = f"its summary section is cut ({why}); its data is whole" if state["data_end"] else why
-    chunks = state["chunks"]
+                cut = f"its summary section is cut ({why}); its data is whole" if data_end else why
     messages = {topics[c]: m for c, m in by_channel.items() if c in topics}
     return records, messages, lost, chunks, cut
 
