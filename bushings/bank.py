@@ -33,19 +33,21 @@ class BushingBank:
     forces [N or N·m] and tangent stiffnesses dF/de. One compiled call serves the whole bank.
     """
 
-    _STATE = ("ladder", "q", "eprev", "cs", "ck", "stack", "diss", "nfail")
+    _STATE = ("ladder", "q", "eprev", "cs", "ck", "stack", "diss", "nfail", "worst")
 
     def __init__(self, channels: Sequence[ChannelParams], tolerance: float = DEFAULT_TOLERANCE):
         """``tolerance`` [m or rad]: the implicit ladder solve stops when every node's force
         residual is below tolerance·(Kpa + 2·Kr), i.e. nodes are placed to about this distance."""
         self.channels: tuple[ChannelParams, ...] = tuple(channels)
+        #: The solve's tolerance [m or rad].
+        self.tolerance = tolerance
         M = len(self.channels)
         n_mx = max(sum(len(ch.maxwell_k) for ch in self.channels), 1)
         cells = np.array([0 if ch.continuous else ch.n_cells for ch in self.channels], dtype=np.int64)
         ladder_at, ladder_size = kn.place_ladders(cells)
         shapes = {"P": (M, kn.N_PCOLS), "I": (M, kn.N_ICOLS), "MX": (n_mx, 2), "ladder": (ladder_size,),
                   "q": (n_mx,), "eprev": (M,), "cs": (M, 2), "ck": (M,), "stack": (M, kn.STACK_SIZE, 2),
-                  "diss": (M,), "nfail": (M,), "force": (M,), "tangent": (M,)}
+                  "diss": (M,), "nfail": (M,), "worst": (M,), "force": (M,), "tangent": (M,)}
         self._fbuf, self._ibuf, arrays = kn.pack_bank(shapes)
         for name, array in arrays.items():
             setattr(self, name, array)
@@ -87,8 +89,16 @@ class BushingBank:
 
     @property
     def failed_steps(self) -> np.ndarray:
-        """Per channel, the number of steps whose implicit solve hit its iteration cap (should be 0)."""
+        """Per channel, the number of steps since reset whose implicit solve hit its iteration cap
+        with a residual left (should be 0)."""
         return self.nfail
+
+    @property
+    def worst_residual(self) -> np.ndarray:
+        """Per channel, the largest residual those steps left [m or rad]: the nodes' worst force
+        residual over Kpa + 2·Kr, the distance to which they are placed, to set beside the
+        ``tolerance`` (0 where every step converged; NaN for a residual that was not a number)."""
+        return self.worst
 
     def reset(self) -> None:
         """Return every channel to its virgin, unloaded state at zero deflection."""

@@ -281,7 +281,9 @@ def _grow(n, S, Kr, pw):
 
 @nb.njit(cache=True, fastmath=_FAST, error_model="numpy")
 def _ladder_step(e, de, h, n, Kpa, Kr, Ff, Co, pw, tol_x, S):
-    """Advance one ladder of n nodes to deflection e; returns (F_ladder, dF/de, energy dissipated, ok).
+    """Advance one ladder of n nodes to deflection e; returns (F_ladder, dF/de, energy dissipated,
+    residual): ``residual`` 0 when the solve converged, else the nodes' worst force residual over
+    Kpa + 2·Kr [m or rad] (NaN for a residual that is not a number; see :func:`_ladder_residual`).
 
     Converged when every node's force residual is below tol_x·(Kpa + 2·Kr), i.e. the nodes are
     placed to about tol_x [m or rad]. ``S`` starts at the channel's ladder (see :func:`place_ladders`);
@@ -410,6 +412,8 @@ def _ladder_step(e, de, h, n, Kpa, Kr, Ff, Co, pw, tol_x, S):
                 if wr != 0.0:
                     S[_W + j] = wr
                     S[_SG + j] = sg
+    # the iteration cap reached: the residual of the slips the last pass left (its Newton step unchecked)
+    residual = 0.0 if ok else _ladder_residual(n, h, Kr, Ff, Co, pw, tol, tol_stick, S) / (Kpa + 2.0 * Kr)
     # Consistent tangent: du_1/de = Kpa·[A⁻¹]_11 on the final slipping set, with the damper
     # slopes of the converged pass. Only the run of slipping nodes from node 1 couples to the input.
     diss = 0.0
@@ -429,7 +433,30 @@ def _ladder_step(e, de, h, n, Kpa, Kr, Ff, Co, pw, tol_x, S):
         for j in range(b, 0, -1):
             d2, d1 = d1, S[_AP + j] * d1 - (S[_SC + j] * S[_SC + j + 1]) * d2
         du1 = Kpa * d2 / d1 * (S[_SC + 1] / Kr)
-    return Kpa * (e - S[_U + 1]), Kpa * (1.0 - du1), diss, ok
+    return Kpa * (e - S[_U + 1]), Kpa * (1.0 - du1), diss, residual
+
+
+@nb.njit(cache=True, fastmath=_FAST)
+def _ladder_residual(n, h, Kr, Ff, Co, pw, tol, tol_stick, S):
+    """The worst force residual [N or N·m] of a ladder's nodes at the slips S[_W], as the solve's
+    passes test them: a slipping node's imbalance beyond its slider and power law (above ``tol``),
+    a stuck node's beyond its threshold (above ``tol_stick``); 0 if none, NaN if one is not a number.
+    Called only when the solve stops at its iteration cap, so that the loop it mirrors stays lean."""
+    worst = 0.0
+    for j in range(1, n + 1):
+        pos = S[_U + j] + S[_W + j]
+        df = S[_KL + j] * ((S[_U + j - 1] + S[_W + j - 1]) - pos) - Kr * (pos - (S[_U + j + 1] + S[_W + j + 1]))
+        sg = S[_SG + j]
+        if sg != 0.0:
+            aw = max(abs(S[_W + j]), _W_FLOOR) if S[_W + j] != 0.0 else h
+            r = abs(df - sg * (Ff + (Co * _pow(aw / h, pw) if Co > 0.0 else 0.0)))
+            bad = not r <= tol
+        else:
+            r = abs(df) - Ff
+            bad = not r <= tol_stick
+        if bad and worst == worst and (r != r or r > worst):   # a NaN, once found, is kept
+            worst = r
+    return worst
 
 
 @nb.njit(cache=True, inline="always", fastmath=_FAST)
@@ -510,10 +537,11 @@ def _continuous_step(x, Kpa, Ct, nroot, eps, stack, cs, ck):
 
 
 @nb.njit(cache=True, fastmath=_FAST)
-def step_bank(e, h, P, I, MX, L, q, eprev, cs, ck, stack, diss, nfail, F, K):
+def step_bank(e, h, P, I, MX, L, q, eprev, cs, ck, stack, diss, nfail, worst, F, K):
     """Advance all channels of a bank by one step of h seconds to deflections e (in place).
 
-    ``L`` holds the channels' ladders (:func:`place_ladders`).
+    ``L`` holds the channels' ladders (:func:`place_ladders`); ``nfail`` counts each channel's steps
+    whose solve did not converge, ``worst`` keeps their largest residual [m or rad] (NaN kept).
     """
     M = e.shape[0]
     for c in range(M):
@@ -529,13 +557,15 @@ def step_bank(e, h, P, I, MX, L, q, eprev, cs, ck, stack, diss, nfail, F, K):
         if I[c, I_KIND] == KIND_LADDER:
             n = I[c, I_NCELL]
             if n > 0:
-                fl, kl, dl, ok = _ladder_step(x, de, h, n, P[c, P_KPA], P[c, P_KR], P[c, P_FF], P[c, P_CO],
-                                              P[c, P_PW], P[c, P_TOL], L[I[c, I_LADDER]:])
+                fl, kl, dl, residual = _ladder_step(x, de, h, n, P[c, P_KPA], P[c, P_KR], P[c, P_FF], P[c, P_CO],
+                                                    P[c, P_PW], P[c, P_TOL], L[I[c, I_LADDER]:])
                 f += fl
                 k += kl
                 diss[c] += dl
-                if not ok:
+                if residual != 0.0:
                     nfail[c] += 1
+                    if worst[c] == worst[c] and (residual != residual or residual > worst[c]):
+                        worst[c] = residual
         else:
             fh, kh = _continuous_step(x, P[c, P_KPA], P[c, P_CT], P[c, P_NROOT], P[c, P_EPS],
                                       stack[c], cs[c], ck[c:c + 1])
@@ -564,7 +594,7 @@ def step_bank(e, h, P, I, MX, L, q, eprev, cs, ck, stack, diss, nfail, F, K):
 BANK_ARRAYS = (("P", np.float64, 2), ("I", np.int64, 2), ("MX", np.float64, 2), ("ladder", np.float64, 1),
                ("q", np.float64, 1), ("eprev", np.float64, 1), ("cs", np.float64, 2), ("ck", np.int64, 1),
                ("stack", np.float64, 3), ("diss", np.float64, 1), ("nfail", np.int64, 1),
-               ("force", np.float64, 1), ("tangent", np.float64, 1))
+               ("worst", np.float64, 1), ("force", np.float64, 1), ("tangent", np.float64, 1))
 _HEAD_DIMS = 3
 _HEAD = len(BANK_ARRAYS) * (1 + _HEAD_DIMS)
 _ALIGN = 8  # elements: every array starts a multiple of 64 bytes from its buffer's start
@@ -617,4 +647,4 @@ def step_packed(e, h, fb, ib):
         raise ValueError("deflections e must have one entry per channel of the bank")
     step_bank(e, h, _view2(fb, ib, 0), _view2(ib, ib, 1), _view2(fb, ib, 2), _view1(fb, ib, 3), _view1(fb, ib, 4),
               _view1(fb, ib, 5), _view2(fb, ib, 6), _view1(ib, ib, 7), _view3(fb, ib, 8), _view1(fb, ib, 9),
-              _view1(ib, ib, 10), _view1(fb, ib, 11), _view1(fb, ib, 12))
+              _view1(ib, ib, 10), _view1(fb, ib, 11), _view1(fb, ib, 12), _view1(fb, ib, 13))

@@ -21,6 +21,7 @@ from elastokin.recordings import run_reader
 from elastokin.recordings.run_reader import check_samples
 from elastokin.recordings.run_format import Run as RecordedRun
 from elastokin.recordings.run_writer import write_run
+from elastokin.vehicle.simulation.unconverged import UnconvergedSteps
 
 if TYPE_CHECKING:
     import pandas
@@ -126,6 +127,15 @@ class Run:
     def reason(self) -> str:
         """Why the run is incomplete ("" when complete)."""
         return self.recorded.reason
+
+    @property
+    def unconverged(self) -> tuple[UnconvergedSteps, ...]:
+        """The bushing directions whose implicit solve stopped at its iteration cap in some steps:
+        each one's count, worst residual [m or rad] against the tolerance, and the case and time
+        window [s] of the worst (empty for a run without, as every shipped vehicle's runs are, and for
+        a measured one). A run with some warns with
+        :class:`~elastokin.vehicle.simulation.unconverged.UnconvergedBushingSteps` when it ends."""
+        return self.recorded.unconverged
 
     @property
     def metadata(self) -> dict[str, Any]:

@@ -84,6 +84,11 @@ class Simulation:
             InputError: ``output`` exists and not ``overwrite``.
             elastokin.vehicle.simulation.runner.DivergenceError: the simulation diverged (a
                 recording is kept, incomplete).
+
+        Warns:
+            elastokin.vehicle.simulation.unconverged.UnconvergedBushingSteps: some bushing steps
+                did not converge to the solve's tolerance (where and by how much:
+                :attr:`Run.unconverged <elastokin.api.runs.Run.unconverged>`).
         """
         scenario = self.scenario if self.bushings is None else replace(self.scenario, bushing_model=self.bushings)
         bar = ProgressBar() if progress is True else None

@@ -17,7 +17,7 @@ from elastokin.cli import (built_ins, bushing_fit, bushing_run, bushings_on_road
                            plot, rig_import, rig_measure, run, sweep, view)
 from elastokin.core.provenance import software_version
 from elastokin.cli.interrupts import handle_sigterm, status
-from elastokin.core.errors import InputError
+from elastokin.core.errors import ElastokinWarning, InputError
 
 #: Command groups: name -> (help, description, their commands' modules).
 GROUPS: dict[str, tuple[str, str, tuple[ModuleType, ...]]] = {
@@ -53,9 +53,9 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
-    """A damaged recording's warning as one line of vsim's own (``vsim: warning: FILE: what is
-    missing``); any other as Python shows it."""
-    if category.__name__ == "DamagedRecording":
+    """The product's own warnings (a damaged recording, unconverged bushing steps) as one line of
+    vsim's (``vsim: warning: FILE: what is missing``); any other as Python shows it."""
+    if issubclass(category, ElastokinWarning):
         print(f"vsim: warning: {message}", file=sys.stderr, flush=True)
     else:
         _python_warning(message, category, filename, lineno, file, line)
@@ -66,7 +66,7 @@ _python_warning = warnings.showwarning
 
 def main(argv: list[str] | None = None) -> int:
     """Run ``vsim`` with ``argv``; input errors print one clear line and exit with status 2, Ctrl-C
-    and SIGTERM one line and 128 + the signal's number; a damaged recording's warnings one line each."""
+    and SIGTERM one line and 128 + the signal's number; the product's warnings one line each."""
     warnings.showwarning = _show_warning
     args = build_parser().parse_args(argv)
     handle_sigterm()

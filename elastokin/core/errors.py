@@ -4,6 +4,10 @@ what was expected."""
 from __future__ import annotations
 
 
+class ElastokinWarning(UserWarning):
+    """A warning a user can act on, about their data or their run (``vsim`` shows it as one line of its own)."""
+
+
 class InputError(ValueError):
     """Bad input from a file or the command line, with a message a user can act on."""
 

@@ -2,7 +2,8 @@
 case (:mod:`elastokin.analysis.road_metrics`); on the rig, the centre-line gradients and loop widths of
 camber, toe and half-track on each case's last cycle and the named K&C metrics of `vsim kc` per case
 and axle (periodic inputs, :mod:`elastokin.analysis.run_metrics`), the toe drift over the final hold
-(rack steps), and the peak deflection of every bushing during the inputs."""
+(rack steps), the peak deflection of every bushing during the inputs, and the bushing steps whose
+solve did not converge, if any."""
 
 from __future__ import annotations
 
@@ -16,6 +17,7 @@ from elastokin.analysis.road_metrics import RESPONSES, bandwidth_hz, road_metric
 from elastokin.analysis.run_metrics import (case_loop, case_mask, case_relaxation, cases, gradient_unit, input_phase, is_road,
                                        loop_axes, run_metrics)
 from elastokin.recordings.run_format import Run
+from elastokin.vehicle.simulation.unconverged import headline, worst_first
 
 SUMMARY_CORNERS = {"front": "fl", "rear": "rl"}   #: the left wheel of each axle is summarised
 _DIRECTIONS = ("x", "y", "z", "rx", "ry", "rz")
@@ -123,6 +125,8 @@ def summary(run: Run, contact_base: Mapping[str, float] | None = None) -> str:
     if extra["duration_scale"] != 1.0:
         lines.append(f"durations scaled by {extra['duration_scale']:g}: rates differ from the scenario's, "
                      f"and so do rate-dependent loops")
+    if run.unconverged:
+        lines += [f"WARNING: {headline(run.unconverged)}:"] + [f"  {s.describe()}" for s in worst_first(run.unconverged)]
     if is_road(run):
         lines += _road_table(run)
     elif extra["x_quantity"] is not None:

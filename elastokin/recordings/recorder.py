@@ -11,6 +11,7 @@ exception (:class:`elastokin.recordings.run_writer.RunWriter`).
 from __future__ import annotations
 
 import time
+import warnings
 from contextlib import closing
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -27,6 +28,7 @@ from elastokin.vehicle.scenarios.schedule import Progress
 from elastokin.vehicle.simulation.mounted import MountedCar
 from elastokin.vehicle.simulation.road_runner import RoadRun
 from elastokin.vehicle.simulation.runner import ScenarioRun
+from elastokin.vehicle.simulation.unconverged import UnconvergedBushingSteps, UnconvergedSteps, summary
 from elastokin.recordings.background import BackgroundWriter
 from elastokin.recordings.road_signals import RoadSignalLayout
 from elastokin.recordings.run_format import GeomSpec, Run, RunMetadata, rotation_matrix
@@ -103,13 +105,16 @@ def run_scenario(scenario: Scenario | RoadScenario, output: Path, *, bushing_mod
     geometry = geometry_from_model(play.car.model, bodies)
     with RunWriter(output, signals=layout.specs, bodies=bodies, geometry=geometry, metadata=metadata,
                    overwrite=overwrite) as writer:
-        # the blocks are closed first (the rig's context left at once if writing fails), then the queue is written
-        with BackgroundWriter(writer, layout) as sink, closing(play.blocks()) as blocks:
-            for block in blocks:
-                sink.put(block)
+        try:
+            # the blocks are closed first (the rig's context left at once if writing fails), then the queue is written
+            with BackgroundWriter(writer, layout) as sink, closing(play.blocks()) as blocks:
+                for block in blocks:
+                    sink.put(block)
+        finally:   # a run stopped early keeps what it found too
+            writer.unconverged = play.unconverged.steps()
     # the times as the file holds them: whole nanoseconds
     run = _in_memory(output, np.concatenate(sink.times_ns) / 1e9, sink.values, layout, metadata,
-                     (bodies, sink.body_pos, sink.body_quat_wxyz, geometry))
+                     (bodies, sink.body_pos, sink.body_quat_wxyz, geometry), writer.unconverged)
     return RunResult(output, play.total_s, time.perf_counter() - started, play.stepping_s, run)
 
 
@@ -143,15 +148,19 @@ def play_in_memory(scenario: Scenario | RoadScenario, vehicle: VehicleDefinition
     path = Path("(in memory)")
     bodies = play.bodies() if poses else []
     kept = (bodies, positions, quaternions, geometry_from_model(play.car.model, bodies)) if poses else None
-    run = _in_memory(path, np.concatenate(times), rows, layout, metadata, kept)
+    run = _in_memory(path, np.concatenate(times), rows, layout, metadata, kept, play.unconverged.steps())
     return RunResult(path, play.total_s, time.perf_counter() - started, play.stepping_s, run)
 
 
 def _in_memory(path: Path, t_s: np.ndarray, blocks: list[np.ndarray], layout: SignalLayout | RoadSignalLayout,
                metadata: RunMetadata,
-               poses: tuple[list[str], list[np.ndarray], list[np.ndarray], list[GeomSpec]] | None = None) -> Run:
+               poses: tuple[list[str], list[np.ndarray], list[np.ndarray], list[GeomSpec]] | None = None,
+               unconverged: tuple[UnconvergedSteps, ...] = ()) -> Run:
     """A complete :class:`Run` of the blocks of values ``blocks`` (one row per time in ``t_s``), with the
-    bodies' ``poses`` (their names, blocks of positions and of quaternions, geometry), or none."""
+    bodies' ``poses`` (their names, blocks of positions and of quaternions, geometry), or none, and
+    its ``unconverged`` bushing steps (said in a :class:`UnconvergedBushingSteps` warning)."""
+    if unconverged:
+        warnings.warn(UnconvergedBushingSteps(f"{path}: {summary(unconverged)}"), stacklevel=3)
     specs = layout.specs
     values = np.concatenate(blocks).reshape(len(t_s), len(specs))
     signals = {s.name: values[:, i] for i, s in enumerate(specs)}
@@ -160,7 +169,7 @@ def _in_memory(path: Path, t_s: np.ndarray, blocks: list[np.ndarray], layout: Si
                groups={s.name: s.group for s in specs}, specs=specs, body_names=bodies,
                body_pos=np.concatenate(positions) if bodies else np.empty((len(values), 0, 3)),
                body_quat_wxyz=np.concatenate(quaternions) if bodies else np.empty((len(values), 0, 4)),
-               geometry=geometry, metadata=metadata, complete=True, reason="")
+               geometry=geometry, metadata=metadata, complete=True, reason="", unconverged=unconverged)
 
 
 def geometry_from_model(model: mujoco.MjModel, bodies: list[str]) -> list[GeomSpec]:

@@ -22,7 +22,10 @@ metadata record ``vsim.run``
     hint), the body list and the geometry (JSON). A ``rig`` record has no vehicle YAML and no
     bushing parameters: measured data carries nothing about a model.
 metadata record ``vsim.status``
-    written by :meth:`elastokin.recordings.run_writer.RunWriter.close`: ``complete`` (``"true"``/``"false"``) and ``reason``.
+    written by :meth:`elastokin.recordings.run_writer.RunWriter.close`: ``complete`` (``"true"``/``"false"``),
+    ``reason`` and ``unconverged`` (JSON: a list of
+    :meth:`elastokin.vehicle.simulation.unconverged.UnconvergedSteps.to_record`, one per bushing direction
+    with steps whose solve did not converge; empty for a run without, and for a rig recording).
 
 Every time in the file is simulation time (``log_time`` = ``publish_time`` = stamp = t in ns), so
 equal inputs give bit-identical data. The file is written as ``<path>.partial`` and renamed to
@@ -39,6 +42,8 @@ from pathlib import Path
 from typing import Any, Mapping
 
 import numpy as np
+
+from elastokin.vehicle.simulation.unconverged import UnconvergedSteps
 
 TF_TOPIC = "/tf"
 GEOMETRY_TOPIC = "/geometry"
@@ -116,6 +121,7 @@ class Run:
     ``units[name]``; ``body_pos`` (N, B, 3) world positions in m; ``body_quat_wxyz`` (N, B, 4).
     ``complete`` is false for a run stopped early (divergence, Ctrl-C, exception), with the cause
     in ``reason``, and for a file read in part, what it could not give in ``damage`` (and ``reason``).
+    ``unconverged`` lists the bushing directions whose solve stopped at its iteration cap in some steps.
     """
 
     path: Path
@@ -132,6 +138,7 @@ class Run:
     complete: bool
     reason: str
     damage: tuple[str, ...] = ()   #: what a damaged file could not give (a chunk's CRC, a cut)
+    unconverged: tuple[UnconvergedSteps, ...] = ()
 
     def label(self, name: str) -> str:
         """``"name [unit]"`` for axis labels and legends."""

@@ -17,14 +17,15 @@ from mcap.records import Channel, Chunk, DataEnd, Message, Metadata
 from mcap.exceptions import EndOfFile
 from mcap.stream_reader import CRCValidationError, StreamReader, breakup_chunk
 
-from elastokin.core.errors import InputError
+from elastokin.core.errors import ElastokinWarning, InputError
 from elastokin.core.files import is_file
+from elastokin.vehicle.simulation.unconverged import UnconvergedSteps
 from elastokin.recordings.message_layouts import FrameTransformsLayout, JointStateLayout, timestamp_len
 from elastokin.recordings.run_format import (FORMAT_VERSION, PARTIAL_SUFFIX, RUN_RECORD, SIGNAL_TOPIC_PREFIX, STATUS_RECORD,
                                         TF_TOPIC, GeomSpec, Run, RunMetadata, SignalSpec, signal_label)
 
 
-class DamagedRecording(UserWarning):
+class DamagedRecording(ElastokinWarning):
     """A run file read in part: cut short, or with chunks that failed their CRC (the message says
     what is missing). :func:`load_run` warns with it, or raises it as an InputError when strict."""
 
@@ -217,7 +218,17 @@ def load_run(path: str | os.PathLike[str], *, strict: bool = False) -> Run:
         complete=status.get("complete") == "true",
         reason=str(status.get("reason", "")),
         damage=tuple(damage),
+        unconverged=_unconverged(records.get(STATUS_RECORD, {}), path),
     )
+
+
+def _unconverged(status: dict[str, str], path: Path) -> tuple[UnconvergedSteps, ...]:
+    """The status record's unconverged bushing steps (none in a file written before it kept them)."""
+    try:
+        return tuple(UnconvergedSteps.from_record(r) for r in json.loads(status.get("unconverged", "[]")))
+    except (ValueError, KeyError, TypeError, AttributeError) as exc:
+        raise InputError(f"its '{STATUS_RECORD}' record is damaged ({type(exc).__name__}: {exc})",
+                         source=str(path)) from None
 
 
 def _damage(lost: list[_Lost], chunks: int, cut: str, t_ns: np.ndarray, metadata: RunMetadata) -> list[str]:

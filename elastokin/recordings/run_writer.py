@@ -19,6 +19,7 @@ from foxglove.messages import (Color, CubePrimitive, CylinderPrimitive, Pose, Qu
 
 from elastokin.core.errors import InputError
 from elastokin.core.files import check_output
+from elastokin.vehicle.simulation.unconverged import UnconvergedSteps
 from elastokin.recordings.message_layouts import JOINT_STATE_SCHEMA, FrameTransformsLayout, JointStateLayout, timestamp_field
 from elastokin.recordings.run_format import (FORMAT_VERSION, GEOM_KINDS, GEOMETRY_TOPIC, NAME_PATTERN, PARTIAL_SUFFIX,
                                         RUN_RECORD, SIGNAL_TOPIC_PREFIX, SOURCES, STATUS_RECORD, TF_TOPIC, GeomSpec,
@@ -122,6 +123,8 @@ class RunWriter:
         self.partial_path = self.path.with_name(self.path.name + PARTIAL_SUFFIX)
         self._last_t_ns = -1
         self._closed = False
+        #: The bushing directions with unconverged steps, written in the status record at :meth:`close`.
+        self.unconverged: tuple[UnconvergedSteps, ...] = ()
         self._tf_layouts: dict[int, FrameTransformsLayout] = {}
 
         run_record = {
@@ -223,7 +226,8 @@ class RunWriter:
             return
         self._closed = True
         try:
-            self._writer.write_metadata(STATUS_RECORD, {"complete": "true" if complete else "false", "reason": reason})
+            self._writer.write_metadata(STATUS_RECORD, {"complete": "true" if complete else "false", "reason": reason,
+                                                        "unconverged": to_json([s.to_record() for s in self.unconverged])})
         finally:
             self._writer.close()
             os.replace(self.partial_path, self.path)
@@ -250,5 +254,6 @@ def write_run(run: Run, path: str | os.PathLike[str], *, overwrite: bool = False
         values = np.column_stack([run.signals[s.name] for s in run.specs]) if run.specs else np.empty((len(run.t_s), 0))
         if len(run.t_s):
             writer.write_block(run.t_s, values, run.body_pos, run.body_quat_wxyz)
+        writer.unconverged = run.unconverged
         writer.close(complete=run.complete, reason=run.reason)
     return Path(path)

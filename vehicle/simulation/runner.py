@@ -36,6 +36,7 @@ from elastokin.vehicle.scenarios.schedule import (PHASES, CaseSchedule, Progress
 from elastokin.vehicle.simulation.mounted import MountedCar
 from elastokin.vehicle.simulation.outputs import MeasuredColumns, SampleBlock
 from elastokin.vehicle.simulation.rig import KCRig
+from elastokin.vehicle.simulation.unconverged import UnconvergedTally
 from elastokin.core.units import DEG_PER_RAD, MM_PER_M
 
 
@@ -140,6 +141,8 @@ class PlayedScenario:
         self.recorded_bodies = np.arange(1 if poses else 0, self.car.model.nbody if poses else 0, dtype=np.int64)
         #: Wall time the cases spent in the compiled stepping loop [s] (their cars' ``stepping_s``).
         self.stepping_s = 0.0
+        #: The bushing steps whose solve did not converge, so far.
+        self.unconverged = UnconvergedTally()
 
     def bodies(self) -> list[str]:
         """Names of the bodies whose poses the blocks carry."""
@@ -177,6 +180,8 @@ class CaseSamples:
         self.names = tuple(ch.name for ch in car.car.channels)
         #: Steps the case has made so far.
         self.step = 0
+        #: The bank's counts of unconverged steps already tallied (the bank is the case's own).
+        self._tallied: np.ndarray | None = None
 
     def measure(self, phase: int, samples: int, apart: int, inputs: np.ndarray, recorded: np.ndarray,
                 also: Callable[[SampleBlock], tuple[int, str] | None] | None = None) -> Iterator[SampleBlock]:
@@ -190,6 +195,7 @@ class CaseSamples:
         self.step = int(steps[-1])
         block = SampleBlock(self.when.start_s + steps * dt, self.number, phase, (steps - self.input_start) * dt,
                             recorded[:len(measured)], measured, pos, quat)
+        self._tally_unconverged(float(block.time_s[0]) - apart * dt, float(block.time_s[-1]))
         found = [f for f in (divergence(block, car.columns, self.names, car, self.play.scenario),
                              also and also(block)) if f is not None]
         if found:
@@ -198,6 +204,19 @@ class CaseSamples:
             raise DivergenceError(float(block.time_s[row]), f"{self.number} '{self.label}'", what)
         yield block
         self.play._report(self.number, self.label, phase, float(block.time_s[-1]))
+
+    def _tally_unconverged(self, from_s: float, to_s: float) -> None:
+        """Add the unconverged bushing steps of the block from ``from_s`` to ``to_s`` [s] to the run's tally."""
+        forces = self.car.coupling.bushings
+        if forces.bank is None or not forces.bank.size:   # the laws are off, or every direction is linear
+            return
+        bank = forces.bank.bank
+        if self._tallied is None:
+            self._tallied = np.zeros(bank.size, dtype=np.int64)
+        if (bank.failed_steps != self._tallied).any():
+            units = ["rad" if ch.quantity == "rotation" else "m" for ch in bank.channels]
+            self.play.unconverged.add([self.names[i] for i in forces.bank_idx], units, bank.failed_steps,
+                                      self._tallied, bank.worst_residual, bank.tolerance, self.number, from_s, to_s)
 
 
 class ScenarioRun(PlayedScenario):
