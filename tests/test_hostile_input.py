@@ -212,6 +212,22 @@ def test_malformed_rig_csv_files_are_refused_at_their_line(tmp_path: Path, edit,
     assert not (tmp_path / "rig.mcap").exists()
 
 
+def test_a_record_imported_under_another_scenario_is_refused(tmp_path: Path) -> None:
+    """The shipped pumping export with a META naming the roll test: refused at its first pad sample
+    off, naming the line, the column, the time and both values (issue 50: it was imported as roll)."""
+    meta = (EXAMPLE / "META.yaml").read_text().replace("../../../scenarios/pumping.yaml", str(SCENARIO_DIR / "kc/roll.yaml"))
+    (tmp_path / "META.yaml").write_text(meta)
+    with pytest.raises(InputError) as error:
+        import_csv(EXAMPLE / "kc_pumping.csv", tmp_path / "META.yaml", tmp_path / "rig.mcap")
+    line = int(error.value.key.split(",")[0].removeprefix("line "))
+    header, *rows = (EXAMPLE / "kc_pumping.csv").read_text().splitlines()
+    column, row = error.value.key.split("column ")[1], rows[line - 2].split(",")
+    recorded, t_s = float(row[header.split(",").index(column)]), float(row[0]) / 1e3
+    assert column in ("pad_z_FL_mm", "pad_z_FR_mm", "pad_z_RL_mm", "pad_z_RR_mm")
+    assert f"the rig input is {recorded:.6g} mm at t = {t_s:.9g} s where the scenario kc_roll commands " in str(error.value)
+    assert not (tmp_path / "rig.mcap").exists()
+
+
 def test_a_bench_record_with_one_absurd_force_sample_is_refused(tmp_path: Path) -> None:
     file = tmp_path / "r.csv"
     file.write_text("t_s,e_mm,F_N\n0,0,0\n0.01,0.1,1e30\n0.02,0.2,3\n")

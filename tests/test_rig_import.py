@@ -244,3 +244,38 @@ def test_run_writer_refuses_a_rig_record_with_a_model(tmp_path: Path) -> None:
     with pytest.raises(ValueError, match="carries no model"):
         RunWriter(tmp_path / "rig.mcap", signals=[SignalSpec("camber_fl", "deg", "camber")], bodies=[], geometry=[],
                   metadata=metadata)
+
+
+def _pads_as_played(simulated: Run, lag_s: float = 0.0, gain: float = 1.0, noise_mm: float = 0.0
+                    ) -> dict[str, np.ndarray]:
+    """The simulated run's measured channels, its pad travels as a rig would have played them:
+    ``lag_s`` late, ``gain`` times the command, with white noise of ``noise_mm`` (seeded)."""
+    signals = {name: simulated.signals[name].copy() for name in measured_channels()}
+    noise = np.random.default_rng(7)
+    for tag in ("fl", "fr", "rl", "rr"):
+        played = np.interp(simulated.t_s - lag_s, simulated.t_s, simulated.signals[f"pad_z_{tag}"])
+        signals[f"pad_z_{tag}"] = gain * played + noise.normal(0.0, noise_mm, played.size)
+    return signals
+
+
+@pytest.mark.parametrize("lag_s, gain, noise_mm, refused", [
+    (0.02, 1.02, 0.1, False),     # a rig's servo: late, a little high, noisy
+    (-0.03, 0.98, 0.0, False),
+    (0.15, 1.0, 0.0, True),       # 2 Hz triangles of 10 mm: 8 mm off beyond the 50 ms allowed
+    (0.0, 1.25, 0.0, True),       # 2.5 mm off at the 10 mm peak: beyond 5 % + 0.5 mm
+    (0.0, -1.0, 0.0, True),       # a sign wrong
+])
+def test_rig_inputs_must_follow_the_scenario(simulated: Run, tmp_path: Path, lag_s: float, gain: float,
+                                             noise_mm: float, refused: bool) -> None:
+    signals = _pads_as_played(simulated, lag_s, gain, noise_mm)
+    write = lambda: write_rig_recording(tmp_path / "rig.mcap", load_scenario(PUMPING), simulated.t_s, signals,
+                                        measured_channels(), rig={"name": "test"}, duration_scale=QUICK)
+    if not refused:
+        assert load_run(write()).signals["pad_z_fl"].tolist() == signals["pad_z_fl"].tolist()
+        return
+    with pytest.raises(InputError, match=r"the rig input is -?[\d.]+ mm at t = [\d.]+ s where the scenario pumping "
+                                         r"commands -?[\d.]+ mm \(case 1 'amplitude_mm=10', input\)") as error:
+        write()
+    assert error.value.key.startswith("sample ") and error.value.key.endswith(", pad_z_fl")
+    assert not any(tmp_path.iterdir())
+

@@ -17,8 +17,8 @@ import numpy as np
 
 from elastokin.vehicle.scenarios.channels import INPUT_CHANNELS
 from elastokin.vehicle.scenarios.scenario import Scenario
-from elastokin.vehicle.scenarios.schedule import CaseSchedule, schedule, timestep
-from elastokin.core.units import plausible
+from elastokin.vehicle.scenarios.schedule import PHASES, CaseSchedule, schedule, timestep
+from elastokin.core.units import plausible, si
 from elastokin.core.errors import InputError
 from elastokin.core.files import atomic_output
 from elastokin.recordings.run_format import SignalSpec
@@ -35,6 +35,14 @@ DERIVED = ("case", "phase", "input_time")
 TIME_TOLERANCE_S = 1e-6
 #: A time step longer than this many median steps is a sampling gap.
 MAX_STEP_RATIO = 1.5
+#: A recorded rig input follows its command to within this fraction of the channel's largest
+#: command in the case, plus :data:`TRACKING_FLOOR` (a servo-hydraulic rig tracks to about 1 % of full scale)...
+TRACKING_FRACTION = 0.05
+#: ... in the channel's unit (a load cell's and a displacement transducer's noise and zero, widely).
+TRACKING_FLOOR = {"mm": 0.5, "N": 100.0, "N·m": 10.0}
+#: ... and as late or early as this [s] (a controller's and a filter's lag, tens of milliseconds).
+TRACKING_LAG_S = 0.05
+_LAGS = np.linspace(-TRACKING_LAG_S, TRACKING_LAG_S, 11)
 _NO_POSES = (np.empty((0, 3)), np.empty((0, 4)))
 
 
@@ -140,6 +148,50 @@ def _schedule_signals(t: np.ndarray, plan: list[CaseSchedule], dt: float) -> dic
     return {"case": k + 1.0, "phase": phase, "input_time": t - bounds[:, 1]}
 
 
+def _commanded(scenario: Scenario, plan: list[CaseSchedule], dt: float, duration_scale: float,
+               t: np.ndarray) -> np.ndarray:
+    """The rig inputs the scenario commands at times ``t`` [s] of the file, (len(t), len(INPUT_CHANNELS))
+    in SI: as the runner plays them, held at zero before each case's input and the input at
+    ``input_time`` / ``duration_scale`` of the case during it."""
+    at = _schedule_signals(t, plan, dt)
+    out = np.zeros((len(t), len(INPUT_CHANNELS)))
+    for k, case in enumerate(scenario.cases):
+        rows = (at["case"] == k + 1) & (at["phase"] == 2)
+        if rows.any():
+            out[rows] = case.inputs(at["input_time"][rows] / duration_scale)
+    return out
+
+
+def _check_inputs(scenario: Scenario, plan: list[CaseSchedule], dt: float, duration_scale: float, t: np.ndarray,
+                  values: Mapping[str, np.ndarray], source: str | None, where: Callable[[int, str], str]) -> None:
+    """Every recorded rig input follows what ``scenario`` commands (TRACKING_FRACTION, _FLOOR and
+    _LAG_S): a record of another scenario, or an input column with a wrong sign, unit or offset,
+    is refused at its first sample off, with both values."""
+    given = [(j, ch) for j, ch in enumerate(INPUT_CHANNELS) if ch in values]
+    if not given:
+        return
+    lagged = np.stack([_commanded(scenario, plan, dt, duration_scale, t + lag) for lag in _LAGS])   # (lags, N, C)
+    at = _schedule_signals(t, plan, dt)
+    case = at["case"].astype(int) - 1
+    known = measured_channels()
+    for j, ch in given:
+        unit = known[ch]
+        command = lagged[:, :, j] / si(unit)
+        peaks = np.zeros(len(plan))
+        np.maximum.at(peaks, case, np.abs(command).max(axis=0))   # each case's largest command
+        slack = TRACKING_FRACTION * peaks[case] + TRACKING_FLOOR[unit]
+        off = np.flatnonzero((values[ch] < command.min(axis=0) - slack) | (values[ch] > command.max(axis=0) + slack))
+        if off.size:
+            i, k = off[0], case[off[0]]
+            raise InputError(
+                f"the rig input is {values[ch][i]:.6g} {unit} at t = {t[i]:.9g} s where the scenario "
+                f"{scenario.name} commands {command[len(_LAGS) // 2, i]:.6g} {unit} (case {k + 1} "
+                f"'{scenario.cases[k].label}', {PHASES[int(at['phase'][i])]}); expected to follow it to within "
+                f"{slack[i]:.3g} {unit} ({TRACKING_FRACTION:.0%} of the case's largest command, {peaks[k]:.6g} {unit}, "
+                f"+ {TRACKING_FLOOR[unit]:g} {unit}) and ±{TRACKING_LAG_S * 1e3:g} ms: a record of another scenario, "
+                f"or the column's sign, unit or offset wrong?", source=source, key=where(i, ch))
+
+
 def _sample(index: int, name: str) -> str:
     return f"sample {index}, {name}"
 
@@ -160,8 +212,10 @@ def write_rig_recording(path: str | os.PathLike[str], scenario: Scenario, t_s: n
     data in errors (the CSV importer names its file, lines and columns).
 
     Raises :class:`InputError` for an existing ``path`` without ``overwrite``, an unknown channel or
-    unit, a missing required channel, a non-finite value, or a time base that is not strictly
-    increasing, has a sampling gap (a step over 1.5 × the median) or does not cover the scenario;
+    unit, a missing required channel, a non-finite value, a time base that is not strictly
+    increasing, has a sampling gap (a step over 1.5 × the median) or does not cover the scenario,
+    or a rig input (pad travel, pad force or torque, rack) that does not follow the scenario's
+    command (to within 5 % of the channel's largest command in the case + 0.5 mm, 100 N or 10 N·m, ±50 ms);
     nothing is written then, nor if writing fails (the file appears complete or not at all).
     """
     path = Path(path)
@@ -181,6 +235,7 @@ def write_rig_recording(path: str | os.PathLike[str], scenario: Scenario, t_s: n
     plan = schedule(scenario, duration_scale, dt)
     _check_time(t, plan[-1].end_s(dt), source, where)
 
+    _check_inputs(scenario, plan, dt, duration_scale, t, values, source, where)
     values.update(_schedule_signals(t, plan, dt))
     metadata = run_metadata(scenario, plan, duration_scale, dt)
     metadata.extra["rig"] = {"sample_rate_hz": 1.0 / float(np.median(np.diff(t))), **rig}
