@@ -21,6 +21,7 @@ import numpy as np
 import pytest
 
 from elastokin.bushings.parameter_sets import load_parameter_set
+from tests.damage_helpers import damaged_kc_dataset
 from tests.diagnosis_helpers import (MIN_PAIR_SUCCESS_RATE, MIN_SUCCESS_RATE, OWN_FORM_SUCCESS_RATE, PAIR, SLOW_SEEDS,
                                      assert_success_rate)
 from elastokin.vehicle.model.file_overrides import vehicle_with
@@ -39,10 +40,10 @@ from elastokin.diagnosis.kc_fits import (Candidate, Scorer, fit, fit_pair, halfw
 from elastokin.diagnosis.kc_layout import Layout, Test
 from elastokin.diagnosis.verdict import Separation, pair_named, split, told_apart
 from elastokin.diagnosis.virtual_kc_rig import DEFAULT_SCENARIOS, measure_kc, parse_kc_truth
-from elastokin.presentation.kc_report import _candidate, _parameters, summary
+from elastokin.presentation.kc_report import _candidate, _parameters, summary, write_report
 from elastokin.recordings.recorder import run_scenario, simulate
 from elastokin.recordings.kc_dataset import read_kc_dataset
-from elastokin.recordings.run_reader import load_run
+from elastokin.recordings.run_reader import DamagedRecording, load_run
 
 KC_CAUSES = sorted(c for c in OBSERVABLE if c != "backlash")
 #: The default suite diagnoses one draw (about 2 min); the slow suite SLOW_SEEDS per cause.
@@ -239,7 +240,8 @@ def test_the_screening_fit_scales_the_effect_and_clips_a_hopeless_one_at_its_bou
     shape = np.column_stack([np.sin(2 * np.pi * t), np.cos(3 * np.pi * t)])
     base = np.zeros_like(shape)
     measured = 1.5 * shape + 0.2 * rng.standard_normal(shape.shape)
-    tests = [Test(name, None, rows) for name, rows in (("a", np.arange(1000)), ("b", np.arange(1000, 2000)))]
+    tests = [Test(name, None, rows, np.arange(len(rows)), True)
+             for name, rows in (("a", np.arange(1000)), ("b", np.arange(1000, 2000)))]
     layout = Layout(["c_x", "c_y"], measured, np.zeros(2000), np.zeros(2000, dtype=int), np.repeat([0, 1], 1000), tests)
     scorer = Scorer(layout, base, split(2))
     for h, name, as_fitted in ((Hypothesis("broad_relaxation", ("e1_front", "y"), nominal("broad_relaxation")),
@@ -262,7 +264,8 @@ def test_the_refit_fits_a_second_parameter_along_its_slope_and_keeps_it_in_bound
     t = np.linspace(0.0, 1.0, 2000)
     shape = np.column_stack([np.sin(2 * np.pi * t), np.cos(3 * np.pi * t)])
     slope = np.column_stack([np.sin(5 * np.pi * t), t - 0.5]) * 8.0
-    tests = [Test(name, None, rows) for name, rows in (("a", np.arange(1000)), ("b", np.arange(1000, 2000)))]
+    tests = [Test(name, None, rows, np.arange(len(rows)), True)
+             for name, rows in (("a", np.arange(1000)), ("b", np.arange(1000, 2000)))]
     h = Hypothesis("broad_relaxation", ("e1_front", "y"), nominal("broad_relaxation"))
     k1, alpha = h.values["k1"], h.values["alpha"]
     for move, expected in ((0.05, alpha + 0.05), (0.8, parameters(h.cause)[1].bounds[1])):
@@ -295,7 +298,7 @@ def test_the_pair_refit_fits_the_second_causes_second_parameter_along_its_slope(
     first, second, slope = (np.column_stack([np.sin(k * np.pi * t), np.cos((k + 1) * np.pi * t)]) for k in (2, 5, 9))
     slope = 8.0 * slope
     measured = 1.2 * first + 0.9 * second + 0.05 * slope + 0.2 * rng.standard_normal(first.shape)
-    tests = [Test(str(i), None, np.arange(1000 * i, 1000 * (i + 1))) for i in range(4)]
+    tests = [Test(str(i), None, np.arange(1000 * i, 1000 * (i + 1)), np.arange(1000), True) for i in range(4)]
     layout = Layout(["c_x", "c_y"], measured, np.zeros(4000), np.zeros(4000, dtype=int), np.repeat(np.arange(4), 1000),
                     tests)
     base = np.zeros_like(first)
@@ -324,7 +327,7 @@ def test_the_second_stage_fits_the_second_cause_beside_the_first():
     first, second, decoy = (np.column_stack([np.sin(k * np.pi * t), np.cos((k + 1) * np.pi * t)]) for k in (2, 5, 9))
     measured = 1.3 * first + 0.8 * second + 0.05 * decoy + 0.2 * rng.standard_normal(first.shape)
     second = second + 0.3 * first     # the second hypothesis's effect overlaps the first's
-    tests = [Test(str(i), None, np.arange(1000 * i, 1000 * (i + 1))) for i in range(4)]
+    tests = [Test(str(i), None, np.arange(1000 * i, 1000 * (i + 1)), np.arange(1000), True) for i in range(4)]
     layout = Layout(["c_x", "c_y"], measured, np.zeros(4000), np.zeros(4000, dtype=int), np.repeat(np.arange(4), 1000),
                     tests)
     base = np.zeros_like(first)
@@ -381,7 +384,7 @@ def test_a_pair_refit_that_overshoots_is_tried_at_half_its_step():
 
     mullins = Hypothesis("mullins", ("e1_rear", "x"), nominal("mullins"))
     truth = replace(mullins, values={"mullins": 1.2 * m0, "mullins_shape": 1.32})
-    tests = [Test(str(i), None, np.arange(1000 * i, 1000 * (i + 1))) for i in range(4)]
+    tests = [Test(str(i), None, np.arange(1000 * i, 1000 * (i + 1)), np.arange(1000), True) for i in range(4)]
     layout = Layout(["c_x", "c_y"], first + effect(truth) + 0.2 * rng.standard_normal(first.shape), np.zeros(4000),
                     np.zeros(4000, dtype=int), np.repeat(np.arange(4), 1000), tests)
     base = np.zeros_like(first)
@@ -635,3 +638,22 @@ def test_success_rate_over_many_seeds(tmp_path, record_property, cause):
     assert_success_rate(cause, seeds, tmp_path, attempt, record_property,
                         MIN_PAIR_SUCCESS_RATE if cause == PAIR else MIN_SUCCESS_RATE if cause == "backlash"
                         else OWN_FORM_SUCCESS_RATE)
+
+
+@pytest.mark.slow
+def test_a_damaged_dataset_used_as_it_is_still_names_its_cause(tmp_path):
+    """The shipped dataset (a rear coupling of 70 N/mm, data/README.md) with a chunk of its roll
+    recording failing its CRC (8.6 s of the roll test missing), diagnosed with --use-damaged: the
+    same cause at its place, the stiffness within two of its standard deviations, the damage in the
+    report."""
+    folder = damaged_kc_dataset(tmp_path)
+    with pytest.warns(DamagedRecording):
+        data = read_kc_dataset(folder, use_damaged=True)
+    result = diagnose_kc(data, load_vehicle(DEFAULT_VEHICLE), executor=SerialExecutor())
+    out = summary(result)
+    assert out["cause"] == "coupling" and out["location"]["bushing"] == "e1_rear"
+    stiffness = out["parameters"]["stiffness"]
+    assert abs(stiffness["value"] - 70.0) <= 2 * stiffness["std"]
+    assert out["damage"] == [f"02_kc_roll.mcap: {data.tests[1].run.reason}"]
+    write_report(result, load_vehicle(DEFAULT_VEHICLE), tmp_path / "report", str(folder))
+    assert "**Diagnosed on a damaged dataset**" in (tmp_path / "report" / "report.md").read_text()

@@ -47,6 +47,7 @@ from elastokin.recordings.bench_dataset import read_bench_dataset
 from elastokin.recordings.csv_import import import_csv
 from elastokin.recordings.run_reader import DamagedRecording, load_run
 from elastokin.sweeps.sweep_file import load_sweep
+from tests.damage_helpers import chunk_spans
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "data" / "examples" / "kc_import"
@@ -367,19 +368,6 @@ def recording(tmp_path_factory: pytest.TempPathFactory) -> bytes:
     return import_csv(EXAMPLE / "kc_pumping.csv", meta, folder / "rig.mcap").read_bytes()
 
 
-def _chunk_spans(recording: bytes) -> list[tuple[int, int]]:
-    """(start, end) byte offsets of each chunk record of an MCAP file (opcode 0x06: 1 + 8 + length bytes)."""
-    spans, at = [], 8
-    while at + 9 <= len(recording):
-        opcode, length = recording[at], int.from_bytes(recording[at + 1:at + 9], "little")
-        if opcode == 0x06:
-            spans.append((at, at + 9 + length))
-        if opcode == 0x0F:   # the data section's end
-            break
-        at += 9 + length
-    return spans
-
-
 def load_run_quietly(recording: bytes, folder: Path):
     """The original recording, read."""
     path = folder / "original.mcap"
@@ -406,7 +394,7 @@ def test_mcap_runs(recording: bytes, folder: Path, data: st.DataObject) -> None:
     elif action == "splice":
         raw = raw[:at] + raw[data.draw(st.integers(0, len(raw) - 1)):]
     elif action == "drop_chunk":
-        spans = _chunk_spans(recording)
+        spans = chunk_spans(recording)
         start, end = spans[data.draw(st.integers(0, len(spans) - 1))]
         raw = raw[:start] + raw[end:]
     else:

@@ -20,6 +20,7 @@ import pytest
 import yaml
 
 import elastokin
+from tests.damage_helpers import damaged, damaged_kc_dataset
 from elastokin.bushings.bench.bench_file import load_bench
 from elastokin.bushings.bench.records import read_bench_csv
 from elastokin.vehicle.model.builder import build
@@ -30,9 +31,11 @@ from elastokin.vehicle.scenarios.scenario_file import load_scenario
 from elastokin.cli.main import main
 from elastokin.core.documents import Document, dump_yaml
 from elastokin.core.errors import InputError
-from elastokin.core.shipped import BENCH_DIR, DEFAULT_VEHICLE, SCENARIO_DIR
+from elastokin.core.shipped import BENCH_DIR, DATASET_DIR, DEFAULT_VEHICLE, SCENARIO_DIR
 from elastokin.recordings.csv_import import import_csv
-from elastokin.recordings.run_reader import load_run
+from elastokin.diagnosis.kc_layout import Layout
+from elastokin.recordings.kc_dataset import read_kc_dataset
+from elastokin.recordings.run_reader import DamagedRecording, load_run
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "data" / "examples" / "kc_import"
@@ -382,26 +385,6 @@ def chunked_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return output
 
 
-def _chunks(data: bytes) -> list[int]:
-    """The byte offsets of an MCAP file's chunk records (opcode 0x06; a record is 1 + 8 + length bytes)."""
-    at, out = 8, []
-    while data[at] != 0x0F:   # the data section's end
-        out += [at] if data[at] == 0x06 else []
-        at += 9 + int.from_bytes(data[at + 1:at + 9], "little")
-    return out
-
-
-def _damaged(source: Path, folder: Path, kind: str) -> Path:
-    data = source.read_bytes()
-    chunks = _chunks(data)
-    middle, inside = len(data) // 2, chunks[len(chunks) // 2] + 2000   # halfway; inside a middle chunk's data
-    damaged = {"cut_half": data[:middle], "inverted": data[:inside] + bytes(b ^ 0xFF for b in data[inside:inside + 64])
-               + data[inside + 64:], "cut_last_byte": data[:-1], "cut_at_start": data[:_chunks(data)[0] + 1000]}[kind]
-    path = folder / f"{kind}.mcap"
-    path.write_bytes(damaged)
-    return path
-
-
 @pytest.mark.parametrize("kind, words, whole", [
     ("cut_half", [r"recording cut at \d+\.\d s of its 13\.\d s \((no summary section|the file ends inside a record)\): "
                   r"read as far as it goes"],
@@ -414,7 +397,7 @@ def test_a_damaged_recording_is_said_damaged_by_every_reader(chunked_run: Path, 
     """Cut short, 64 bytes inverted, its summary cut: read as far as it goes, the part missing said on
     stderr by plot, view, compare, in the run (reason, damage) and the comparison; --strict refuses it."""
     original = load_run(chunked_run)
-    path = _damaged(chunked_run, tmp_path, kind)
+    path = damaged(chunked_run, tmp_path, kind)
     with pytest.warns(UserWarning) as said:
         run = load_run(path)
     message = str(said[0].message)
@@ -444,9 +427,34 @@ def test_a_damaged_recording_is_said_damaged_by_every_reader(chunked_run: Path, 
 
 def test_a_recording_cut_before_its_first_sample_is_refused_by_plot_and_view(chunked_run: Path, tmp_path: Path,
                                                                             capsys) -> None:
-    path = _damaged(chunked_run, tmp_path, "cut_at_start")
+    path = damaged(chunked_run, tmp_path, "cut_at_start")
     for argv, what in ((["plot", str(path), "-o", str(tmp_path / "p")], "plot"),
                        (["view", str(path), "--save", str(tmp_path / "v.rrd")], "replay")):
         code, err = _vsim(capsys, *argv)
         assert code == 2 and "recording cut before its first whole sample" in err and "Traceback" not in err, err
         assert f"holds no whole sample: nothing to {what}" in err
+
+
+def test_a_kc_dataset_with_a_damaged_recording_is_refused_unless_asked(tmp_path: Path, capsys) -> None:
+    folder = damaged_kc_dataset(tmp_path)
+    code, err = _vsim(capsys, "diagnose", str(folder))
+    assert code == 2 and re.search(r"rig\.yaml: recordings\[1\]: 02_kc_roll\.mcap is incomplete \(chunk 4 of 6 failed "
+                                   r"its CRC: [\d.]+ s missing \(t = [\d.]+ to [\d.]+ s\)\); --use-damaged", err), err
+    assert "vsim: warning: " in err and "Traceback" not in err
+    code, err = _vsim(capsys, "diagnose", "bench", "--bushing-set", "fig5_9", "--use-damaged")
+    assert code == 2 and "--use-damaged (use_damaged=True) is for a K&C dataset's recordings" in err
+    with pytest.warns(DamagedRecording):
+        kept = read_kc_dataset(folder, use_damaged=True)
+    assert kept.damage == (f"02_kc_roll.mcap: {kept.tests[1].run.reason}",)
+    vehicle = load_vehicle(DEFAULT_VEHICLE)
+    whole, part = Layout.of(read_kc_dataset(DATASET_DIR / "kc"), vehicle), Layout.of(kept, vehicle)
+    assert [t.name for t in part.tests] == [t.name for t in whole.tests]
+    lost = {p.name: len(w.rows) - len(p.rows) for w, p in zip(whole.tests, part.tests)}
+    assert sum(lost.values()) > 0 and all(n == 0 for name, n in lost.items() if not name.startswith("02_kc_roll"))
+    whole_by_name = {t.name: t for t in whole.tests}
+    for t in part.tests:   # each row is the whole dataset's at its test and sample
+        np.testing.assert_array_equal(part.measured[t.rows], whole.measured[whole_by_name[t.name].rows][t.samples])
+    # a simulation's input phase goes to the samples recorded
+    simulated = {t.name: {ch: whole.measured[t.rows, j] for j, ch in enumerate(whole.channels)} for t in whole.tests}
+    stacked = part.stack([simulated[t.name] for t in part.tests], range(len(part.tests)))
+    np.testing.assert_array_equal(stacked, part.measured)

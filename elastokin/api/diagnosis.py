@@ -17,7 +17,8 @@ from elastokin.recordings.datasets import check_baseline, dataset_level
 
 def diagnose(dataset: str | Path, vehicle: Vehicle | str | Path | None = None, *,
              bushings: ParameterSet | str | Path | None = None, scheduler: str | None = None,
-             workers: int | None = None, progress: Callable[[str], None] | None = None) -> Diagnosis:
+             workers: int | None = None, progress: Callable[[str], None] | None = None,
+             use_damaged: bool = False) -> Diagnosis:
     """What the model misses in a measured dataset: the baseline run on exactly the tests found,
     every applicable cause of the catalogue fitted on half of them and scored on the other half.
 
@@ -31,17 +32,21 @@ def diagnose(dataset: str | Path, vehicle: Vehicle | str | Path | None = None, *
             else local.
         workers: worker processes of a local cluster (default: one per core).
         progress: called with a line of text at each stage.
+        use_damaged: diagnose a K&C dataset whose recordings are damaged or incomplete with the
+            samples they hold (what they lack is in the report and ``summary()["damage"]``);
+            default: refuse it.
 
     Returns:
         The :class:`~elastokin.api.verdicts.Diagnosis`.
 
     Raises:
-        InputError: a damaged or missing dataset, a baseline of the wrong level (a vehicle for a
+        InputError: a damaged (unless ``use_damaged``) or missing dataset, a baseline of the wrong level (a vehicle for a
             bench dataset, a law for a K&C one), a bench dataset without its baseline law.
     """
     folder = dataset_folder(dataset)
     level = dataset_level(folder)
-    check_baseline(folder, level, vehicle is not None, bushings is not None)
+    check_baseline(folder, level, vehicle is not None, bushings is not None, use_damaged)
     if level == "kc":
-        return diagnose_kc_dataset(folder, vehicle, scheduler=scheduler, workers=workers, progress=progress)
+        return diagnose_kc_dataset(folder, vehicle, scheduler=scheduler, workers=workers, progress=progress,
+                                   use_damaged=use_damaged)
     return diagnose_bench_dataset(folder, bushings, progress)

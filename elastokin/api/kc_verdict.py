@@ -14,11 +14,13 @@ from elastokin.recordings.kc_dataset import read_kc_dataset
 
 
 def diagnose_kc_dataset(folder: Path, vehicle: Vehicle | str | Path | None, *, scheduler: str | None = None,
-                        workers: int | None = None, progress: Callable[[str], None] | None = None) -> Diagnosis:
+                        workers: int | None = None, progress: Callable[[str], None] | None = None,
+                        use_damaged: bool = False) -> Diagnosis:
     """:func:`elastokin.diagnose` of the K&C dataset in ``folder`` against ``vehicle`` (default:
-    the built-in car), its runs on ``scheduler``'s cluster."""
+    the built-in car), its runs on ``scheduler``'s cluster; with ``use_damaged``, on the samples
+    its damaged or incomplete recordings hold."""
     car = load_vehicle() if vehicle is None else vehicle if isinstance(vehicle, Vehicle) else load_vehicle(vehicle)
-    data = read_kc_dataset(folder)
+    data = read_kc_dataset(folder, use_damaged=use_damaged)
     with cluster(scheduler, workers) as ex:
         result = diagnose_kc(data, car.definition, executor=ex, progress=progress)
     return Diagnosis("kc", folder, result, car, kc_report.verdict_sentence, kc_report.summary,

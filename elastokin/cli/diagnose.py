@@ -16,14 +16,14 @@ def _diagnose(args: argparse.Namespace) -> int:
 
     folder = dataset(args.dataset)
     level = dataset_level(folder)
-    check_baseline(folder, level, args.vehicle is not None, args.bushing_set is not None)
+    check_baseline(folder, level, args.vehicle is not None, args.bushing_set is not None, args.use_damaged)
     progress = None if args.json else lambda s: print(f"  {s}", file=sys.stderr, flush=True)
     try:
         if level == "kc":   # the K&C diagnosis alone loads MuJoCo: a bench's does not
             from elastokin.api.kc_verdict import diagnose_kc_dataset
 
             found = diagnose_kc_dataset(folder, args.vehicle, scheduler=args.scheduler, workers=args.workers,
-                                        progress=progress)
+                                        progress=progress, use_damaged=args.use_damaged)
         else:
             from elastokin.api.bench_verdict import diagnose_bench_dataset
 
@@ -62,5 +62,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="write report.md, PNGs, diagnosis.json and the extended model here (extended_model.yaml for a bench, "
                         "extended_vehicle.yaml for K&C)")
     p.add_argument("--json", action="store_true", help="print the verdict as one JSON object")
+    p.add_argument("--use-damaged", action="store_true",
+                   help="diagnose a K&C dataset whose recordings are damaged or incomplete with the samples they hold "
+                        "(default: refuse it; what they lack goes into the report)")
     add_scheduler_options(p, "K&C datasets: ")
     p.set_defaults(func=_diagnose, compiles=True)

@@ -65,8 +65,9 @@ class Scorer:
     def _noise(self, residual: np.ndarray) -> np.ndarray:
         """Per channel: the white noise of the residual from its sample-to-sample differences within
         each test (robust: median absolute deviation), which a smooth model error hardly affects;
-        channels of one quantity share their median."""
-        d = np.vstack([np.diff(residual[t.rows], axis=0) for t in self.layout.tests])
+        channels of one quantity share their median. Only successive samples are differenced (a
+        damaged recording's gap is not one)."""
+        d = np.vstack([np.diff(residual[t.rows], axis=0)[np.diff(t.samples) == 1] for t in self.layout.tests])
         per = 1.4826 * np.median(np.abs(d - np.median(d, axis=0)), axis=0) / math.sqrt(2.0)
         family = [c.rsplit("_", 1)[0] for c in self.layout.channels]
         out = np.array([np.median([p for p, g in zip(per, family) if g == f]) for f in family])

@@ -9,6 +9,7 @@ from typing import Sequence
 
 import numpy as np
 
+from elastokin.core.errors import InputError
 from elastokin.vehicle.model.definition import VehicleDefinition
 from elastokin.vehicle.scenarios.scenario import Scenario
 from elastokin.recordings.kc_dataset import KCDataset
@@ -43,6 +44,8 @@ class Test:
     name: str
     job: Job                  #: the baseline's run of it
     rows: np.ndarray          #: its rows in the layout
+    samples: np.ndarray       #: each row's sample of the input phase (0-based; a damaged recording lacks some)
+    whole: bool               #: from a recording read whole: it holds every sample of the input phase
 
 
 @dataclass
@@ -56,27 +59,36 @@ class Layout:
     recording: np.ndarray         #: (N,) index of the recording of each row (a rig session: one zero per channel)
     test: np.ndarray              #: (N,) index of the test of each row
     tests: list[Test]
+    damage: tuple[str, ...] = ()  #: what the dataset's damaged recordings lack (their cases unrecorded too)
 
     @classmethod
     def of(cls, data: KCDataset, vehicle: VehicleDefinition) -> "Layout":
         """The compared channels of a dataset, case by case, and the baseline ``vehicle``'s run of each case."""
         first = data.tests[0].run
         channels = [n for n in first.signals if n.rsplit("_", 1)[0] in COMPARED or n.rsplit("_", 2)[0] in COMPARED]
-        measured, times, recording, tests, start = [], [], [], [], 0
+        measured, times, recording, tests, start, unrecorded = [], [], [], [], 0, []
         for k, t in enumerate(data.tests):
             run, scale = t.run, float(t.run.metadata.extra.get("duration_scale", 1.0))
             phase, number = run.signals["phase"], run.signals["case"].astype(int)
             for c, case in enumerate(t.scenario.cases, start=1):
                 on = (phase == 2) & (number == c)
                 n = int(on.sum())
+                if n == 0:   # only a damaged recording lacks a case's whole input
+                    unrecorded.append(f"{t.file.name}: case {c} ({case.label}) has no sample of its input: left out")
+                    continue
                 measured.append(np.column_stack([run.signals[ch][on] for ch in channels]))
                 times.append(run.signals["input_time"][on])
                 recording.append(np.full(n, k))
                 job = Job(replace(t.scenario, cases=[case]), vehicle, scale, tuple(channels))
-                tests.append(Test(f"{t.name} case {c} ({case.label})", job, np.arange(start, start + n)))
+                tests.append(Test(f"{t.name} case {c} ({case.label})", job, np.arange(start, start + n),
+                                  _samples(times[-1], t.scenario, f"{t.file.name}, case {c}"), run.complete))
                 start += n
+        if not tests:
+            raise InputError("no recording holds a sample of a case's input: nothing to diagnose",
+                             source=str(data.path))
         test = np.concatenate([np.full(len(t.rows), i) for i, t in enumerate(tests)])
-        return cls(channels, np.vstack(measured), np.concatenate(times), np.concatenate(recording), test, tests)
+        return cls(channels, np.vstack(measured), np.concatenate(times), np.concatenate(recording), test, tests,
+                   (*data.damage, *unrecorded))
 
     def jobs(self, vehicle: VehicleDefinition, tests: Sequence[int]) -> list[Job]:
         """The runs of ``tests`` (indices) on ``vehicle``."""
@@ -86,9 +98,24 @@ class Layout:
         """(N, C) rows of simulated runs of ``tests``; NaN in the rows of the others."""
         out = np.full(self.measured.shape, np.nan)
         for result, i in zip(results, tests):
-            rows = self.tests[i].rows
-            if len(result[self.channels[0]]) != len(rows):
-                raise RuntimeError(f"{self.tests[i].name}: the simulation gave {len(result[self.channels[0]])} "
-                                   f"samples of the input phase, the recording {len(rows)}")
-            out[rows] = np.column_stack([result[ch] for ch in self.channels])
+            t, n = self.tests[i], len(result[self.channels[0]])
+            if (n != len(t.rows)) if t.whole else (t.samples[-1] >= n):
+                raise RuntimeError(f"{t.name}: the simulation gave {n} samples of the input phase, the recording "
+                                   f"{len(t.rows)}{'' if t.whole else f' up to sample {t.samples[-1] + 1}'}")
+            out[t.rows] = np.column_stack([result[ch][t.samples] for ch in self.channels])
         return out
+
+
+def _samples(input_time_s: np.ndarray, scenario: Scenario, where: str) -> np.ndarray:
+    """The samples (0-based) of a case's input phase at the recorded times since its input started
+    [s]: the k-th comes k output intervals after the start, as the simulation records them.
+    InputError for samples off the scenario's output rate (a rig recording at another rate)."""
+    interval = 1.0 / scenario.output_rate_hz
+    k = np.rint(input_time_s / interval).astype(np.int64)
+    off = (k < 1) | (np.abs(k * interval - input_time_s) > 1e-6) | np.r_[False, np.diff(k) < 1]
+    if off.any():
+        i = int(np.argmax(off))
+        raise InputError(f"{where}: a sample {input_time_s[i]:.9g} s after the input started is not on the "
+                         f"scenario's output rate ({scenario.output_rate_hz:g} Hz), which the diagnosis compares at; "
+                         f"expected a recording at that rate")
+    return k - 1

@@ -86,6 +86,7 @@ def summary(d: KCDiagnosis) -> dict[str, Any]:
         "misfits": [_misfit(m) for m in d.misfits],
         "misfits_after": [_misfit(m) for m in d.misfits_after],
         "noise": {c: float(s) for c, s in zip(d.layout.channels, d.noise)},
+        "damage": list(d.layout.damage),
         "wall_s": d.wall_s,
     }
 
@@ -224,6 +225,9 @@ def write_report(d: KCDiagnosis, baseline: VehicleDefinition, out_dir: Path, dat
                     f"held out from every fit (every other one). Errors are RMS of measured − simulated over every "
                     f"measured channel but the rig inputs, each in units of its own measurement noise (estimated from "
                     f"the data), each channel's zero in each recording removed: 1 is a perfect model.")
+    if d.layout.damage:
+        report.paragraph("**Diagnosed on a damaged dataset** (`--use-damaged`), with the samples its recordings hold: "
+                         + "; ".join(d.layout.damage) + ".")
     if d.named:
         model = out_dir / "extended_vehicle.yaml"
         hypotheses = [c.hypothesis for c in d.causes]

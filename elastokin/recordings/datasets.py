@@ -54,10 +54,15 @@ def write_manifest(directory: str | os.PathLike[str], manifest: Mapping[str, Any
     return path
 
 
-def check_baseline(directory: str | os.PathLike[str], level: str, vehicle: bool, law: bool) -> None:
+def check_baseline(directory: str | os.PathLike[str], level: str, vehicle: bool, law: bool,
+                   use_damaged: bool = False) -> None:
     """InputError unless the baseline given suits the dataset's ``level``: a ``vehicle`` for K&C,
-    a bushing ``law`` for a bench (which needs one)."""
+    a bushing ``law`` for a bench (which needs one); and unless ``use_damaged`` is asked of a K&C
+    dataset only (a bench's CSV records are read whole or refused)."""
     where = str(Path(directory) / RIG_FILE)
+    if level == "bench" and use_damaged:
+        raise InputError("--use-damaged (use_damaged=True) is for a K&C dataset's recordings; a bench dataset's CSV "
+                         "records are read whole or refused", source=where, key="level")
     if level == "kc" and law:
         raise InputError("a K&C dataset is diagnosed against a vehicle (--vehicle; vehicle=...), not a bushing set",
                          source=where, key="level")

@@ -53,6 +53,9 @@ class KCDataset:
     vehicle_text: str
     rig: dict[str, Any] = field(default_factory=dict)
     tests: list[KCTest] = field(default_factory=list)
+    #: what its damaged or incomplete recordings lack (``"02_kc_roll.mcap: chunk 3 of 12 failed ..."``),
+    #: read with ``use_damaged``
+    damage: tuple[str, ...] = ()
 
 
 def write_kc_rig_yaml(directory: str | os.PathLike[str], vehicle_text: str, rig: Mapping[str, Any],
@@ -62,10 +65,11 @@ def write_kc_rig_yaml(directory: str | os.PathLike[str], vehicle_text: str, rig:
                                       "recordings": list(recordings)})
 
 
-def read_kc_dataset(directory: str | os.PathLike[str]) -> KCDataset:
+def read_kc_dataset(directory: str | os.PathLike[str], *, use_damaged: bool = False) -> KCDataset:
     """Read and validate a K&C dataset; errors name ``rig.yaml`` and the key (``recordings[i]`` for
-    a recording that is missing, unreadable, not a rig recording, incomplete, or whose scenario
-    cannot be rebuilt)."""
+    a recording that is missing, unreadable, not a rig recording, or whose scenario cannot be
+    rebuilt; and, unless ``use_damaged``, one that is damaged or incomplete: with it, the samples
+    such a recording holds are used and what it lacks is in the dataset's ``damage``)."""
     root = Path(directory)
     path, data = read_manifest(root, LEVEL, _KEYS)
     source = str(path)
@@ -79,7 +83,7 @@ def read_kc_dataset(directory: str | os.PathLike[str]) -> KCDataset:
     if not isinstance(entries, list) or not entries:
         raise InputError(f"expected a non-empty list of recording files (.mcap, relative to this file), got "
                          f"{entries!r}", source=source, key="recordings")
-    tests, seen = [], set()
+    tests, seen, damage = [], set(), []
     for i, entry in enumerate(entries):
         key = f"recordings[{i}]"
         if not isinstance(entry, str) or not entry:
@@ -90,12 +94,14 @@ def read_kc_dataset(directory: str | os.PathLike[str]) -> KCDataset:
         file = root / entry
         if not is_file(file):
             raise InputError(f"no such recording file {entry!r}", source=source, key=key)
-        run = _load(file, source, key)
+        run = _load(file, source, key, use_damaged)
+        if not run.complete:
+            damage.append(f"{file.name}: {run.reason}")
         tests.append(KCTest(file.stem, file, run, recorded_scenario(run, source=source, key=key)))
-    return KCDataset(root, vehicle_text, dict(rig), tests)
+    return KCDataset(root, vehicle_text, dict(rig), tests, tuple(damage))
 
 
-def _load(file: Path, source: str, key: str) -> Run:
+def _load(file: Path, source: str, key: str, use_damaged: bool) -> Run:
     try:
         run = load_run(file)
     except InputError as exc:
@@ -103,8 +109,9 @@ def _load(file: Path, source: str, key: str) -> Run:
     if run.metadata.source != "rig":
         raise InputError(f"{file.name} is a {run.metadata.source} run, not a rig recording (source: rig); "
                          f"a measured dataset holds measurements only", source=source, key=key)
-    if not run.complete:
-        raise InputError(f"{file.name} is incomplete ({run.reason})", source=source, key=key)
+    if not run.complete and not use_damaged:
+        raise InputError(f"{file.name} is incomplete ({run.reason}); --use-damaged (use_damaged=True) diagnoses "
+                         f"with the samples it holds", source=source, key=key)
     if run.t_s.size < 2:
         raise InputError(f"{file.name} holds {run.t_s.size} sample(s); expected a whole test", source=source, key=key)
     return run
