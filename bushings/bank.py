@@ -43,15 +43,16 @@ class BushingBank:
         self.tolerance = tolerance
         M = len(self.channels)
         n_mx = max(sum(len(ch.maxwell_k) for ch in self.channels), 1)
+        n_cv = max(sum(len(ch.curve) for ch in self.channels), 1)
         cells = np.array([0 if ch.continuous else ch.n_cells for ch in self.channels], dtype=np.int64)
         ladder_at, ladder_size = kn.place_ladders(cells)
-        shapes = {"P": (M, kn.N_PCOLS), "I": (M, kn.N_ICOLS), "MX": (n_mx, 2), "ladder": (ladder_size,),
+        shapes = {"P": (M, kn.N_PCOLS), "I": (M, kn.N_ICOLS), "MX": (n_mx, 2), "CV": (n_cv, 3), "ladder": (ladder_size,),
                   "q": (n_mx,), "eprev": (M,), "cs": (M, 2), "ck": (M,), "stack": (M, kn.STACK_SIZE, 2),
                   "diss": (M,), "nfail": (M,), "worst": (M,), "force": (M,), "tangent": (M,)}
         self._fbuf, self._ibuf, arrays = kn.pack_bank(shapes)
         for name, array in arrays.items():
             setattr(self, name, array)
-        mx = 0
+        mx = cv = 0
         for c, ch in enumerate(self.channels):
             self.P[c, kn.P_K0] = ch.K0
             self.P[c, kn.P_C] = ch.C
@@ -75,6 +76,11 @@ class BushingBank:
             for k, cc in zip(ch.maxwell_k, ch.maxwell_c):
                 self.MX[mx] = (k, cc)
                 mx += 1
+            self.I[c, kn.I_CV_N] = len(ch.curve)
+            self.I[c, kn.I_CV_OFF] = cv
+            for node in ch.curve:
+                self.CV[cv] = node
+                cv += 1
         self.reset()
 
     @property

@@ -105,21 +105,21 @@ def _effects_out(h, e, X, EP, ES, P, diss, F, K, Fout, Kout):
 
 
 @nb.njit(cache=True)
-def step_extended(e, h, EP, ES, X, Fout, Kout, P, I, MX, L, q, eprev, cs, ck, stack, diss, nfail, worst, F, K):
+def step_extended(e, h, EP, ES, X, Fout, Kout, P, I, MX, CV, L, q, eprev, cs, ck, stack, diss, nfail, worst, F, K):
     """One step of every channel to deflections e with its effects; (Fout, Kout) in place.
 
     The arguments after Kout are the bank's kernel arguments (:meth:`BushingBank.kernel_args`).
     """
     _effects_in(e, EP, X)
-    kn.step_bank(X, h, P, I, MX, L, q, eprev, cs, ck, stack, diss, nfail, worst, F, K)
+    kn.step_bank(X, h, P, I, MX, CV, L, q, eprev, cs, ck, stack, diss, nfail, worst, F, K)
     _effects_out(h, e, X, EP, ES, P, diss, F, K, Fout, Kout)
 
 
 @nb.njit(cache=True, nogil=True)
-def run_extended(E, dts, EP, ES, X, Fhist, Khist, P, I, MX, L, q, eprev, cs, ck, stack, diss, nfail, worst, F, K):
+def run_extended(E, dts, EP, ES, X, Fhist, Khist, P, I, MX, CV, L, q, eprev, cs, ck, stack, diss, nfail, worst, F, K):
     """Step through deflections E (T, M) with steps dts (T,) [s]; forces and tangents into (T, M)."""
     for t in range(E.shape[0]):
-        step_extended(E[t], dts[t], EP, ES, X, Fhist[t], Khist[t], P, I, MX, L, q, eprev, cs, ck, stack, diss,
+        step_extended(E[t], dts[t], EP, ES, X, Fhist[t], Khist[t], P, I, MX, CV, L, q, eprev, cs, ck, stack, diss,
                       nfail, worst, F, K)
 
 

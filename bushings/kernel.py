@@ -29,8 +29,8 @@ P_K0, P_C, P_NSUP, P_NINF, P_SSUP, P_SINF, P_PSUP, P_PINF, P_KPA, P_KR, P_FF, P_
     P_EPS, P_TOL = range(17)
 N_PCOLS = 17
 # Columns of the int parameter matrix I.
-I_KIND, I_NCELL, I_MX_N, I_MX_OFF, I_LADDER = range(5)
-N_ICOLS = 5
+I_KIND, I_NCELL, I_MX_N, I_MX_OFF, I_LADDER, I_CV_N, I_CV_OFF = range(7)
+N_ICOLS = 7
 KIND_LADDER, KIND_CONTINUOUS = 0, 1
 #: Turning points kept per continuous-STS channel (nested minor loops beyond this are merged).
 STACK_SIZE = 64
@@ -467,6 +467,37 @@ def _sts_shape(s, Ct, nroot, A, B):
 
 
 @nb.njit(cache=True, inline="always", fastmath=_FAST)
+def _curve(x, CV, o, n):
+    """A tabulated elastic law and its slope at deflection x: the cubic Hermite through the nodes
+    ``CV[o:o + n] = (x_i, F_i, dF/dx_i)`` (monotone when the slopes are PCHIP's), straight on with
+    the end slopes beyond the first and last node."""
+    if x <= CV[o, 0]:
+        return CV[o, 1] + CV[o, 2] * (x - CV[o, 0]), CV[o, 2]
+    last = o + n - 1
+    if x >= CV[last, 0]:
+        return CV[last, 1] + CV[last, 2] * (x - CV[last, 0]), CV[last, 2]
+    lo, hi = o, last
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if CV[mid, 0] <= x:
+            lo = mid
+        else:
+            hi = mid
+    h = CV[hi, 0] - CV[lo, 0]
+    t = (x - CV[lo, 0]) / h
+    f0, s0, f1, s1 = CV[lo, 1], CV[lo, 2] * h, CV[hi, 1], CV[hi, 2] * h
+    f = f0 + t * (s0 + t * (3.0 * (f1 - f0) - 2.0 * s0 - s1 + t * (2.0 * (f0 - f1) + s0 + s1)))
+    k = (s0 + t * (6.0 * (f1 - f0) - 4.0 * s0 - 2.0 * s1 + t * (6.0 * (f0 - f1) + 3.0 * s0 + 3.0 * s1))) / h
+    return f, k
+
+
+@nb.njit(cache=True)
+def curve_at(x, nodes):
+    """:func:`_curve` of the nodes (n, 3) alone: (force, slope) at x, for code outside the kernel."""
+    return _curve(x, nodes, 0, nodes.shape[0])
+
+
+@nb.njit(cache=True, inline="always", fastmath=_FAST)
 def _branch(x, xo, ho, d, virgin, Ct, nroot, A, B):
     """Hysteretic force on the branch leaving (xo, ho) in direction d (Masing: 2·H0(s/2)), or on the
     first-loading curve when ``virgin``."""
@@ -537,17 +568,21 @@ def _continuous_step(x, Kpa, Ct, nroot, eps, stack, cs, ck):
 
 
 @nb.njit(cache=True, fastmath=_FAST)
-def step_bank(e, h, P, I, MX, L, q, eprev, cs, ck, stack, diss, nfail, worst, F, K):
+def step_bank(e, h, P, I, MX, CV, L, q, eprev, cs, ck, stack, diss, nfail, worst, F, K):
     """Advance all channels of a bank by one step of h seconds to deflections e (in place).
 
-    ``L`` holds the channels' ladders (:func:`place_ladders`); ``nfail`` counts each channel's steps
+    ``CV`` holds the nodes of the channels with a tabulated elastic law (:func:`_curve`), ``L`` the
+    channels' ladders (:func:`place_ladders`); ``nfail`` counts each channel's steps
     whose solve did not converge, ``worst`` keeps their largest residual [m or rad] (NaN kept).
     """
     M = e.shape[0]
     for c in range(M):
         x = e[c]
-        f, k = _elastic(x, P[c, P_K0], P[c, P_NSUP], P[c, P_NINF], P[c, P_SSUP], P[c, P_SINF],
-                        P[c, P_PSUP], P[c, P_PINF])
+        if I[c, I_CV_N] > 0:
+            f, k = _curve(x, CV, I[c, I_CV_OFF], I[c, I_CV_N])
+        else:
+            f, k = _elastic(x, P[c, P_K0], P[c, P_NSUP], P[c, P_NINF], P[c, P_SSUP], P[c, P_SINF],
+                            P[c, P_PSUP], P[c, P_PINF])
         cdamp = P[c, P_C]
         de = x - eprev[c]
         if cdamp > 0.0:
@@ -591,7 +626,8 @@ def step_bank(e, h, P, I, MX, L, q, eprev, cs, ck, stack, diss, nfail, worst, F,
 # 15 cost about 0.6 µs more per call on the benchmark (25 µs). The int buffer opens with a header
 # holding, for each array, its offset in its buffer and its shape (padded with 1s to _HEAD_DIMS).
 #: step_bank's arrays in its argument order after (e, h): name, dtype, dimensions.
-BANK_ARRAYS = (("P", np.float64, 2), ("I", np.int64, 2), ("MX", np.float64, 2), ("ladder", np.float64, 1),
+BANK_ARRAYS = (("P", np.float64, 2), ("I", np.int64, 2), ("MX", np.float64, 2), ("CV", np.float64, 2),
+               ("ladder", np.float64, 1),
                ("q", np.float64, 1), ("eprev", np.float64, 1), ("cs", np.float64, 2), ("ck", np.int64, 1),
                ("stack", np.float64, 3), ("diss", np.float64, 1), ("nfail", np.int64, 1),
                ("worst", np.float64, 1), ("force", np.float64, 1), ("tangent", np.float64, 1))
@@ -645,6 +681,6 @@ def step_packed(e, h, fb, ib):
     """:func:`step_bank` on a bank packed by :func:`pack_bank` (float buffer fb, int buffer ib)."""
     if e.shape[0] != ib[1]:  # P's rows: one per channel
         raise ValueError("deflections e must have one entry per channel of the bank")
-    step_bank(e, h, _view2(fb, ib, 0), _view2(ib, ib, 1), _view2(fb, ib, 2), _view1(fb, ib, 3), _view1(fb, ib, 4),
-              _view1(fb, ib, 5), _view2(fb, ib, 6), _view1(ib, ib, 7), _view3(fb, ib, 8), _view1(fb, ib, 9),
-              _view1(ib, ib, 10), _view1(fb, ib, 11), _view1(fb, ib, 12), _view1(fb, ib, 13))
+    step_bank(e, h, _view2(fb, ib, 0), _view2(ib, ib, 1), _view2(fb, ib, 2), _view2(fb, ib, 3), _view1(fb, ib, 4),
+              _view1(fb, ib, 5), _view1(fb, ib, 6), _view2(fb, ib, 7), _view1(ib, ib, 8), _view3(fb, ib, 9),
+              _view1(fb, ib, 10), _view1(ib, ib, 11), _view1(fb, ib, 12), _view1(fb, ib, 13), _view1(fb, ib, 14))

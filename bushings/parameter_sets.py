@@ -115,9 +115,9 @@ def save_parameter_set(pset: ParameterSet, path: str | Path) -> Path:
 
 
 def _plain(v: Any) -> Any:
-    """A parameter value as a YAML scalar (int or float) or a list of floats."""
+    """A parameter value as a YAML scalar (int or float), or a list of them (a curve: of pairs)."""
     if isinstance(v, (list, tuple)):
-        return [float(x) for x in v]
+        return [_plain(x) if isinstance(x, (list, tuple)) else float(x) for x in v]
     return int(v) if isinstance(v, int) else float(v)
 
 

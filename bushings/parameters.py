@@ -11,6 +11,8 @@ import math
 from dataclasses import dataclass, field, replace
 from typing import Any, Mapping
 
+import numpy as np
+
 from elastokin.core import units
 from elastokin.core.errors import InputError
 
@@ -33,7 +35,7 @@ _PARAMETERS: dict[str, tuple[int | None, str]] = {
     "Co": (None, "{F}/({L}/s)^pw"), "pw": (0, ""), "N": (0, ""),
     "N_sup": (1, "{L}"), "N_inf": (1, "{L}"), "S_sup": (1, "{L}"), "S_inf": (1, "{L}"), "P_sup": (0, "{F}"),
     "P_inf": (0, "{F}"), "Ct": (-1, "{F}^n/{L}"), "n": (0, ""), "maxwell_k": (-1, "{F}/{L}"),
-    "maxwell_c": (-1, "{F}·s/{L}"),
+    "maxwell_c": (-1, "{F}·s/{L}"), "curve": (None, "[{L}, {F}] points"),
 }
 
 _ELASTIC_KEYS = ("N_sup", "N_inf", "S_sup", "S_inf", "P_sup", "P_inf")
@@ -50,7 +52,10 @@ MODELS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
     "rt": (("K0", "Kpa", "Kr", "Co", "pw"), ("N", "C") + _ELASTIC_KEYS + _MAXWELL_KEYS),
     "stvs": (("K0", "Kpa", "Kr", "Ff", "Co", "pw"), ("N", "C") + _ELASTIC_KEYS + _MAXWELL_KEYS),
     "tvs": (("K0", "Kpa", "Kr", "Ff") + _MAXWELL_KEYS, ("N", "C") + _ELASTIC_KEYS),
+    "curve": (("curve",), ("C",) + _MAXWELL_KEYS),
 }
+#: Most points of a tabulated elastic law (``curve``).
+MAX_CURVE_POINTS = 1000
 
 #: The models the bench identification fits (all their required parameters, N fixed): a constant
 #: here, so that the command line lists them without importing the fit (and scipy).
@@ -72,7 +77,8 @@ class ChannelParams:
     """One bushing direction's force law, in SI (N, m, s; or N·m, rad, s for rotations).
 
     The force is ``F = F_el(e) + C·de/dt + ladder(e) + Σ maxwell_j(e)`` (or the continuous
-    STS hysteresis instead of the ladder). ``n_cells = 0`` means no ladder.
+    STS hysteresis instead of the ladder). ``n_cells = 0`` means no ladder. A ``curve`` law's
+    ``F_el`` is its tabulated curve (``curve`` nodes), and ``K0`` the curve's slope at zero.
     """
 
     model: str
@@ -95,6 +101,8 @@ class ChannelParams:
     n_root: float = 2.0             #: root of the continuous STS (2 = Coveney; STSn+ otherwise)
     maxwell_k: tuple[float, ...] = field(default_factory=tuple)  #: Maxwell spring stiffnesses [N/m]
     maxwell_c: tuple[float, ...] = field(default_factory=tuple)  #: Maxwell damper rates [N·s/m]
+    #: a tabulated elastic law's nodes (deflection [m], force [N], slope [N/m]), deflections increasing
+    curve: tuple[tuple[float, float, float], ...] = field(default_factory=tuple)
 
     @property
     def continuous(self) -> bool:
@@ -121,7 +129,8 @@ def to_si(model: str, values: Mapping[str, Any], quantity: str = "translation",
 
     ``values`` uses the thesis's names: K0, Kpa, Kr [N/mm], Ff [N], Co [N/(mm/s)^pw], pw, N,
     C [N·s/mm], N_sup/N_inf/S_sup/S_inf [mm], P_sup/P_inf [N], Ct [N^n/mm], n, maxwell_k [N/mm],
-    maxwell_c [N·s/mm] (N·m and deg in place of N and mm for ``quantity: rotation``).
+    maxwell_c [N·s/mm], curve [[mm, N], ...] (N·m and deg in place of N and mm for ``quantity:
+    rotation``).
     """
     if not isinstance(model, str) or model not in MODELS:
         raise InputError(f"unknown model {model!r}; expected one of {', '.join(MODELS)}",
@@ -141,6 +150,10 @@ def to_si(model: str, values: Mapping[str, Any], quantity: str = "translation",
     length = LENGTH_UNIT_SI[quantity]
     si: dict[str, Any] = {}
     for key, raw in values.items():
+        if key == "curve":
+            si["curve"] = curve_nodes(raw, length, source)
+            si["K0"] = _slope_at_zero(si["curve"])
+            continue
         if key in ("maxwell_k", "maxwell_c"):
             if not isinstance(raw, (list, tuple)) or not raw:
                 raise InputError(f"expected a non-empty list of numbers, got {raw!r}", source=source, key=key)
@@ -178,6 +191,60 @@ def to_si(model: str, values: Mapping[str, Any], quantity: str = "translation",
     if model == "rt":
         si["Ff"] = 0.0
     return ChannelParams(model=model, quantity=quantity, **si)
+
+
+def curve_nodes(points: Any, length_si: float, source: str = "<parameters>", key: str = "curve"
+                ) -> tuple[tuple[float, float, float], ...]:
+    """The nodes (deflection [m or rad], force [N or N·m], slope) of a tabulated elastic law given as
+    ``points`` [[deflection, force], ...] in the length unit ``length_si`` (SI per unit): the
+    monotone cubic through the points (PCHIP's slopes, so that it neither overshoots nor wiggles
+    between them; the end slopes are the end segments'). InputError naming ``key`` unless there are
+    2 to MAX_CURVE_POINTS points of two finite numbers, deflections increasing and spanning 0, the
+    force not falling and zero at zero deflection (a preload is the vehicle's, not the law's)."""
+    if not isinstance(points, (list, tuple)) or not 2 <= len(points) <= MAX_CURVE_POINTS:
+        raise InputError(f"expected 2 to {MAX_CURVE_POINTS} [deflection, force] points, got {str(points)[:60]}",
+                         source=source, key=key)
+    rows = []
+    for i, p in enumerate(points):
+        if not isinstance(p, (list, tuple)) or len(p) != 2:
+            raise InputError(f"expected a [deflection, force] pair, got {p!r}", source=source, key=f"{key}[{i}]")
+        rows.append([_number(v, source, f"{key}[{i}]") for v in p])
+    x = [r[0] * length_si for r in rows]
+    f = [r[1] for r in rows]
+    for i in range(1, len(rows)):
+        if not x[i] > x[i - 1]:
+            raise InputError(f"deflection {rows[i][0]:g} does not follow {rows[i - 1][0]:g}; expected increasing "
+                             f"deflections", source=source, key=f"{key}[{i}]")
+        if f[i] < f[i - 1]:
+            raise InputError(f"force falls from {rows[i - 1][1]:g} to {rows[i][1]:g}; expected a curve that does not "
+                             f"fall (a falling stiffness is unstable)", source=source, key=f"{key}[{i}]")
+    if not x[0] <= 0.0 <= x[-1]:
+        raise InputError(f"deflections {rows[0][0]:g} to {rows[-1][0]:g} do not span 0; expected the curve through "
+                         f"the unloaded bushing", source=source, key=key)
+    if f[-1] <= f[0]:
+        raise InputError("the force never rises; expected a stiffness", source=source, key=key)
+    from scipy.interpolate import PchipInterpolator   # here: the vehicle's command line needs no scipy
+
+    slopes = PchipInterpolator(x, f).derivative()(x)
+    slopes[0], slopes[-1] = (f[1] - f[0]) / (x[1] - x[0]), (f[-1] - f[-2]) / (x[-1] - x[-2])
+    nodes = tuple((xi, fi, float(si)) for xi, fi, si in zip(x, f, slopes))
+    at_zero = curve_force(0.0, nodes)[0]
+    if abs(at_zero) > 1e-6 * max(abs(f[0]), abs(f[-1])):
+        raise InputError(f"force {at_zero:.6g} at zero deflection; expected 0 (the curve through the unloaded "
+                         f"bushing; a preload is set on the vehicle's bushing)", source=source, key=key)
+    return nodes
+
+
+def _slope_at_zero(nodes: tuple[tuple[float, float, float], ...]) -> float:
+    """The tabulated law's slope at zero deflection (its linear stiffness about the design position)."""
+    return curve_force(0.0, nodes)[1]
+
+
+def curve_force(x: float, nodes: tuple[tuple[float, float, float], ...]) -> tuple[float, float]:
+    """A tabulated law's force and slope at deflection ``x``, as the kernel evaluates them."""
+    from elastokin.bushings.kernel import curve_at   # the kernel's own evaluation (numba, loaded when needed)
+
+    return curve_at(float(x), np.asarray(nodes, dtype=float))
 
 
 def _check_elastic(si: dict[str, Any], source: str) -> None:

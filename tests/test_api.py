@@ -282,3 +282,12 @@ def test_the_front_doors_objects_say_briefly_what_they_are(pumping: elastokin.Ru
     assert repr(car) == f"<Vehicle 'c_segment' from {car.path}>" and len(repr(car)) < 200
     assert repr(car.with_values({"front.spring.rate": 30000.0})).endswith(", changed in code>")
     assert repr(pumping).startswith("<Run pumping (pumping): 6 case(s)")
+
+
+def test_the_list_commands_kinds_are_the_apis() -> None:
+    """`vsim list KIND` offers every kind the API lists (the command line keeps its own copy to load nothing)."""
+    from elastokin.api.built_ins import KINDS
+    from elastokin.cli.main import build_parser
+
+    listing = build_parser()._subparsers._group_actions[0].choices["list"]
+    assert list(next(a for a in listing._actions if a.dest == "kind").choices) == [k.name for k in KINDS]

@@ -14,6 +14,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
+from elastokin.bushings.adams_bus import read_bus
 from elastokin.bushings.bench.programmes import Sweep, TimeSeries, read_programme
 from elastokin.bushings.effects import NO_EFFECTS, Effects
 from elastokin.bushings.extended_bank import ExtendedBank
@@ -27,7 +28,7 @@ from elastokin.core.units import MM
 
 #: Longest bench time step accepted [s]: the bench samples rubber that relaxes in tenths of a second.
 MAX_DT_S = 1.0
-_BENCH_KEYS = ("model", "params", "dt_s", "programme")
+_BENCH_KEYS = ("model", "params", "direction", "dt_s", "programme")
 
 
 @dataclass(frozen=True)
@@ -49,8 +50,9 @@ def parse_bench(data: Any, source: str, base_dir: Path | None = None) -> Bench:
 def read_bench(doc: Document, base_dir: Path | None = None) -> Bench:
     """Validate a bench document; errors name its file:line and the key.
 
-    ``params`` is the name (or path) of a parameter set, read as ``model`` if given, or an inline
-    mapping in N, mm, s (``model`` then required).
+    ``params`` is the name (or path) of a parameter set, read as ``model`` if given, an Adams bushing
+    property file (``.bus``, its ``direction``'s curve and damping: x, y or z, default x), or an
+    inline mapping in N, mm, s (``model`` then required).
     """
     f = doc.top(_BENCH_KEYS)
     for key in ("params", "dt_s", "programme"):
@@ -68,6 +70,8 @@ def read_bench(doc: Document, base_dir: Path | None = None) -> Bench:
         channel, effects = _named_set(params, model, f, base_dir)
     else:
         raise f.fail("params", f"expected a parameter-set name or a mapping, got {params!r}")
+    if f.has("direction") and not (isinstance(params, str) and params.endswith(".bus")):
+        raise f.fail("direction", "a direction is read from an Adams property file (params: F.bus) only")
     if channel.quantity != "translation":
         raise f.fail("params", f"the bench works in mm; set {params!r} is a {channel.quantity}")
     dt = f.raw("dt_s")
@@ -84,10 +88,13 @@ def _named_set(name: str, model: str | None, f: Fields, base_dir: Path | None) -
     """A parameter set (SI law and effects) by name, or by path relative to the bench file; errors
     name both files."""
     path = Path(name)
-    if path.suffix in (".yaml", ".yml") and not path.is_absolute() and base_dir is not None:
+    if path.suffix in (".yaml", ".yml", ".bus") and not path.is_absolute() and base_dir is not None:
         name = str(base_dir / path)
+    direction = f.raw("direction", "x")
+    if direction not in ("x", "y", "z"):
+        raise f.fail("direction", f"expected x, y or z (the bench works in mm), got {direction!r}")
     try:
-        pset = load_parameter_set(name)
+        pset = read_bus(name).parameter_set(direction) if path.suffix == ".bus" else load_parameter_set(name)
         return pset.channel(model), pset.effects_si()
     except InputError as exc:
         raise f.fail("params", str(exc)) from exc

@@ -1,5 +1,5 @@
-"""The shipped files a user can name: vehicles, scenarios, sweeps, bushing parameter sets, tyres,
-bench programmes and example datasets; their list, and editable copies of them."""
+"""The shipped files a user can name: vehicles, scenarios, sweeps, bushing parameter sets and
+property files, tyres, bench programmes and example datasets; their list, and editable copies."""
 
 from __future__ import annotations
 
@@ -28,6 +28,8 @@ class Kind:
 KINDS = (
     Kind("vehicles", VEHICLE_DIR, ".yaml", "vehicle files (format: models/vehicles/README.md)"),
     Kind("bushing sets", PARAMETER_SET_DIR, ".yaml", "bushing parameter sets (models/bushings/README.md)"),
+    Kind("bushing property files", PARAMETER_SET_DIR, ".bus",
+         "Adams bushing property files, exported from sets (`property_file:` in a vehicle file)"),
     Kind("tyres", TYRE_DIR, ".tir", "tyre property files, Magic Formula (models/tyres/README.md)"),
     Kind("scenarios", SCENARIO_DIR, ".yaml", "what the car is made to do, on the rig and the road (scenarios/README.md)"),
     Kind("sweeps", SWEEP_DIR, ".yaml", "designs of runs over vehicle-file numbers (scenarios/sweeps/README.md)"),
@@ -40,7 +42,7 @@ def _names(kind: Kind) -> list[str]:
     if not kind.suffix:
         return sorted(p.parent.name for p in kind.folder.glob("*/rig.yaml"))
     if kind.folder == PARAMETER_SET_DIR:   # the bench programmes are a folder of their own
-        return sorted(p.stem for p in kind.folder.glob("*.yaml"))
+        return sorted(p.stem for p in kind.folder.glob(f"*{kind.suffix}"))
     return built_in(kind.folder, kind.suffix)
 
 

@@ -30,7 +30,8 @@ def _copy(args: argparse.Namespace) -> int:
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``list`` and ``copy``."""
-    from_kinds = ("vehicles", "bushing sets", "tyres", "scenarios", "sweeps", "bench programmes", "datasets")
+    from_kinds = ("vehicles", "bushing sets", "bushing property files", "tyres", "scenarios", "sweeps",
+                  "bench programmes", "datasets")
     listing = subparsers.add_parser(
         "list", help="the built-in vehicles, scenarios, bushing sets, tyres, sweeps, bench programmes and datasets",
         description="Every file shipped with the software that a command takes by name instead of a path.")

@@ -13,16 +13,18 @@ import sys
 import warnings
 from types import ModuleType
 
-from elastokin.cli import (built_ins, bushing_fit, bushing_run, bushings_on_road, compare, compile, diagnose, kc, model_export,
-                           plot, rig_import, rig_measure, run, sweep, view)
+from elastokin.cli import (built_ins, bushing_export, bushing_fit, bushing_import, bushing_run, bushings_on_road,
+                           compare, compile, diagnose, kc, model_export, plot, rig_import, rig_measure, run, sweep, view)
 from elastokin.core.provenance import software_version
 from elastokin.cli.interrupts import handle_sigterm, status
 from elastokin.core.errors import ElastokinWarning, InputError
 
 #: Command groups: name -> (help, description, their commands' modules).
 GROUPS: dict[str, tuple[str, str, tuple[ModuleType, ...]]] = {
-    "bushing": ("virtual bushing bench and identification",
-                "Rubber-bushing models (STS, RT, STVS, ...) on a virtual bench.", (bushing_run, bushing_fit)),
+    "bushing": ("virtual bushing bench, identification, Adams property files",
+                "Rubber-bushing models (STS, RT, STVS, ...) on a virtual bench; Adams bushing property files (.bus) "
+                "in and out.",
+                (bushing_run, bushing_fit, bushing_import, bushing_export)),
     "model": ("vehicle models", "Vehicle models.", (model_export,)),
     "rig": ("measured data: import a K&C rig's CSV export, or measure on the virtual rig",
             "Measured K&C rig data (data/README.md).", (rig_import, rig_measure)),

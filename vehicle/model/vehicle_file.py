@@ -16,6 +16,7 @@ from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 
+from elastokin.bushings.adams_bus import BusFile, read_bus
 from elastokin.bushings.parameter_sets import ParameterSet, load_parameter_set
 from elastokin.bushings.parameters import LENGTH_UNIT_SI, MODELS, UNIT_LABELS
 from elastokin.vehicle.model.definition import (BUSHING_PARTS, DIRECTIONS, FRONT_MASSES, FRONT_POINTS, NO_FAMILIES, REAR_MASSES,
@@ -28,7 +29,7 @@ from elastokin.vehicle.model.plausibility import (MAX_BODY_MASS_KG, MAX_CAMBER_D
 from elastokin.core.documents import Document, Fields, KeyPath, check_number, check_vector, dotted
 from elastokin.core.errors import InputError
 from elastokin.core.files import is_file, read_text
-from elastokin.core.shipped import DEFAULT_VEHICLE, TYRE_DIR, VEHICLE_DIR, resolve
+from elastokin.core.shipped import DEFAULT_VEHICLE, PARAMETER_SET_DIR, TYRE_DIR, VEHICLE_DIR, resolve
 
 #: Source named in the errors of :func:`with_extensions`.
 EXTENSIONS_SOURCE = "with_extensions"
@@ -265,11 +266,40 @@ def _checked(d: DirectionDef, doc: Document, path: KeyPath) -> DirectionDef:
     return d
 
 
+def _bus_file(f: Fields, key: str) -> BusFile:
+    """The Adams bushing property file named at ``f``'s ``key``: a path from the vehicle file's
+    folder, or a shipped one of models/bushings/ by name; errors name both files."""
+    try:
+        return read_bus(resolve(f.text(key), PARAMETER_SET_DIR, "bushing property", base=Path(f.doc.source).parent,
+                                suffix=".bus"))
+    except InputError as error:
+        raise f.fail(key, f"{error.source}: {error.bare}" if error.source else error.bare) from None
+
+
+def _from_bus(f: Fields, key: str, d: str, quantity: str, families: Families,
+              effects: Mapping[str, Any] | None = None) -> DirectionDef:
+    """Direction ``d``'s law from the property file at ``f``'s ``key``: its curve and damping."""
+    bus = _bus_file(f, key)
+    try:
+        pset = bus.parameter_set(d)
+    except InputError as error:
+        raise f.fail(key, f"{error.source}: {error.bare}") from None
+    source = f"{f.doc.where(f.path(key))}: {dotted(f.path(key))} ({pset.source})"
+    return _checked(DirectionDef(quantity, None, "curve", dict(pset.values), source, families, dict(effects or {})),
+                    f.doc, f.path(key))
+
+
 def _direction(f: Fields, d: str, quantity: str, families: Families) -> DirectionDef:
-    r = f.fields(d, ("set", "model", "params", "effects"))
+    r = f.fields(d, ("set", "model", "params", "effects", "property_file"))
     path = f.path(d)
+    if r.has("property_file"):
+        if r.has("set") or r.has("params") or r.has("model"):
+            raise f.doc.error(path, "give one of `set`, `model` with `params`, or `property_file` (a .bus file)")
+        return _from_bus(r, "property_file", d, quantity, families, _mapping(f.doc, r.path("effects"),
+                                                                             r.raw("effects", {})))
     if r.has("set") == r.has("params"):
-        raise f.doc.error(path, "give either `set` (a parameter set of models/bushings/) or `model` with `params`")
+        raise f.doc.error(path, "give either `set` (a parameter set of models/bushings/), `model` with `params`, or "
+                                "`property_file` (an Adams .bus file)")
     model = r.raw("model", None)
     if model is not None and not isinstance(model, str):
         raise r.fail("model", f"expected a model name, got {model!r}")
@@ -339,7 +369,8 @@ def _axis(f: Fields, key: str, points: Mapping[str, np.ndarray]) -> np.ndarray:
 
 def _bushing(doc: Document, path: KeyPath, value: Any, points: Mapping[str, np.ndarray],
              families: Families) -> BushingDef:
-    r = Fields.of(doc, path, value, ("name", "parent", "child", "location", "axes", "directions", "coupling"))
+    r = Fields.of(doc, path, value, ("name", "parent", "child", "location", "axes", "directions", "coupling",
+                                     "property_file"))
     name = r.raw("name")
     if not isinstance(name, str) or not name.isidentifier():
         raise r.fail("name", f"expected an identifier, got {name!r}")
@@ -363,11 +394,14 @@ def _bushing(doc: Document, path: KeyPath, value: Any, points: Mapping[str, np.n
         raise ax.fail("y", "axes.y is parallel to axes.x")
     y /= np.linalg.norm(y)
     z = np.cross(x, y)
-    dr = r.fields("directions", DIRECTIONS)
+    dr = r.fields("directions", DIRECTIONS) if r.has("directions") or not r.has("property_file") else None
     directions = {}
     for d in DIRECTIONS:
         quantity = "translation" if len(d) == 1 else "rotation"
-        directions[d] = _direction(dr, d, quantity, families)
+        if r.has("property_file") and (dr is None or not dr.has(d)):   # the file gives what directions do not
+            directions[d] = _from_bus(r, "property_file", d, quantity, families)
+        else:
+            directions[d] = _direction(dr, d, quantity, families)
     coupling = _coupling(r, "coupling", directions)
     return BushingDef(name, "body", child, location,
                       (tuple(x.tolist()), tuple(y.tolist()), tuple(z.tolist())), directions, coupling)

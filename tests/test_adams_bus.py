@@ -1,0 +1,227 @@
+"""Adams bushing property files (issue 51, item 1): a hand-written ``.bus`` read in any of Adams's
+units, run on the bench and in a vehicle, its errors at their line; laws of ours exported and read
+back, with what the export loses measured."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.interpolate import PchipInterpolator
+
+import elastokin
+from elastokin.bushings.adams_bus import read_bus
+from elastokin.bushings.bench.bench_file import load_bench, run_bench
+from elastokin.bushings.bus_export import compare, export, law_of
+from elastokin.bushings.parameter_sets import load_parameter_set
+from elastokin.cli.main import main
+from elastokin.core.errors import InputError
+from elastokin.core.shipped import PARAMETER_SET_DIR
+
+ROOT = Path(__file__).resolve().parents[1]
+#: A hand-written file in mm, N, degrees: six curves (one without its {disp force} line), damping.
+HAND = """$---------------------------------------------------------------------MDI_HEADER
+[MDI_HEADER]
+ FILE_TYPE     =  'bus'
+ FILE_VERSION  =  4.0
+ FILE_FORMAT   =  'ASCII'
+(COMMENTS)
+{comment_string}
+'hand-written: a lower arm front bushing'
+[UNITS]
+ LENGTH = 'mm'
+ ANGLE  = 'degrees'
+ FORCE  = 'newton'
+ MASS   = 'kg'
+ TIME   = 'second'
+[SHAPE]
+{radius width}
+ 45.0  0.0
+ 45.0 30.0
+[DAMPING]
+ FX_DAMPING = 0.5   $ N.s/mm
+ FY_DAMPING = 0.5
+ FZ_DAMPING = 0.3
+ TX_DAMPING = 20.0  $ N.mm.s/deg
+ TY_DAMPING = 20.0
+ TZ_DAMPING = 10.0
+[FX_CURVE]
+{ disp force }
+ -10.0 -12000.0
+  -6.0  -5200.0
+  -3.0  -2300.0
+   0.0      0.0
+   3.0   2300.0
+   6.0   5200.0
+  10.0  12000.0
+[FY_CURVE]
+ -10.0 -12000.0
+  -6.0  -5200.0
+  -3.0  -2300.0
+   0.0      0.0
+   3.0   2300.0
+   6.0   5200.0
+  10.0  12000.0
+[FZ_CURVE]
+{ disp force }
+ -8.0 -6000.0
+  0.0     0.0
+  8.0  6000.0
+[TX_CURVE]
+{ angle torque }
+ -20.0 -40000.0
+   0.0      0.0
+  20.0  40000.0
+[TY_CURVE]
+{ angle torque }
+ -10.0 -60000.0
+   0.0      0.0
+  10.0  60000.0
+[TZ_CURVE]
+{ angle torque }
+ -10.0 -60000.0
+   0.0      0.0
+  10.0  60000.0
+"""
+FX = np.array([[-10.0, -12000.0], [-6.0, -5200.0], [-3.0, -2300.0], [0.0, 0.0], [3.0, 2300.0], [6.0, 5200.0],
+               [10.0, 12000.0]])
+
+
+def _write(folder: Path, text: str = HAND, name: str = "hand.bus") -> Path:
+    (folder / name).write_text(text)
+    return folder / name
+
+
+def _bench(folder: Path, programme: str, direction: str = "x") -> dict[str, np.ndarray]:
+    (folder / "bench.yaml").write_text(f"params: hand.bus\ndirection: {direction}\ndt_s: 0.001\nprogramme: {programme}\n")
+    return run_bench(load_bench(folder / "bench.yaml"))
+
+
+def test_a_hand_written_file_on_the_bench_gives_its_curve_and_its_damping(tmp_path: Path) -> None:
+    _write(tmp_path)
+    slow = _bench(tmp_path, "{type: triangle, amplitude_mm: 10.0, speed_mm_s: 1.0, cycles: 1}")
+    e, force = slow["e_mm"], slow["F_N"]
+    for x, f in FX:   # at the curve's points, less the dashpot's 0.5 N.s/mm at 1 mm/s
+        at = np.flatnonzero(np.isclose(e, x, atol=1e-9))
+        assert at.size, x
+        moving = np.sign(e[at] - e[at - 1])
+        assert np.all(np.abs(force[at] - 0.5 * moving - f) <= 0.005 * abs(f) + 1e-6), (x, force[at], f)
+    # the damping: two speeds at one deflection differ by c·Δv
+    fast = _bench(tmp_path, "{type: triangle, amplitude_mm: 10.0, speed_mm_s: 20.0, cycles: 1}")
+    for x in (1.5, 4.5, 7.0):   # on the first rise, 0 to +10 mm
+        rising = [np.interp(x, r["e_mm"][1:np.argmax(r["e_mm"]) + 1], r["F_N"][1:np.argmax(r["e_mm"]) + 1])
+                  for r in (slow, fast)]
+        assert rising[1] - rising[0] == pytest.approx(0.5 * (20.0 - 1.0), rel=1e-6)
+    # between the points: the monotone cubic through them (PCHIP; its end slopes are the end segments' here,
+    # scipy's another's: compared from 0 to 6 mm, between interior points)
+    x = np.linspace(0.1, 5.9, 25)
+    up = slice(1, np.argmax(e) + 1)
+    np.testing.assert_allclose(np.interp(x, e[up], force[up]) - 0.5, PchipInterpolator(*FX.T)(x), rtol=1e-6, atol=1e-6)
+
+
+def test_the_same_law_in_any_of_adams_units_and_with_or_without_table_headers(tmp_path: Path) -> None:
+    base = read_bus(_write(tmp_path))
+    converted = (HAND.replace("LENGTH = 'mm'", "LENGTH = 'meter'").replace("FORCE  = 'newton'", "FORCE  = 'kilonewton'")
+                 .replace("ANGLE  = 'degrees'", "ANGLE  = 'radians'"))
+    lines = []
+    section = ""
+    for line in converted.splitlines():
+        section = line.strip("[]") if line.startswith("[") else section
+        cells = line.split()
+        if section.endswith("_CURVE") and len(cells) == 2 and not line.startswith("{"):
+            x, f = float(cells[0]), float(cells[1])
+            rotation = section.startswith("T")
+            # m and kN; radians and kN·m
+            line = f" {x * math.pi / 180 if rotation else x / 1e3!r} {f / 1e6 if rotation else f / 1e3!r}"
+        if section == "DAMPING" and "=" in line:
+            key, value = line.split("=")[0], float(line.split("=")[1].split("$")[0])
+            rotation = key.strip().startswith("T")
+            # N·s/mm → kN·s/m; N·mm·s/deg → kN·m·s/rad
+            line = f"{key}= {value * 180 / math.pi / 1e6 if rotation else value!r}"
+        lines.append(line)
+    other = read_bus(_write(tmp_path, "\n".join(lines).replace("{ disp force }", "").replace("{ angle torque }", ""),
+                            "other.bus"))
+    for d in ("x", "y", "z", "rx", "ry", "rz"):
+        a, b = base.parameter_set(d).channel(), other.parameter_set(d).channel()
+        np.testing.assert_allclose(np.array(a.curve), np.array(b.curve), rtol=1e-12, atol=1e-12)
+        assert a.C == pytest.approx(b.C, rel=1e-12) and a.K0 == pytest.approx(b.K0, rel=1e-12)
+    ry = base.parameter_set("ry").channel()
+    assert ry.K0 == pytest.approx(6.0 * 180 / math.pi) and ry.C == pytest.approx(0.02 * 180 / math.pi)   # N·m/rad
+
+
+@pytest.mark.parametrize("old, new, expected", [
+    ("  -3.0  -2300.0\n   0.0      0.0\n   3.0   2300.0\n   6.0   5200.0", "  -3.0  -2300.0\n   0.0      0.0\n   3.0   "
+     "2300.0\n   6.0   2200.0", r"hand\.bus:33: \[FX_CURVE\] row 6: force falls from 2300 to 2200"),
+    ("LENGTH = 'mm'", "LENGTH = 'furlong'", r"hand\.bus:10: \[UNITS\] LENGTH: unknown unit 'furlong'; expected one of mm"),
+    (" FZ_DAMPING = 0.3", " FZ_DAMPING = -0.3", r"hand\.bus:22: \[DAMPING\] FZ_DAMPING: -0\.3: expected a damping of at "
+                                                r"least 0"),
+    (" FZ_DAMPING = 0.3", " FZ_DAMP = 0.3", r"hand\.bus:22: \[DAMPING\] FZ_DAMP: unknown key; expected FX_DAMPING"),
+    ("FILE_TYPE     =  'bus'", "FILE_TYPE     =  'tir'", r"hand\.bus:3: \[MDI_HEADER\] FILE_TYPE: 'tir'; expected 'bus'"),
+    ("[SHAPE]", "[SHAPES]", r"hand\.bus:15: unknown section \[SHAPES\]"),
+    (" 0.0     0.0\n  8.0  6000.0", " 0.0     30.0\n  8.0  6000.0",
+     r"hand\.bus:\d+: \[FZ_CURVE\]: force 30 at zero deflection; expected 0"),
+    (" -10.0 -12000.0\n  -6.0  -5200.0", " -10.0 -12000.0 1.0\n  -6.0  -5200.0",
+     r"hand\.bus:28: \[FX_CURVE\]: expected a row of 2 numbers"),
+])
+def test_a_bad_file_is_refused_at_its_line(tmp_path: Path, old: str, new: str, expected: str) -> None:
+    assert old in HAND
+    with pytest.raises(InputError, match=expected):
+        read_bus(_write(tmp_path, HAND.replace(old, new, 1)))
+
+
+def test_a_vehicle_takes_a_property_file_per_bushing_or_per_direction(tmp_path: Path) -> None:
+    bus = _write(tmp_path)
+    text = (ROOT / "models/vehicles/c_segment.yaml").read_text()
+    text = text.replace("property_file: 195_65R15", f"property_file: {ROOT / 'models/tyres/195_65R15.tir'}")
+    per_direction = text.replace("      y:  {set: fig5_7_lowloss}                                  # radial "
+                                 "(Bourgeteau fig. 5.7)", "      y:  {property_file: hand.bus}", 1)
+    assert per_direction != text
+    (tmp_path / "car.yaml").write_text(per_direction)
+    car = elastokin.load_vehicle(tmp_path / "car.yaml")
+    e1 = next(b for b in car.definition.bushings if b.name == "e1_front")
+    assert e1.directions["y"].channel() == read_bus(bus).parameter_set("y").channel()
+    assert e1.directions["z"].set_name == "fig5_7_lowloss"
+    # the whole bushing from the file: no directions given
+    start = text.index("  - name: e1_front")
+    block = text[start:text.index("  - name: e2_front")]
+    whole = text.replace(block, block[:block.index("    directions:")] + "    property_file: hand.bus\n")
+    (tmp_path / "whole.yaml").write_text(whole)
+    e1 = next(b for b in elastokin.load_vehicle(tmp_path / "whole.yaml").definition.bushings if b.name == "e1_front")
+    assert {d: e1.directions[d].channel().K0 for d in ("x", "rz")} == pytest.approx(
+        {"x": 2300.0 / 3.0 * 1e3, "rz": 6.0 * 180 / math.pi}, rel=1e-9)   # the curves' slopes at zero [N/m, N·m/rad]
+    run = elastokin.Simulation(car, "pumping", duration_scale=0.05).run()
+    deflection, force = run["e1_front_left_y_deflection"] * 1e3, run["e1_front_left_y_force"]   # mm, N
+    assert np.abs(deflection).max() > 1.0   # the bushing moved
+    # with the laws on (the car settles on linear bushings first) and where it moves slowly (below 2 mm/s:
+    # the dashpot's 1 N and the coupling's step of lag aside), its force is the file's curve
+    slow = (run["phase"] >= 1) & (np.abs(np.gradient(deflection, run.t_s)) < 2.0)
+    curve = PchipInterpolator(*np.array(read_bus(bus).directions["y"].curve).T)
+    assert slow.sum() > 50 and np.abs(force - curve(deflection))[slow].max() <= 0.01 * np.abs(force).max()
+
+def test_an_exported_law_reads_back_and_keeps_its_loss_at_the_matched_point(tmp_path: Path, capsys) -> None:
+    law = load_parameter_set("fig5_9").channel()
+    made = export(law, "x", 2.0, damping_hz=1.0, damping_amplitude=1.0)
+    assert main(["bushing", "export", "fig5_9", "-o", str(tmp_path / "f.bus")]) == 0
+    back = read_bus(tmp_path / "f.bus")
+    assert set(back.directions) == {"x", "y", "z"}
+    np.testing.assert_allclose(np.array(back.directions["z"].curve), np.array(made.direction.curve), rtol=1e-7)
+    assert back.directions["z"].damping == pytest.approx(made.direction.damping, rel=1e-7)
+    text = (tmp_path / "f.bus").read_text()
+    assert "not carried: hysteresis at vanishing rates, relaxation, the Payne effect" in text and "law tan delta" in text
+    side = compare(law, made)
+    matched = (side.frequencies_hz.index(1.0), side.amplitudes.index(1.0))
+    loss = {k: side.k_dyn[k][matched] * side.tan_delta[k][matched] / math.hypot(1.0, side.tan_delta[k][matched])
+            for k in ("law", "export")}
+    assert loss["export"] == pytest.approx(loss["law"], rel=0.01)   # Im K* matched at 1 Hz, 1 mm
+    assert side.loop_width["law"] > 10 * side.loop_width["export"] > 0   # the slow loop's hysteresis is lost
+    assert main(["bushing", "import", str(tmp_path / "f.bus"), "-o", str(tmp_path / "sets")]) == 0
+    assert load_parameter_set(tmp_path / "sets" / "f_x.yaml").channel() == law_of(back.directions["x"])
+    assert main(["bushing", "import", str(tmp_path / "f.bus"), "-o", str(tmp_path / "sets")]) == 2
+    assert "pass --overwrite to replace it" in capsys.readouterr().err
+
+@pytest.mark.parametrize("name", sorted(p.name for p in PARAMETER_SET_DIR.glob("*.bus")))
+def test_the_shipped_property_files_read(name: str) -> None:
+    bus = read_bus(PARAMETER_SET_DIR / name)
+    assert set(bus.directions) == {"x", "y", "z"} and bus.comments[0].startswith("written by vsim")
