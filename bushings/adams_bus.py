@@ -116,8 +116,11 @@ def read_bus(path: str | os.PathLike[str]) -> BusFile:
     length, force, angle, time = si["LENGTH"], si["FORCE"], si["ANGLE"], si["TIME"]
     scale = {"translation": (length / _MM, force, force * time / length * _MM),
              "rotation": (angle / _DEG, force * length, force * length * time / angle * _DEG)}
+    if "DAMPING" in bus.tables or "DAMPING" in bus.texts:
+        raise InputError("a table; expected KEY = value lines (FX_DAMPING = 0.5, ...)", source=_section_line(bus, "DAMPING"),
+                         key="[DAMPING]")
     damping: dict[str, float] = {}
-    for key, value in bus.values.get("DAMPING", {}).items():
+    for key in bus.values.get("DAMPING", {}):
         if key not in DAMPING_KEYS:
             raise bus.error("DAMPING", key, f"unknown key; expected {', '.join(DAMPING_KEYS)}")
         c = bus.number("DAMPING", key)
@@ -138,11 +141,11 @@ def read_bus(path: str | os.PathLike[str]) -> BusFile:
             width = "no rows" if table is None else f"{table.shape[1]} columns"
             raise InputError(f"expected a table of two columns (deflection, force), got {width}",
                              source=_section_line(bus, section), key=f"[{section}]")
-        curve = tuple((float(x) * x_scale, float(f) * f_scale) for x, f in table)
-        try:
-            curve_nodes([list(p) for p in curve], 1.0, key="row")
+        try:   # the file's own numbers (the checks do not depend on the units), so that errors quote them
+            curve_nodes(table.tolist(), 1.0, key="row")
         except InputError as exc:
             raise _at_row(bus, section, exc) from None
+        curve = tuple((float(x) * x_scale, float(f) * f_scale) for x, f in table)
         directions[direction] = BusDirection(direction, curve, damping.get(direction, 0.0) * c_scale)
     if not directions:
         raise InputError(f"no curve; expected some of {', '.join(f'[{c}_CURVE]' for c in CURVES)}", source=str(bus.path))
@@ -165,10 +168,9 @@ def _section_line(bus: TeimOrbitFile, section: str) -> str:
 def _at_row(bus: TeimOrbitFile, section: str, exc: InputError) -> InputError:
     """A curve's error (key ``row[i]`` or ``row``) at the row's line of the file."""
     found = re.fullmatch(r"row\[(\d+)\]", exc.key or "")
-    message = exc.bare.replace("deflection", "the deflection", 1) if found else exc.bare
     if found:
-        return bus.row_error(section, int(found[1]), message)
-    return InputError(message, source=_section_line(bus, section), key=f"[{section}]")
+        return bus.row_error(section, int(found[1]), exc.bare)
+    return InputError(exc.bare, source=_section_line(bus, section), key=f"[{section}]")
 
 
 def write_bus(path: str | os.PathLike[str], directions: Mapping[str, BusDirection], comments: Sequence[str],

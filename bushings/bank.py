@@ -100,10 +100,16 @@ class BushingBank:
         return self.nfail
 
     @property
+    def tolerances(self) -> np.ndarray:
+        """Per channel, the tolerance its solve is held to [m or rad]: ``tolerance``, or round-off
+        for a Coulomb ladder (no power-law dampers), solved exactly."""
+        return np.array([self.tolerance if ch.Co > 0.0 else kn.STICK_TOLERANCE for ch in self.channels])
+
+    @property
     def worst_residual(self) -> np.ndarray:
         """Per channel, the largest residual those steps left [m or rad]: the nodes' worst force
         residual over Kpa + 2·Kr, the distance to which they are placed, to set beside the
-        ``tolerance`` (0 where every step converged; NaN for a residual that was not a number)."""
+        :attr:`tolerances` (0 where every step converged; NaN for a residual that was not a number)."""
         return self.worst
 
     def reset(self) -> None:

@@ -38,6 +38,8 @@ STACK_SIZE = 64
 # so that an overshoot in a simulation gives a large finite force instead of an infinite one.
 _THETA_MAX = 0.49 * math.pi
 _MAX_NEWTON = 80
+#: Tolerance [m or rad] of the sliders' release, and of a Coulomb ladder's whole solve (round-off).
+STICK_TOLERANCE = 1e-13
 #: Relative Newton step above which a growing node takes the power-law step of _grow.
 _R_GROW = 0.02
 #: Relative predictor step up to which a node gets the second-order correction of the predictor.
@@ -296,7 +298,7 @@ def _ladder_step(e, de, h, n, Kpa, Kr, Ff, Co, pw, tol_x, S):
     """
     # Sliders are released at their threshold to round-off, whatever tol_x: the stick–slip pattern
     # is exact, and a Coulomb ladder (one linear solve per active set) is solved to round-off.
-    tol_stick = 1e-13 * (Kpa + 2.0 * Kr)
+    tol_stick = STICK_TOLERANCE * (Kpa + 2.0 * Kr)
     tol = tol_x * (Kpa + 2.0 * Kr) if Co > 0.0 else tol_stick
     m = (n + 3) // 4 * 4
     S[_U + 0] = e  # the input: column 0 of the positions u_old + w (w = 0 there)
@@ -489,12 +491,6 @@ def _curve(x, CV, o, n):
     f = f0 + t * (s0 + t * (3.0 * (f1 - f0) - 2.0 * s0 - s1 + t * (2.0 * (f0 - f1) + s0 + s1)))
     k = (s0 + t * (6.0 * (f1 - f0) - 4.0 * s0 - 2.0 * s1 + t * (6.0 * (f0 - f1) + 3.0 * s0 + 3.0 * s1))) / h
     return f, k
-
-
-@nb.njit(cache=True)
-def curve_at(x, nodes):
-    """:func:`_curve` of the nodes (n, 3) alone: (force, slope) at x, for code outside the kernel."""
-    return _curve(x, nodes, 0, nodes.shape[0])
 
 
 @nb.njit(cache=True, inline="always", fastmath=_FAST)

@@ -152,7 +152,7 @@ def to_si(model: str, values: Mapping[str, Any], quantity: str = "translation",
     for key, raw in values.items():
         if key == "curve":
             si["curve"] = curve_nodes(raw, length, source)
-            si["K0"] = _slope_at_zero(si["curve"])
+            si["K0"] = curve_stiffness(si["curve"])
             continue
         if key in ("maxwell_k", "maxwell_c"):
             if not isinstance(raw, (list, tuple)) or not raw:
@@ -198,9 +198,11 @@ def curve_nodes(points: Any, length_si: float, source: str = "<parameters>", key
     """The nodes (deflection [m or rad], force [N or N·m], slope) of a tabulated elastic law given as
     ``points`` [[deflection, force], ...] in the length unit ``length_si`` (SI per unit): the
     monotone cubic through the points (PCHIP's slopes, so that it neither overshoots nor wiggles
-    between them; the end slopes are the end segments'). InputError naming ``key`` unless there are
-    2 to MAX_CURVE_POINTS points of two finite numbers, deflections increasing and spanning 0, the
-    force not falling and zero at zero deflection (a preload is the vehicle's, not the law's)."""
+    between them; the end slopes are the end segments'). InputError naming ``key`` (``key[i]`` for
+    point i) unless there are 2 to MAX_CURVE_POINTS points of two finite numbers, deflections
+    increasing, the force rising from point to point, and (0, 0) among them: the unloaded bushing,
+    whose slope there is the law's stiffness about its design position (a preload is the
+    vehicle's; a dead band the ``backlash`` effect)."""
     if not isinstance(points, (list, tuple)) or not 2 <= len(points) <= MAX_CURVE_POINTS:
         raise InputError(f"expected 2 to {MAX_CURVE_POINTS} [deflection, force] points, got {str(points)[:60]}",
                          source=source, key=key)
@@ -209,42 +211,39 @@ def curve_nodes(points: Any, length_si: float, source: str = "<parameters>", key
         if not isinstance(p, (list, tuple)) or len(p) != 2:
             raise InputError(f"expected a [deflection, force] pair, got {p!r}", source=source, key=f"{key}[{i}]")
         rows.append([_number(v, source, f"{key}[{i}]") for v in p])
-    x = [r[0] * length_si for r in rows]
-    f = [r[1] for r in rows]
     for i in range(1, len(rows)):
-        if not x[i] > x[i - 1]:
-            raise InputError(f"deflection {rows[i][0]:g} does not follow {rows[i - 1][0]:g}; expected increasing "
-                             f"deflections", source=source, key=f"{key}[{i}]")
-        if f[i] < f[i - 1]:
-            raise InputError(f"force falls from {rows[i - 1][1]:g} to {rows[i][1]:g}; expected a curve that does not "
-                             f"fall (a falling stiffness is unstable)", source=source, key=f"{key}[{i}]")
-    if not x[0] <= 0.0 <= x[-1]:
-        raise InputError(f"deflections {rows[0][0]:g} to {rows[-1][0]:g} do not span 0; expected the curve through "
-                         f"the unloaded bushing", source=source, key=key)
-    if f[-1] <= f[0]:
-        raise InputError("the force never rises; expected a stiffness", source=source, key=key)
+        (x0, f0), (x1, f1) = rows[i - 1], rows[i]
+        if not x1 > x0:
+            raise InputError(f"deflection {x1:g} does not follow {x0:g}; expected increasing deflections",
+                             source=source, key=f"{key}[{i}]")
+        if not f1 > f0:
+            raise InputError(f"force {'falls' if f1 < f0 else 'stays'} from {f0:g} to {f1:g}; expected a force that "
+                             f"rises (a falling or flat stretch has no stiffness: a dead band is the backlash "
+                             f"effect)", source=source, key=f"{key}[{i}]")
+    zero = [i for i, (x, _) in enumerate(rows) if x == 0.0]
+    if not zero or abs(rows[zero[0]][1]) > 1e-9 * max(abs(rows[0][1]), abs(rows[-1][1])):
+        got = f"force {rows[zero[0]][1]:g} at zero deflection" if zero else "no point at zero deflection"
+        raise InputError(f"{got}; expected the point (0, 0), the unloaded bushing (a preload is set on the "
+                         f"vehicle's bushing)", source=source, key=f"{key}[{zero[0]}]" if zero else key)
     from scipy.interpolate import PchipInterpolator   # here: the vehicle's command line needs no scipy
 
+    x, f = np.array(rows).T
+    with np.errstate(all="ignore"):
+        secants = np.diff(f) / np.diff(x)   # in the points' own units
+    steep = np.flatnonzero(~(secants <= MAX_MAGNITUDE))
+    if steep.size:
+        raise InputError(f"a slope of {secants[steep[0]]:.3g} to this point; expected at most {MAX_MAGNITUDE:g} (N/mm "
+                         f"or N·m/deg: points closer than the numbers resolve?)", source=source,
+                         key=f"{key}[{steep[0] + 1}]")
+    x = x * length_si
     slopes = PchipInterpolator(x, f).derivative()(x)
-    slopes[0], slopes[-1] = (f[1] - f[0]) / (x[1] - x[0]), (f[-1] - f[-2]) / (x[-1] - x[-2])
-    nodes = tuple((xi, fi, float(si)) for xi, fi, si in zip(x, f, slopes))
-    at_zero = curve_force(0.0, nodes)[0]
-    if abs(at_zero) > 1e-6 * max(abs(f[0]), abs(f[-1])):
-        raise InputError(f"force {at_zero:.6g} at zero deflection; expected 0 (the curve through the unloaded "
-                         f"bushing; a preload is set on the vehicle's bushing)", source=source, key=key)
-    return nodes
+    slopes[0], slopes[-1] = secants[0] / length_si, secants[-1] / length_si
+    return tuple((float(a), float(b), float(c)) for a, b, c in zip(x, f, slopes))
 
 
-def _slope_at_zero(nodes: tuple[tuple[float, float, float], ...]) -> float:
-    """The tabulated law's slope at zero deflection (its linear stiffness about the design position)."""
-    return curve_force(0.0, nodes)[1]
-
-
-def curve_force(x: float, nodes: tuple[tuple[float, float, float], ...]) -> tuple[float, float]:
-    """A tabulated law's force and slope at deflection ``x``, as the kernel evaluates them."""
-    from elastokin.bushings.kernel import curve_at   # the kernel's own evaluation (numba, loaded when needed)
-
-    return curve_at(float(x), np.asarray(nodes, dtype=float))
+def curve_stiffness(nodes: tuple[tuple[float, float, float], ...]) -> float:
+    """A tabulated law's slope at its (0, 0) node: its stiffness about the design position."""
+    return next(slope for x, _, slope in nodes if x == 0.0)
 
 
 def _check_elastic(si: dict[str, Any], source: str) -> None:

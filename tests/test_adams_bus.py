@@ -9,12 +9,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, seed, settings
+from hypothesis import strategies as st
 from scipy.interpolate import PchipInterpolator
 
 import elastokin
 from elastokin.bushings.adams_bus import read_bus
 from elastokin.bushings.bench.bench_file import load_bench, run_bench
-from elastokin.bushings.bus_export import compare, export, law_of
+from elastokin.bushings.bench.bus_export import compare, export, law_of
 from elastokin.bushings.parameter_sets import load_parameter_set
 from elastokin.cli.main import main
 from elastokin.core.errors import InputError
@@ -161,7 +163,16 @@ def test_the_same_law_in_any_of_adams_units_and_with_or_without_table_headers(tm
     ("FILE_TYPE     =  'bus'", "FILE_TYPE     =  'tir'", r"hand\.bus:3: \[MDI_HEADER\] FILE_TYPE: 'tir'; expected 'bus'"),
     ("[SHAPE]", "[SHAPES]", r"hand\.bus:15: unknown section \[SHAPES\]"),
     (" 0.0     0.0\n  8.0  6000.0", " 0.0     30.0\n  8.0  6000.0",
-     r"hand\.bus:\d+: \[FZ_CURVE\]: force 30 at zero deflection; expected 0"),
+     r"hand\.bus:46: \[FZ_CURVE\] row 2: force 30 at zero deflection; expected the point \(0, 0\)"),
+    (" 0.0     0.0\n  8.0  6000.0", " 0.5     0.0\n  8.0  6000.0",
+     r"hand\.bus:43: \[FZ_CURVE\]: no point at zero deflection; expected the point \(0, 0\)"),
+    ("  -3.0  -2300.0\n   0.0      0.0\n   3.0   2300.0", "  -3.0  0.0\n   0.0      0.0\n   3.0   2300.0",
+     r"hand\.bus:31: \[FX_CURVE\] row 4: force stays from 0 to 0; expected a force that rises \(a falling or flat "
+     r"stretch has no stiffness: a dead band is the backlash effect\)"),   # zero stiffness at design: refused
+    ("   0.0      0.0\n   3.0   2300.0\n   6.0   5200.0", "   0.0      0.0\n(COMMENTS)\n   3.0   2300.0\n   6.0   5200.0",
+     r"hand\.bus:33: \[FX_CURVE\]: a row of numbers after the table of \[FX_CURVE\] ended"),
+    ("  -3.0  -2300.0\n   0.0      0.0", "  -1e-300  -2300.0\n   0.0      0.0",
+     r"hand\.bus:31: \[FX_CURVE\] row 4: a slope of 2\.3e\+303 to this point; expected at most 1e\+09"),
     (" -10.0 -12000.0\n  -6.0  -5200.0", " -10.0 -12000.0 1.0\n  -6.0  -5200.0",
      r"hand\.bus:28: \[FX_CURVE\]: expected a row of 2 numbers"),
 ])
@@ -169,6 +180,41 @@ def test_a_bad_file_is_refused_at_its_line(tmp_path: Path, old: str, new: str, e
     assert old in HAND
     with pytest.raises(InputError, match=expected):
         read_bus(_write(tmp_path, HAND.replace(old, new, 1)))
+
+
+def test_errors_quote_the_files_numbers_and_a_vehicle_names_the_row(tmp_path: Path) -> None:
+    metres = HAND.replace("LENGTH = 'mm'", "LENGTH = 'meter'").replace("  -6.0  -5200.0", "  -0.002  -5200.0", 1)
+    with pytest.raises(InputError, match=r"hand\.bus:30: \[FX_CURVE\] row 3: deflection -3 does not follow -0\.002"):
+        read_bus(_write(tmp_path, metres))
+    _write(tmp_path, HAND.replace("   6.0   5200.0", "   6.0   2200.0", 1))
+    (tmp_path / "car.yaml").write_text((ROOT / "models/vehicles/c_segment.yaml").read_text().replace(
+        "      y:  {set: fig5_7_lowloss}                                  # radial (Bourgeteau fig. 5.7)",
+        "      y:  {property_file: hand.bus}", 1))
+    with pytest.raises(InputError, match=r"car\.yaml:\d+: bushings\[0\]\.directions\.y\.property_file: .*hand\.bus:33: "
+                                         r"\[FX_CURVE\] row 6: force falls from 2300 to 2200"):
+        elastokin.load_vehicle(tmp_path / "car.yaml")
+
+
+def test_time_units_and_the_other_damping_keys(tmp_path: Path) -> None:
+    """TDX ... RDZ read as FX_DAMPING ... TZ_DAMPING; a damping in N·ms/mm is a thousandth of one in N·s/mm."""
+    base = read_bus(_write(tmp_path))
+    other = HAND.replace("TIME   = 'second'", "TIME   = 'millisecond'").replace("MASS   = 'kg'", "MASS   = 'tonne'")
+    for new, old in zip(("TDX", "TDY", "TDZ", "RDX", "RDY", "RDZ"), ("FX", "FY", "FZ", "TX", "TY", "TZ")):
+        other = other.replace(f" {old}_DAMPING =", f" {new} =")
+    other = read_bus(_write(tmp_path, other, "other.bus"))
+    for d in ("x", "y", "z", "rx", "ry", "rz"):
+        assert other.directions[d].damping == pytest.approx(base.directions[d].damping / 1e3, rel=1e-12)
+        assert other.directions[d].curve == base.directions[d].curve
+    twice = HAND.replace(" FX_DAMPING = 0.5   $ N.s/mm", " FX_DAMPING = 0.5\n TDX = 0.5")
+    with pytest.raises(InputError, match=r"\[DAMPING\] TDX: direction x already has its damping"):
+        read_bus(_write(tmp_path, twice, "twice.bus"))
+
+
+@pytest.mark.parametrize("option, value", [("--range", "0"), ("--range", "nan"), ("--damping-hz", "0"),
+                                           ("--damping-at", "-1")])
+def test_export_refuses_options_that_are_not_positive(tmp_path: Path, capsys, option: str, value: str) -> None:
+    assert main(["bushing", "export", "fig5_9", "-o", str(tmp_path / "f.bus"), option, value]) == 2
+    assert f"{option}: expected a positive number" in capsys.readouterr().err and not (tmp_path / "f.bus").exists()
 
 
 def test_a_vehicle_takes_a_property_file_per_bushing_or_per_direction(tmp_path: Path) -> None:
@@ -225,3 +271,44 @@ def test_an_exported_law_reads_back_and_keeps_its_loss_at_the_matched_point(tmp_
 def test_the_shipped_property_files_read(name: str) -> None:
     bus = read_bus(PARAMETER_SET_DIR / name)
     assert set(bus.directions) == {"x", "y", "z"} and bus.comments[0].startswith("written by vsim")
+
+
+SHIPPED = (PARAMETER_SET_DIR / "fig5_9.bus").read_text().splitlines() + HAND.splitlines()
+_TOKENS = st.sampled_from(["", "nan", "inf", "1e400", "-1e300", "abc", "'x'", "{a b c}", "[FX_CURVE]", "(COMMENTS)",
+                           "0", "-0", "1D+03", "$", "!", "=", "FX_DAMPING =", "\ufeff", "'", "{", "}"])
+
+
+@given(st.lists(st.tuples(st.sampled_from(["drop", "repeat", "replace", "insert", "swap"]), st.integers(0, 10 ** 6),
+                          _TOKENS), min_size=1, max_size=4),
+       st.integers(0, 10 ** 6))
+@settings(max_examples=300, deadline=None, database=None, suppress_health_check=list(HealthCheck))
+@seed(20261202)
+def test_a_damaged_or_hostile_file_is_refused_or_read_never_a_traceback(tmp_path_factory, edits, cut) -> None:
+    """Lines of the shipped and the hand-written files dropped, repeated, swapped, replaced or
+    joined by hostile tokens, and the file cut anywhere: an InputError or a law that loads."""
+    lines = list(SHIPPED)
+    for action, at, token in edits:
+        i = at % len(lines)
+        if action == "drop" and len(lines) > 1:
+            del lines[i]
+        elif action == "repeat":
+            lines.insert(i, lines[i])
+        elif action == "replace":
+            cells = lines[i].split()
+            lines[i] = " ".join(cells[:1] + [token] + cells[2:]) if cells else token
+        elif action == "insert":
+            lines.insert(i, token)
+        else:
+            j = (at // 7) % len(lines)
+            lines[i], lines[j] = lines[j], lines[i]
+    text = "\n".join(lines)
+    path = tmp_path_factory.mktemp("fuzz") / "f.bus"
+    path.write_text(text[:cut % (len(text) + 1)], encoding="utf-8", errors="surrogatepass")
+    try:
+        bus = read_bus(path)
+    except InputError as error:
+        assert str(error).strip()
+        return
+    for d in bus.directions:
+        channel = bus.parameter_set(d).channel()
+        assert np.all(np.isfinite(np.array(channel.curve))) and channel.K0 > 0.0

@@ -33,7 +33,7 @@ def synthetic(rng: np.random.Generator, bump: bool) -> tuple[Layout, np.ndarray,
     tests, start = [], 0
     dummy = Job(Scenario.__new__(Scenario), None, 1.0, tuple(CHANNELS))
     for i, n in enumerate(lengths):
-        tests.append(Test(f"test {i}", dummy, np.arange(start, start + n)))
+        tests.append(Test(f"test {i}", dummy, np.arange(start, start + n), np.arange(n), True))
         start += n
     baseline = np.cumsum(rng.normal(0.0, 0.05, (start, len(CHANNELS))), axis=0)   # any smooth prediction
     recording = np.concatenate([np.full(n, i // 2) for i, n in enumerate(lengths)])

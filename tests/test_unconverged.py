@@ -19,6 +19,8 @@ from elastokin.vehicle.simulation.unconverged import UnconvergedBushingSteps, Un
 
 #: A tolerance no solve meets: every step of a slipping ladder reaches the iteration cap.
 UNREACHABLE = 1e-300
+#: The two channels' tolerances in the tally's tests [m or rad].
+TOLERANCES = np.full(2, 1e-8)
 
 
 def _sine(set_name: str, tolerance: float) -> tuple[BushingBank, np.ndarray]:
@@ -46,18 +48,18 @@ def test_the_kernel_counts_the_steps_at_its_cap_and_their_residual() -> None:
 def test_the_tally_keeps_the_block_of_the_worst_and_a_nan() -> None:
     tally, seen = UnconvergedTally(), np.zeros(2, dtype=np.int64)
     names, units = ["b.x", "b.rz"], ["m", "rad"]
-    tally.add(names, units, np.array([3, 0]), seen, np.array([2e-7, 0.0]), 1e-8, 1, 0.0, 1.0)
-    tally.add(names, units, np.array([5, 1]), seen, np.array([2e-7, 4e-6]), 1e-8, 1, 1.0, 2.0)   # x not worse
-    tally.add(names, units, np.array([6, 1]), seen, np.array([9e-7, 4e-6]), 1e-8, 1, 2.0, 3.0)   # x worse
+    tally.add(names, units, np.array([3, 0]), seen, np.array([2e-7, 0.0]), TOLERANCES, 1, 0.0, 1.0)
+    tally.add(names, units, np.array([5, 1]), seen, np.array([2e-7, 4e-6]), TOLERANCES, 1, 1.0, 2.0)   # x not worse
+    tally.add(names, units, np.array([6, 1]), seen, np.array([9e-7, 4e-6]), TOLERANCES, 1, 2.0, 3.0)   # x worse
     x, rz = tally.steps()
     assert (x.steps, x.worst_residual, x.from_s, x.to_s) == (6, 9e-7, 2.0, 3.0)
     assert (rz.steps, rz.unit, rz.from_s) == (1, "rad", 1.0)
     assert seen.tolist() == [6, 1]
     # a fresh bank (the next case) counts from 0 again, its worst from 0: a smaller one keeps the old window
     seen[:] = 0
-    tally.add(names, units, np.array([2, 0]), seen, np.array([1e-7, 0.0]), 1e-8, 2, 10.0, 11.0)
-    tally.add(names, units, np.array([3, 0]), seen, np.array([np.nan, 0.0]), 1e-8, 2, 11.0, 12.0)
-    tally.add(names, units, np.array([4, 0]), seen, np.array([np.nan, 0.0]), 1e-8, 2, 12.0, 13.0)
+    tally.add(names, units, np.array([2, 0]), seen, np.array([1e-7, 0.0]), TOLERANCES, 2, 10.0, 11.0)
+    tally.add(names, units, np.array([3, 0]), seen, np.array([np.nan, 0.0]), TOLERANCES, 2, 11.0, 12.0)
+    tally.add(names, units, np.array([4, 0]), seen, np.array([np.nan, 0.0]), TOLERANCES, 2, 12.0, 13.0)
     x = tally.steps()[0]
     assert x.steps == 10 and np.isnan(x.worst_residual) and (x.case, x.from_s) == (2, 11.0)
     assert UnconvergedSteps.from_record(x.to_record()).to_record() == x.to_record()

@@ -61,6 +61,8 @@ def read_bench(doc: Document, base_dir: Path | None = None) -> Bench:
     if model is not None and (not isinstance(model, str) or model not in MODELS):
         raise f.fail("model", f"unknown model {model!r}; expected one of {', '.join(MODELS)}")
     params = f.raw("params")
+    if f.has("direction") and not (isinstance(params, str) and Path(params).suffix.lower() == ".bus"):
+        raise f.fail("direction", "a direction is read from an Adams property file (params: F.bus) only")
     effects = NO_EFFECTS
     if isinstance(params, Mapping):
         if model is None:
@@ -70,8 +72,7 @@ def read_bench(doc: Document, base_dir: Path | None = None) -> Bench:
         channel, effects = _named_set(params, model, f, base_dir)
     else:
         raise f.fail("params", f"expected a parameter-set name or a mapping, got {params!r}")
-    if f.has("direction") and not (isinstance(params, str) and params.endswith(".bus")):
-        raise f.fail("direction", "a direction is read from an Adams property file (params: F.bus) only")
+
     if channel.quantity != "translation":
         raise f.fail("params", f"the bench works in mm; set {params!r} is a {channel.quantity}")
     dt = f.raw("dt_s")
@@ -88,13 +89,13 @@ def _named_set(name: str, model: str | None, f: Fields, base_dir: Path | None) -
     """A parameter set (SI law and effects) by name, or by path relative to the bench file; errors
     name both files."""
     path = Path(name)
-    if path.suffix in (".yaml", ".yml", ".bus") and not path.is_absolute() and base_dir is not None:
+    if path.suffix.lower() in (".yaml", ".yml", ".bus") and not path.is_absolute() and base_dir is not None:
         name = str(base_dir / path)
     direction = f.raw("direction", "x")
     if direction not in ("x", "y", "z"):
         raise f.fail("direction", f"expected x, y or z (the bench works in mm), got {direction!r}")
     try:
-        pset = read_bus(name).parameter_set(direction) if path.suffix == ".bus" else load_parameter_set(name)
+        pset = read_bus(name).parameter_set(direction) if path.suffix.lower() == ".bus" else load_parameter_set(name)
         return pset.channel(model), pset.effects_si()
     except InputError as exc:
         raise f.fail("params", str(exc)) from exc

@@ -3,17 +3,22 @@
 from __future__ import annotations
 
 import argparse
+import math
 
 from elastokin.cli.arguments import output_file
 
 
 def _export(args: argparse.Namespace) -> int:
     from elastokin.bushings.adams_bus import CURVES, write_bus
-    from elastokin.bushings.bus_export import SLOW_RATE, compare, comparison_lines, export
+    from elastokin.bushings.bench.bus_export import SLOW_RATE, compare, comparison_lines, export
     from elastokin.bushings.parameter_sets import load_parameter_set
     from elastokin.core.errors import InputError
     from elastokin.core.provenance import software_version
 
+    for option in ("range", "damping_hz", "damping_at"):
+        value = getattr(args, option)
+        if not (math.isfinite(value) and value > 0.0):
+            raise InputError(f"expected a positive number, got {value!r}", key=f"--{option.replace('_', '-')}")
     sets = [load_parameter_set(name) for name in args.sets]
     by_quantity = {}
     for name, pset in zip(args.sets, sets):
@@ -25,8 +30,8 @@ def _export(args: argparse.Namespace) -> int:
     for quantity, pset in by_quantity.items():
         unit = "mm" if quantity == "translation" else "deg"
         channel = pset.channel()
-        made = export(channel, "x", args.range, args.damping_hz, args.damping_at)
         names = [c for c, d in CURVES.items() if (len(d) == 1) == (quantity == "translation")]
+        made = export(channel, CURVES[names[0]], args.range, args.damping_hz, args.damping_at)
         for name in names:
             directions[CURVES[name]] = type(made.direction)(CURVES[name], made.direction.curve, made.direction.damping)
         lines = comparison_lines(compare(channel, made), quantity)

@@ -82,7 +82,8 @@ class TeimOrbitFile:
         if value is None:
             if default is not None:
                 return default
-            raise self.error(section, key, "missing; expected a quoted text")
+            raise self.error(section, key, "missing; expected a quoted text" +
+                             ("" if section in self.values else f" (the file has no [{section}] section)"))
         return value if isinstance(value, str) else f"{value:g}"
 
 
@@ -107,7 +108,7 @@ def read_teim_orbit(path: str | Path, what: str, headerless_tables: tuple[str, .
     columns: dict[str, tuple[str, ...]] = {}
     sections: dict[str, int] = {}
     section, table = "", ""   # the section, and the table its rows go to ("" outside a table)
-    for number, raw in enumerate(read_text(path).splitlines(), start=1):
+    for number, raw in enumerate(read_text(path).removeprefix("\ufeff").splitlines(), start=1):
         line = _without_comment(raw).strip()
         where = f"{path}:{number}"
         if not line:
@@ -137,6 +138,9 @@ def read_teim_orbit(path: str | Path, what: str, headerless_tables: tuple[str, .
                 texts.setdefault(table, []).append(line[1:-1].strip())
                 continue
             table = ""
+        if not table and section in columns and _NUMBER.match(line.split()[0]):
+            raise InputError(f"a row of numbers after the table of [{section}] ended (at a sub-block or a text row); "
+                             f"expected one table per section", source=where, key=f"[{section}]")
         if not table and section in headerless_tables and not values[section] and _NUMBER.match(line.split()[0]):
             table = section
             columns[table] = ("",) * len(line.split())

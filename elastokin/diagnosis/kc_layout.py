@@ -80,8 +80,9 @@ class Layout:
                 times.append(run.signals["input_time"][on])
                 recording.append(np.full(n, k))
                 job = Job(replace(t.scenario, cases=[case]), vehicle, scale, tuple(channels))
-                tests.append(Test(f"{t.name} case {c} ({case.label})", job, np.arange(start, start + n),
-                                  _samples(times[-1], t.scenario, f"{t.file.name}, case {c}"), run.complete))
+                samples = np.arange(n) if run.complete else _samples(times[-1], t.scenario, f"{t.file.name}, case {c}")
+                tests.append(Test(f"{t.name} case {c} ({case.label})", job, np.arange(start, start + n), samples,
+                                  run.complete))
                 start += n
         if not tests:
             raise InputError("no recording holds a sample of a case's input: nothing to diagnose",
@@ -107,9 +108,10 @@ class Layout:
 
 
 def _samples(input_time_s: np.ndarray, scenario: Scenario, where: str) -> np.ndarray:
-    """The samples (0-based) of a case's input phase at the recorded times since its input started
-    [s]: the k-th comes k output intervals after the start, as the simulation records them.
-    InputError for samples off the scenario's output rate (a rig recording at another rate)."""
+    """The samples (0-based) of a case's input phase that a damaged recording holds, from their
+    times since the input started [s]: the k-th comes k output intervals after the start, as the
+    simulation records them. InputError for samples off the scenario's output rate (a rig recording
+    at another rate cannot be matched sample by sample once some are missing)."""
     interval = 1.0 / scenario.output_rate_hz
     k = np.rint(input_time_s / interval).astype(np.int64)
     off = (k < 1) | (np.abs(k * interval - input_time_s) > 1e-6) | np.r_[False, np.diff(k) < 1]

@@ -170,23 +170,28 @@ def _check_inputs(scenario: Scenario, plan: list[CaseSchedule], dt: float, durat
     given = [(j, ch) for j, ch in enumerate(INPUT_CHANNELS) if ch in values]
     if not given:
         return
-    lagged = np.stack([_commanded(scenario, plan, dt, duration_scale, t + lag) for lag in _LAGS])   # (lags, N, C)
-    at = _schedule_signals(t, plan, dt)
-    case = at["case"].astype(int) - 1
     known = measured_channels()
-    for j, ch in given:
+    columns = [j for j, _ in given]
+    scale = np.array([si(known[ch]) for _, ch in given])
+    # the command's range within the lags allowed, channel by channel (N, given): kept as it goes, not per lag
+    low = high = now = _commanded(scenario, plan, dt, duration_scale, t)[:, columns] / scale
+    for lag in _LAGS[_LAGS != 0.0]:
+        command = _commanded(scenario, plan, dt, duration_scale, t + lag)[:, columns] / scale
+        low, high = np.minimum(low, command), np.maximum(high, command)
+    at = _schedule_signals(t, plan, dt)
+    case, phase = at["case"].astype(int) - 1, at["phase"]
+    for c, (_, ch) in enumerate(given):
         unit = known[ch]
-        command = lagged[:, :, j] / si(unit)
         peaks = np.zeros(len(plan))
-        np.maximum.at(peaks, case, np.abs(command).max(axis=0))   # each case's largest command
+        np.maximum.at(peaks, case, np.maximum(np.abs(low[:, c]), np.abs(high[:, c])))   # each case's largest command
         slack = TRACKING_FRACTION * peaks[case] + TRACKING_FLOOR[unit]
-        off = np.flatnonzero((values[ch] < command.min(axis=0) - slack) | (values[ch] > command.max(axis=0) + slack))
+        off = np.flatnonzero((values[ch] < low[:, c] - slack) | (values[ch] > high[:, c] + slack))
         if off.size:
             i, k = off[0], case[off[0]]
             raise InputError(
                 f"the rig input is {values[ch][i]:.6g} {unit} at t = {t[i]:.9g} s where the scenario "
-                f"{scenario.name} commands {command[len(_LAGS) // 2, i]:.6g} {unit} (case {k + 1} "
-                f"'{scenario.cases[k].label}', {PHASES[int(at['phase'][i])]}); expected to follow it to within "
+                f"{scenario.name} commands {now[i, c]:.6g} {unit} (case {k + 1} "
+                f"'{scenario.cases[k].label}', {PHASES[int(phase[i])]}); expected to follow it to within "
                 f"{slack[i]:.3g} {unit} ({TRACKING_FRACTION:.0%} of the case's largest command, {peaks[k]:.6g} {unit}, "
                 f"+ {TRACKING_FLOOR[unit]:g} {unit}) and ±{TRACKING_LAG_S * 1e3:g} ms: a record of another scenario, "
                 f"or the column's sign, unit or offset wrong?", source=source, key=where(i, ch))

@@ -273,7 +273,7 @@ def _bus_file(f: Fields, key: str) -> BusFile:
         return read_bus(resolve(f.text(key), PARAMETER_SET_DIR, "bushing property", base=Path(f.doc.source).parent,
                                 suffix=".bus"))
     except InputError as error:
-        raise f.fail(key, f"{error.source}: {error.bare}" if error.source else error.bare) from None
+        raise f.fail(key, str(error)) from None
 
 
 def _from_bus(f: Fields, key: str, d: str, quantity: str, families: Families,
@@ -283,7 +283,7 @@ def _from_bus(f: Fields, key: str, d: str, quantity: str, families: Families,
     try:
         pset = bus.parameter_set(d)
     except InputError as error:
-        raise f.fail(key, f"{error.source}: {error.bare}") from None
+        raise f.fail(key, str(error)) from None
     source = f"{f.doc.where(f.path(key))}: {dotted(f.path(key))} ({pset.source})"
     return _checked(DirectionDef(quantity, None, "curve", dict(pset.values), source, families, dict(effects or {})),
                     f.doc, f.path(key))

@@ -216,7 +216,7 @@ class CaseSamples:
         if (bank.failed_steps != self._tallied).any():
             units = ["rad" if ch.quantity == "rotation" else "m" for ch in bank.channels]
             self.play.unconverged.add([self.names[i] for i in forces.bank_idx], units, bank.failed_steps,
-                                      self._tallied, bank.worst_residual, bank.tolerance, self.number, from_s, to_s)
+                                      self._tallied, bank.worst_residual, bank.tolerances, self.number, from_s, to_s)
 
 
 class ScenarioRun(PlayedScenario):

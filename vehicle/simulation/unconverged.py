@@ -41,9 +41,10 @@ class UnconvergedSteps:
                 f"t = {self.from_s:.3f}–{self.to_s:.3f} s, case {self.case}")
 
     def to_record(self) -> dict[str, Any]:
-        """The fields as a recording's status record keeps them (JSON; a NaN residual as the string 'nan')."""
+        """The fields as a recording's status record keeps them (JSON: a NaN or infinite residual as
+        the string 'nan', 'inf')."""
         record = asdict(self)
-        record["worst_residual"] = self.worst_residual if math.isfinite(self.worst_residual) else "nan"
+        record["worst_residual"] = self.worst_residual if math.isfinite(self.worst_residual) else str(self.worst_residual)
         return record
 
     @classmethod
@@ -78,12 +79,12 @@ class UnconvergedTally:
     def __init__(self) -> None:
         self._by_channel: dict[str, UnconvergedSteps] = {}
 
-    def add(self, names: list[str], units: list[str], failed: np.ndarray, seen: np.ndarray, worst: np.ndarray, tolerance: float,
-            case: int, from_s: float, to_s: float) -> None:
+    def add(self, names: list[str], units: list[str], failed: np.ndarray, seen: np.ndarray, worst: np.ndarray,
+            tolerances: np.ndarray, case: int, from_s: float, to_s: float) -> None:
         """Count a block of samples from ``from_s`` to ``to_s`` [s] of ``case``: ``failed`` (M,) the
         bank's counts now, ``seen`` (M,) the counts before the block (updated in place), ``worst`` (M,) the
-        bank's worst residuals of the case so far [m or rad], ``names`` (M,) its channels and ``units``
-        (M,) their deflections' (``m`` or ``rad``)."""
+        bank's worst residuals of the case so far [m or rad], ``tolerances`` (M,) its solves', ``names``
+        (M,) its channels and ``units`` (M,) their deflections' (``m`` or ``rad``)."""
         for c in np.flatnonzero(failed != seen):
             name, new = names[c], int(failed[c] - seen[c])
             seen[c] = failed[c]
@@ -92,7 +93,7 @@ class UnconvergedTally:
                                and (residual != residual or residual > old.worst_residual)):
                 # the case's worst grew in this block (a bank's worst only grows): it came in this block
                 self._by_channel[name] = UnconvergedSteps(name, units[c], new + (old.steps if old else 0), residual,
-                                                          tolerance, case, from_s, to_s)
+                                                          float(tolerances[c]), case, from_s, to_s)
             else:
                 self._by_channel[name] = replace(old, steps=old.steps + new)
 
