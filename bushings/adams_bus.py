@@ -117,8 +117,8 @@ def read_bus(path: str | os.PathLike[str]) -> BusFile:
     scale = {"translation": (length / _MM, force, force * time / length * _MM),
              "rotation": (angle / _DEG, force * length, force * length * time / angle * _DEG)}
     if "DAMPING" in bus.tables or "DAMPING" in bus.texts:
-        raise InputError("a table; expected KEY = value lines (FX_DAMPING = 0.5, ...)", source=_section_line(bus, "DAMPING"),
-                         key="[DAMPING]")
+        raise InputError("a table; expected KEY = value lines (FX_DAMPING = 0.5, ...)",
+                         source=_section_line(bus, "DAMPING"), key="[DAMPING]")
     damping: dict[str, float] = {}
     for key in bus.values.get("DAMPING", {}):
         if key not in DAMPING_KEYS:
@@ -148,7 +148,8 @@ def read_bus(path: str | os.PathLike[str]) -> BusFile:
         curve = tuple((float(x) * x_scale, float(f) * f_scale) for x, f in table)
         directions[direction] = BusDirection(direction, curve, damping.get(direction, 0.0) * c_scale)
     if not directions:
-        raise InputError(f"no curve; expected some of {', '.join(f'[{c}_CURVE]' for c in CURVES)}", source=str(bus.path))
+        raise InputError(f"no curve; expected some of {', '.join(f'[{c}_CURVE]' for c in CURVES)}",
+                         source=str(bus.path))
     return BusFile(bus.path, directions, tuple(bus.texts.get("MDI_HEADER", ())))
 
 

@@ -68,7 +68,8 @@ def test_the_tally_keeps_the_block_of_the_worst_and_a_nan() -> None:
 
 
 QUICK = {"name": "quick_pumping", "type": "pumping", "vehicle": "c_segment", "output_rate_hz": 50,
-         "settle": {"before_bushings_s": 0.3, "before_input_s": 0.3}, "cases": [{"amplitude_mm": 20, "frequency_hz": 2, "cycles": 1}]}
+         "settle": {"before_bushings_s": 0.3, "before_input_s": 0.3},
+         "cases": [{"amplitude_mm": 20, "frequency_hz": 2, "cycles": 1}]}
 
 
 def test_a_run_says_where_its_bushing_solve_did_not_converge(tmp_path, monkeypatch) -> None:

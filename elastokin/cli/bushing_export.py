@@ -36,8 +36,8 @@ def _export(args: argparse.Namespace) -> int:
             directions[CURVES[name]] = type(made.direction)(CURVES[name], made.direction.curve, made.direction.damping)
         lines = comparison_lines(compare(channel, made), quantity)
         notes += [f"{'/'.join(names)}: {pset.name} ({pset.model}; {pset.source})",
-                  f"  curve: centre line of the slow loop ({SLOW_RATE * 60:g} {unit}/min triangle) over +-{args.range:g} "
-                  f"{unit}, straight on beyond; damping: equivalent viscous at {args.damping_hz:g} Hz, "
+                  f"  curve: centre line of the slow loop ({SLOW_RATE * 60:g} {unit}/min triangle) over "
+                  f"+-{args.range:g} {unit}, straight on beyond; damping: equivalent viscous at {args.damping_hz:g} Hz, "
                   f"{args.damping_at:g} {unit}",
                   "  not carried: hysteresis at vanishing rates, relaxation, the Payne effect (amplitude), frequency "
                   "dependence away from that point" + (", the set's effects" if pset.effects else ""),

@@ -33,7 +33,8 @@ class UnconvergedSteps:
     to_s: float
 
     def describe(self) -> str:
-        """``"lca_front_left.x: 12 steps, worst residual 3.1e-04 mm (tolerance 1e-05 mm) in t = 2.000–3.000 s, case 1"``."""
+        """``"e2_front_left.y: 12 steps, worst residual 3.1e-04 mm (tolerance 1e-05 mm) in t = 2.000–3.000 s,
+        case 1"``."""
         unit = "deg" if self.unit == "rad" else "mm"
         scale = factor(self.unit, unit)
         return (f"{self.channel}: {self.steps} step{'s' * (self.steps != 1)}, worst residual "
@@ -44,7 +45,8 @@ class UnconvergedSteps:
         """The fields as a recording's status record keeps them (JSON: a NaN or infinite residual as
         the string 'nan', 'inf')."""
         record = asdict(self)
-        record["worst_residual"] = self.worst_residual if math.isfinite(self.worst_residual) else str(self.worst_residual)
+        residual = self.worst_residual
+        record["worst_residual"] = residual if math.isfinite(residual) else str(residual)
         return record
 
     @classmethod
