@@ -284,7 +284,7 @@ class _Problem:
 
     def __init__(self, model: str, fixed: Mapping[str, float], records: Sequence[BenchRecord]):
         self.model, self.fixed, self.records = model, dict(fixed), list(records)
-        self.names = FIT_PARAMETERS[model]
+        self.names = tuple(n for n in FIT_PARAMETERS[model] if n not in self.fixed)
         self.weights = [1.0 / (float(np.ptp(r.F)) * math.sqrt(len(r))) for r in self.records]
         self.evaluations = 0
 
@@ -313,8 +313,10 @@ class _Problem:
 
 
 def fit(records: Sequence[BenchRecord], model: str = "stvs", initial: Sequence[ParameterSet] | None = None,
-        n_cells: int | None = None, max_samples: int = 3000, max_iterations: int = 60) -> FitResult:
-    """Least-squares fit of all ``model`` parameters (N fixed) to several records at once.
+        n_cells: int | None = None, max_samples: int = 3000, max_iterations: int = 60,
+        hold: Sequence[str] = ()) -> FitResult:
+    """Least-squares fit of all ``model`` parameters (N fixed, and those named in ``hold`` at their
+    starting values: ``("K0",)`` for a ladder without its parallel spring) to several records at once.
 
     The fit runs from each starting set (default :func:`initial_guesses`) and keeps the best: with
     noisy data the cost has shallow local minima along the Ff-Co-Kr valley.
@@ -327,6 +329,10 @@ def fit(records: Sequence[BenchRecord], model: str = "stvs", initial: Sequence[P
         raise InputError(f"cannot fit model {model!r}; expected one of {', '.join(FIT_PARAMETERS)}", key="model")
     if not records:
         raise InputError("no records to fit")
+    unknown = sorted(set(hold) - set(FIT_PARAMETERS[model]))
+    if unknown:
+        raise InputError(f"cannot hold {', '.join(unknown)}: not a fitted parameter of {model!r} "
+                         f"({', '.join(FIT_PARAMETERS[model])})", key="hold")
     starts = list(initial) if initial is not None else initial_guesses(records, model, n_cells or DEFAULT_CELLS)
     tic = time.perf_counter()
     best, evaluations = None, 0
@@ -334,7 +340,7 @@ def fit(records: Sequence[BenchRecord], model: str = "stvs", initial: Sequence[P
         if start.model != model:
             raise InputError(f"starting set is a {start.model!r} set, expected {model!r}", source=start.name, key="model")
         init_values = dict(start.values, **({"N": n_cells} if n_cells is not None else {}))
-        fixed = {k: v for k, v in init_values.items() if k not in FIT_PARAMETERS[model]}
+        fixed = {k: v for k, v in init_values.items() if k not in FIT_PARAMETERS[model] or k in hold}
         problem = _Problem(model, fixed, [r.subsampled(max_samples) for r in records])
         is_pw = np.array(problem.names) == "pw"
         lower, upper = np.where(is_pw, PW_MIN, -np.inf), np.where(is_pw, 1.0, np.inf)
