@@ -1,0 +1,33 @@
+"""The thesis's measured figures of its bushing (issue 52, item 2): 920 N/mm and tan δ 0.12 at 1 Hz,
+1 mm (Bourgeteau 2009, figs. 5.18–5.23 captions), about 50 % lost from 0.1 to 2 mm at 10 Hz and 20 %
+between 100 and 1 Hz at 0.5 mm (§3.3.1), held by the set identified to them with fig. 5.6's slow
+loops; the figures' own sets miss them, by the margins the report gives."""
+
+from __future__ import annotations
+
+import pytest
+
+from elastokin.bushings.bench.measured_figures import FIGURES, LOOP_TOLERANCE, measures
+from elastokin.bushings.parameter_sets import load_parameter_set
+
+
+def test_the_identified_set_meets_the_thesis_figures_and_fig_5_6s_slow_loop() -> None:
+    m = measures(load_parameter_set("measured_figures_stvs").channel())
+    for key, (target, tolerance) in FIGURES.items():
+        assert abs(m.figures[key] - target) <= tolerance, (key, m.figures[key])
+    assert m.loop_departure <= LOOP_TOLERANCE
+
+
+@pytest.mark.parametrize("name, tan_delta, payne, frequency", [
+    ("fig5_9", 0.169, 0.385, 0.106), ("fig5_8", 0.166, 0.394, 0.086), ("fig5_6", 0.131, 0.425, 0.0)])
+def test_the_figures_own_sets_miss_the_measured_figures(name: str, tan_delta: float, payne: float,
+                                                        frequency: float) -> None:
+    """As initialised from the slow loop (§5.2), the sets of figs. 5.6, 5.8 and 5.9 are lossier at
+    1 Hz, 1 mm than the part measured and lose less stiffness with amplitude and frequency; their
+    slow loops stay fig. 5.6's."""
+    m = measures(load_parameter_set(name).channel())
+    assert m.figures["tan_delta_1hz_1mm"] == pytest.approx(tan_delta, abs=0.001)
+    assert m.figures["payne_loss_10hz"] == pytest.approx(payne, abs=0.001)
+    assert m.figures["frequency_loss_0p5mm"] == pytest.approx(frequency, abs=0.001)
+    assert abs(m.figures["tan_delta_1hz_1mm"] - 0.12) > FIGURES["tan_delta_1hz_1mm"][1]
+    assert m.loop_departure <= LOOP_TOLERANCE
