@@ -11,7 +11,7 @@ from typing import Any, Mapping
 
 
 from elastokin.bushings.effects import Effects, effects_to_si
-from elastokin.bushings.parameters import MODELS, ChannelParams, to_si
+from elastokin.bushings.parameters import MODELS, ChannelParams, model_keys, to_si
 from elastokin.core.documents import Document, dump_yaml
 from elastokin.core.errors import InputError
 from elastokin.core.files import atomic_output, is_file, read_text
@@ -50,7 +50,7 @@ class ParameterSet:
             if not isinstance(target, str) or target not in MODELS:
                 raise InputError(f"unknown model {target!r}; expected one of {', '.join(MODELS)}",
                                  source=str(self.path or self.name), key="model")
-            required, optional = MODELS[target]
+            required, optional = model_keys(target, values)
             values = {k: v for k, v in values.items() if k in required + optional}
         return to_si(target, values, self.quantity, str(self.path or self.name))
 

@@ -38,7 +38,8 @@ _PARAMETERS: dict[str, tuple[int | None, str]] = {
     "maxwell_c": (-1, "{F}·s/{L}"), "curve": (None, "[{L}, {F}] points"),
 }
 
-_ELASTIC_KEYS = ("N_sup", "N_inf", "S_sup", "S_inf", "P_sup", "P_inf")
+#: The nonlinear elastic law's keys (beside K0).
+ELASTIC_KEYS = _ELASTIC_KEYS = ("N_sup", "N_inf", "S_sup", "S_inf", "P_sup", "P_inf")
 # Parallel Maxwell branches: the TVS's viscoelastic part, and broad-spectrum relaxation on any law.
 _MAXWELL_KEYS = ("maxwell_k", "maxwell_c")
 
@@ -56,6 +57,18 @@ MODELS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
 }
 #: Most points of a tabulated elastic law (``curve``).
 MAX_CURVE_POINTS = 1000
+#: The ladder models whose elastic law may be a ``curve`` in place of K0 and the elastic keys.
+CURVE_ELASTIC = ("sts", "sts_continuous", "stsn", "rt", "stvs", "tvs")
+
+
+def model_keys(model: str, values: Mapping[str, Any] = {}) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """(required, optional) keys of ``model`` for ``values``: :data:`MODELS`'s, with a ladder's K0
+    and elastic keys replaced by ``curve`` when ``values`` give one."""
+    required, optional = MODELS[model]
+    if model in CURVE_ELASTIC and "curve" in values:
+        return (tuple(k for k in required if k != "K0"),
+                tuple(k for k in optional if k not in _ELASTIC_KEYS) + ("curve",))
+    return required, optional + (("curve",) if model in CURVE_ELASTIC else ())
 
 #: The models the bench identification fits (all their required parameters, N fixed): a constant
 #: here, so that the command line lists them without importing the fit (and scipy).
@@ -138,7 +151,10 @@ def to_si(model: str, values: Mapping[str, Any], quantity: str = "translation",
     if not isinstance(quantity, str) or quantity not in LENGTH_UNIT_SI:
         raise InputError(f"unknown quantity {quantity!r}; expected translation or rotation",
                          source=source, key="quantity")
-    required, optional = MODELS[model]
+    required, optional = model_keys(model, values)
+    if model in CURVE_ELASTIC and "curve" in values and ({"K0", *_ELASTIC_KEYS} & set(values)):
+        raise InputError("give the elastic law as K0 (and the elastic keys) or as a curve, not both",
+                         source=source, key="curve")
     unknown = sorted(set(values) - set(required) - set(optional))
     if unknown:
         raise InputError(f"unknown parameter(s) {', '.join(unknown)} for model {model!r}; "

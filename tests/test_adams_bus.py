@@ -312,3 +312,28 @@ def test_a_damaged_or_hostile_file_is_refused_or_read_never_a_traceback(tmp_path
     for d in bus.directions:
         channel = bus.parameter_set(d).channel()
         assert np.all(np.isfinite(np.array(channel.curve))) and channel.K0 > 0.0
+
+
+def test_a_fit_keeps_a_property_files_curve_as_its_elastic_law(tmp_path: Path, capsys) -> None:
+    """`vsim bushing fit --elastic F.bus`: the ladder fitted beside the file's curve, held, to records
+    of an STVS whose elastic law is that curve (fig5_9's ladder), recovers the ladder."""
+    from elastokin.bushings.bench.records import simulate_record
+    from elastokin.bushings.bench.programmes import sine, triangle
+    from elastokin.bushings.parameters import to_si
+    from elastokin.core.tables import write_csv_columns
+
+    bus = read_bus(_write(tmp_path))
+    ladder = {"N": 15, "Kpa": 1051.0, "Kr": 2951.0, "Ff": 9.0, "Co": 32.0, "pw": 0.15}
+    truth = to_si("stvs", {**ladder, "curve": bus.parameter_set("y").values["curve"]})
+    for name, (t, e) in {"tri": triangle(2e-3, 0.333e-3, 2, 0.01), "sin": sine(1e-3, 1.0, 3, 0.005)}.items():
+        write_csv_columns(tmp_path / f"{name}.csv", {"t_s": t, "e_mm": e * 1e3,
+                                                     "F_N": simulate_record([truth], t, e)[:, 0]})
+    assert main(["bushing", "fit", str(tmp_path / "tri.csv"), str(tmp_path / "sin.csv"), "--elastic",
+                 str(tmp_path / "hand.bus"), "--direction", "y", "-o", str(tmp_path / "fitted.yaml")]) == 0
+    assert "elastic law: the curve of 7 points from -10 to 10 mm (held)" in capsys.readouterr().out
+    fitted = load_parameter_set(tmp_path / "fitted.yaml")
+    assert fitted.values["curve"] == [list(p) for p in bus.directions["y"].curve] and "K0" not in fitted.values
+    assert fitted.values["Kpa"] == pytest.approx(ladder["Kpa"], rel=0.01)
+    assert fitted.values["Kr"] == pytest.approx(ladder["Kr"], rel=0.01)
+    with pytest.raises(InputError, match="give the elastic law as K0 .* or as a curve, not both"):
+        to_si("stvs", {**ladder, "K0": 500.0, "curve": [[0.0, 0.0], [1.0, 100.0]]})

@@ -25,7 +25,7 @@ from scipy.optimize import least_squares
 
 from elastokin.bushings.bench.records import BenchRecord, simulate_record
 from elastokin.bushings.parameter_sets import ParameterSet
-from elastokin.bushings.parameters import DEFAULT_CELLS, FITTED_MODELS, MODELS, PW_MIN, to_si
+from elastokin.bushings.parameters import DEFAULT_CELLS, ELASTIC_KEYS, FITTED_MODELS, MODELS, PW_MIN, to_si
 from elastokin.core.errors import InputError
 from elastokin.core.units import MM
 
@@ -208,6 +208,14 @@ def starting_set(pset: ParameterSet, model: str) -> ParameterSet:
     return pset
 
 
+def with_elastic_curve(pset: ParameterSet, curve: Sequence[Sequence[float]], where: str) -> ParameterSet:
+    """``pset`` with its elastic law (K0 and the elastic keys) replaced by the tabulated ``curve``
+    ([[mm, N], ...], from ``where``): a fit from it keeps the curve and fits the ladder."""
+    values = {k: v for k, v in pset.values.items() if k not in ("K0", *ELASTIC_KEYS)}
+    return replace(pset, values={**values, "curve": [list(p) for p in curve]},
+                   source=f"{pset.source}, its elastic law the curve of {where}")
+
+
 def initial_guesses(records: Sequence[BenchRecord], model: str, n_cells: int = DEFAULT_CELLS) -> list[ParameterSet]:
     """Starting points for :func:`fit`: direct STS identification on the slowest cyclic record,
     then for the STVS eq. 5.10 twice (slider share 0.8 as the thesis's text says, 0.2 as its
@@ -270,7 +278,8 @@ class FitResult:
         errors = ", ".join(f"{e.source} {e.rms_N:.3g} N ({e.percent:.2f} %)" for e in self.errors)
         source = (f"fitted by vsim bushing fit ({self.model}) on {dt.date.today().isoformat()} to "
                   f"{', '.join(record_paths)}; RMS fit error {errors}")
-        params = {k: (int(v) if k == "N" else float(f"{v:.5g}")) for k, v in self.values.items()}
+        params = {k: (int(v) if k == "N" else float(f"{v:.5g}") if isinstance(v, float) else v)
+                  for k, v in self.values.items()}
         return ParameterSet(name, self.model, "translation", params, source)
 
 
@@ -284,7 +293,9 @@ class _Problem:
 
     def __init__(self, model: str, fixed: Mapping[str, float], records: Sequence[BenchRecord]):
         self.model, self.fixed, self.records = model, dict(fixed), list(records)
-        self.names = tuple(n for n in FIT_PARAMETERS[model] if n not in self.fixed)
+        # a curve is the elastic law in K0's place: it is held, K0 not fitted
+        self.names = tuple(n for n in FIT_PARAMETERS[model]
+                           if n not in self.fixed and not (n == "K0" and "curve" in self.fixed))
         self.weights = [1.0 / (float(np.ptp(r.F)) * math.sqrt(len(r))) for r in self.records]
         self.evaluations = 0
 

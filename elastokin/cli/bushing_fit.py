@@ -10,13 +10,18 @@ from elastokin.cli.arguments import output_file
 
 
 def _fit(args: argparse.Namespace) -> int:
-    from elastokin.bushings.bench.identification import fit, starting_set
+    from elastokin.bushings.adams_bus import read_bus
+    from elastokin.bushings.bench.identification import fit, initial_guesses, starting_set, with_elastic_curve
     from elastokin.bushings.bench.records import read_bench_csv
     from elastokin.bushings.parameter_sets import load_parameter_set, save_parameter_set
     from elastokin.presentation.fit_report import format_result
 
     records = [read_bench_csv(path) for path in args.records]
     initial = [starting_set(load_parameter_set(args.init), args.bushing_model)] if args.init else None
+    if args.elastic is not None:
+        curve = read_bus(args.elastic).parameter_set(args.direction).values["curve"]
+        starts = initial or initial_guesses(records, args.bushing_model, args.n_cells or DEFAULT_CELLS)
+        initial = [with_elastic_curve(s, curve, f"{args.elastic} ({args.direction})") for s in starts]
     result = fit(records, args.bushing_model, initial, n_cells=args.n_cells, max_samples=args.max_samples)
     print(format_result(result))
     if args.output:
@@ -40,6 +45,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help=f"ladder cells (default: the --init set's, else {DEFAULT_CELLS})")
     p.add_argument("--init", metavar="SET", help="starting parameter set (name in models/bushings/ or YAML "
                                                  "path); an STS set is converted by eq. 5.10 for STVS/RT")
+    p.add_argument("--elastic", type=Path, metavar="F.bus",
+                   help="take the elastic law from an Adams bushing property file's curve (held; the ladder is "
+                        "fitted beside it)")
+    p.add_argument("--direction", choices=("x", "y", "z"), default="x", help="the --elastic file's direction (default x)")
     p.add_argument("--max-samples", type=int, default=3000,
                    help="subsample longer records to about this many samples (default 3000)")
     p.set_defaults(func=_fit)
