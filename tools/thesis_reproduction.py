@@ -339,7 +339,8 @@ def report(r: dict, files: dict[str, str]) -> str:
         f"{_fmt(r['speeds_linear'][3]['camber_fl_loop_deg'])} against "
         f"{_fmt(r['speeds_sts'][3]['camber_fl_loop_deg'])} with both). STVS's own viscous branch thins the "
         "loop too (without dampers). The loops are smooth at every speed: the thesis's numerical "
-        "instabilities at the fastest were Adams's.",
+        "instabilities at the fastest came from its own integration of the laws, an explicit Euler without "
+        "corrector inside Adams's VARSUB routine (§3.4.3, §3.5.2, §4.3); here they are stepped implicitly.",
         "",
         "The rear (twist-beam) camber loop [deg] is "
         + ", ".join(_fmt(v, 5) for v in speeds_rear)
