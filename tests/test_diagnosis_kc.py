@@ -565,6 +565,7 @@ def check_pair(result: dict, hs: list[Hypothesis]) -> None:
         assert abs(fitted - h.values[first.name]) <= 0.3 * abs(h.values[first.name]), (h, fitted)
 
 
+@pytest.mark.slow   # the default run keeps two end-to-end diagnoses below; the slow suite draws every cause
 def test_a_drawn_cause_is_named_at_its_place(tmp_path):
     cause = KC_CAUSES[SEED % len(KC_CAUSES)]
     h, measured = measure(tmp_path, cause, SEED)

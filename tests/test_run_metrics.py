@@ -24,7 +24,7 @@ from elastokin.vehicle.simulation.kc_triangles import design_contact_base
 from elastokin.vehicle.simulation.rig import KCRig
 from elastokin.analysis.kc_metrics import BUMP_WINDOW_M, TEST_METRICS
 from elastokin.analysis.kc_test import kc_metrics
-from elastokin.analysis.run_metrics import case_loop, case_metrics, cases, contact_base_m, run_metrics
+from elastokin.analysis.run_metrics import case_loop, case_metrics, cases, contact_base_m, run_metrics, tyre_radius_m
 from elastokin.core.errors import InputError
 from elastokin.core.shipped import DEFAULT_VEHICLE
 from elastokin.presentation.run_summary import summary
@@ -98,8 +98,11 @@ def test_roll_metrics_need_a_contact_base_without_a_vehicle(runs) -> None:
     bare = Run(**{**vars(run), "metadata": RunMetadata(extra=run.metadata.extra)})
     with pytest.raises(InputError, match="tyre radius"):
         run_metrics(bare)
+    assert run_metrics(bare, radius_m=tyre_radius_m(run)) == run_metrics(run)
     given = {"front": 1.5, "rear": 1.5}
-    assert run_metrics(bare, given) == run_metrics(run, given)
+    without_radius = run_metrics(bare, given)
+    assert without_radius[1]["rear"] == {k: v for k, v in run_metrics(run, given)[1]["rear"].items()
+                                         if k != "roll_centre_height_kinematic_mm"}
 
 
 def test_summary_prints_the_kc_metrics(runs) -> None:
@@ -125,11 +128,14 @@ def triangle(t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return x, np.where(falling, 1.0, -1.0)
 
 
+UNITS = {"pad_fz": "N", "half_track": "mm", "wheel_centre_x": "mm"}   #: of synthetic outputs that are no angles
+
+
 def synthetic_run(kind: str, outputs: dict[str, tuple[float, float]], *, right_sign: float = 1.0) -> Run:
     """A two-cycle ``kind`` case recorded at RATE_HZ: every corner's pad and wheel travel follow the
     triangle (right corners × ``right_sign``); output ``q`` of each corner is
     gradient·x + width/2 on the falling branch, − width/2 on the rising one, for
-    ``outputs[q] = (gradient [unit/mm], width [unit])``."""
+    ``outputs[q] = (gradient [unit/mm], width [unit])``, its unit deg unless :data:`UNITS` names it."""
     t = np.arange(int(2 * PERIOD_S * RATE_HZ) + 1) / RATE_HZ
     x, falling = triangle(t)
     signals, units = {"case": np.ones_like(t), "phase": np.full_like(t, 2.0), "input_time": t}, {}
@@ -139,7 +145,7 @@ def synthetic_run(kind: str, outputs: dict[str, tuple[float, float]], *, right_s
             signals[f"{name}_{tag}"], units[f"{name}_{tag}"] = xc, "mm"
         for quantity, (gradient, width) in outputs.items():
             signals[f"{quantity}_{tag}"] = gradient * xc + 0.5 * width * falling
-            units[f"{quantity}_{tag}"] = "deg"
+            units[f"{quantity}_{tag}"] = UNITS.get(quantity, "deg")
     extra = {"type": kind, "x_quantity": "wheel_travel", "axles": ["front", "rear"], "duration_scale": 1.0,
              "cases": [{"case": 1, "label": "synthetic", "parameters": {}, "cycles": 2, "input_start_s": 0.0,
                         "end_s": float(t[-1])}]}
@@ -165,9 +171,14 @@ def test_known_slope_width_and_area_are_recovered_exactly() -> None:
 
 def test_known_slopes_give_the_named_kc_metrics_exactly() -> None:
     toe, camber = (0.004, 0.001), (-0.02, 0.002)   # (deg/mm, deg)
-    run = synthetic_run("pumping", {"toe": toe, "camber": camber})
+    fz, track, x = (25.0, 3.0), (-0.03, 0.01), (-0.05, 0.0)   # (N/mm, N), (mm/mm, mm) ...
+    run = synthetic_run("pumping", {"toe": toe, "camber": camber, "pad_fz": fz, "half_track": track,
+                                    "wheel_centre_x": x})
     bump = case_metrics(run, cases(run)[0])
     for axle in ("front", "rear"):
+        assert bump[axle]["wheel_rate_n_per_mm"] == pytest.approx(fz[0], rel=1e-9)
+        assert bump[axle]["half_track_change_mm_per_m"] == pytest.approx(1e3 * track[0], rel=1e-9)
+        assert bump[axle]["wheel_recession_mm_per_m"] == pytest.approx(-1e3 * x[0], rel=1e-9)
         assert bump[axle]["bump_steer_deg_per_m"] == pytest.approx(1e3 * toe[0], rel=1e-9)
         assert bump[axle]["bump_camber_deg_per_m"] == pytest.approx(1e3 * camber[0], rel=1e-9)
         assert bump[axle]["toe_loop_width_deg"] == pytest.approx(toe[1], rel=1e-9)
@@ -175,10 +186,14 @@ def test_known_slopes_give_the_named_kc_metrics_exactly() -> None:
     # roll: right pads opposite, so roll = (zR − zL)/base = −2x/base; steer = toe·(±1) per side,
     # its mean over the axle cancels on a synthetic car whose steer is the same function on both sides
     base = 1.6   # m
-    run = synthetic_run("roll", {"camber": camber, "steer": toe}, right_sign=-1.0)
+    run = synthetic_run("roll", {"camber": camber, "steer": toe, "pad_fz": fz}, right_sign=-1.0)
     roll = case_metrics(run, cases(run)[0], {"front": base, "rear": base})
     per_roll_deg = math.radians(1.0) * base / -2.0 * 1e3   # mm of x per degree of roll
     for axle in ("front", "rear"):
+        # two wheels of rate k at ±base/2: k·base²/2 per radian
+        assert roll[axle]["roll_stiffness_nm_per_deg"] == pytest.approx(1e3 * fz[0] * base ** 2 / 2 * math.pi / 180,
+                                                                        rel=1e-9)
+        assert "roll_centre_height_kinematic_mm" not in roll[axle]   # no tyre radius: no contact points
         # (camber_R − camber_L)/2 = −camber gradient·x; plus the roll angle itself
         assert roll[axle]["roll_camber_deg_per_deg"] == pytest.approx(1.0 - camber[0] * per_roll_deg, rel=1e-9)
         assert roll[axle]["roll_steer_deg_per_deg"] == pytest.approx(0.0, abs=1e-12)

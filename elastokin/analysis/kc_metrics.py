@@ -15,6 +15,7 @@ whose contact-point force points inboard (an outer wheel in cornering).
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
@@ -39,16 +40,34 @@ METRICS = (
     ("camber_loop_width_deg", "deg", "camber loop width at design height in the bump test"),
     ("toe_loop_width_max_deg", "deg", "largest toe loop width over ±20 mm of bump"),
     ("camber_loop_width_max_deg", "deg", "largest camber loop width over ±20 mm of bump"),
+    ("wheel_rate_n_per_mm", "N/mm", "pad Fz per mm of wheel-centre travel in bump (wheel-centre rate; rigid rig wheels)"),
+    ("ride_rate_n_per_mm", "N/mm", "the wheel rate in series with the tyre's vertical stiffness (VERTICAL_STIFFNESS of its .tir)"),
+    ("half_track_change_mm_per_m", "mm/m", "wheel-centre half-track (outward +) per metre of wheel-centre travel in bump"),
+    ("wheel_recession_mm_per_m", "mm/m", "wheel-centre rearward (−x) travel per metre of wheel-centre travel in bump"),
+    ("roll_stiffness_nm_per_deg", "N·m/deg", "axle's roll moment (right minus left pad Fz × half the contact base) "
+                                           "per degree of roll"),
+    ("roll_stiffness_share_pct", "%", "axle's share of the car's roll stiffness (front + rear)"),
+    ("roll_centre_height_kinematic_mm", "mm", "above the pads at design: the contact points' common lateral "
+                                              "motion per radian of roll (instant centres; roll test, Fy = 0)"),
+    ("roll_centre_height_force_mm", "mm", "above the pads at design: where the resultant of the ground forces "
+                                          "crosses the centre plane under Fy (lateral test, pad heights held)"),
+    ("braking_pad_fz_ratio", "N/N", "pad Fz per N of braking force (−x) at the contact point, pad heights held "
+                                    "(side-view tan θ; + pushes the wheel down)"),
+    ("braking_anti_pitch_pct", "%", "front: anti-dive, rear: anti-lift (SAE J670), the share of the braking "
+                                    "load transfer h/L the linkage carries, this axle braking alone at the contact "
+                                    "point (outboard brakes)"),
 )
 
 #: The metrics (keys of :data:`METRICS`) each test gives for an axle, the bump test's loop widths included.
 TEST_METRICS = {
-    "bump": ("bump_steer_deg_per_m", "bump_camber_deg_per_m", "toe_loop_width_deg", "toe_loop_width_max_deg",
-             "camber_loop_width_deg", "camber_loop_width_max_deg"),
-    "roll": ("roll_steer_deg_per_deg", "roll_camber_deg_per_deg"),
+    "bump": ("bump_steer_deg_per_m", "bump_camber_deg_per_m", "wheel_rate_n_per_mm", "half_track_change_mm_per_m",
+             "wheel_recession_mm_per_m", "toe_loop_width_deg", "toe_loop_width_max_deg", "camber_loop_width_deg",
+             "camber_loop_width_max_deg"),
+    "roll": ("roll_steer_deg_per_deg", "roll_camber_deg_per_deg", "roll_stiffness_nm_per_deg",
+             "roll_centre_height_kinematic_mm"),
     "lateral": ("lateral_force_compliance_steer_deg_per_kn", "lateral_force_compliance_camber_deg_per_kn",
-                "lateral_compliance_mm_per_kn"),
-    "longitudinal": ("longitudinal_compliance_steer_deg_per_kn",),
+                "lateral_compliance_mm_per_kn", "roll_centre_height_force_mm"),
+    "longitudinal": ("longitudinal_compliance_steer_deg_per_kn", "braking_pad_fz_ratio"),
     "aligning": ("aligning_torque_compliance_steer_deg_per_knm",),
 }
 
@@ -66,10 +85,12 @@ def fit_window(test: str, amplitude: float, base: float) -> float:
     return FIT_FRACTION * amplitude * _input_scale(test, base)
 
 
-def triangle_metrics(test: str, axle: str, down: Leg, up: Leg, window: float, base: float) -> dict[str, float]:
-    """The gradients and compliances of :data:`METRICS` that ``test`` (a :data:`TESTS` name) gives
-    for ``axle``, fitted over ±``window`` (:func:`fit_window`); ``base`` [m] is the axle's
-    contact-point base at design (used by roll only)."""
+def triangle_metrics(test: str, axle: str, down: Leg, up: Leg, window: float, base: float,
+                     radius: float = math.nan) -> dict[str, float]:
+    """The gradients, compliances and rates of :data:`TEST_METRICS` that ``test`` (a :data:`TESTS`
+    name) gives for ``axle``, fitted over ±``window`` (:func:`fit_window`); ``base`` [m] is the
+    axle's contact-point base at design (roll and lateral), ``radius`` [m] the tyre's (roll's
+    kinematic roll centre, left out when NaN)."""
     L, R = f"{axle}_left", f"{axle}_right"
     deg = np.degrees
 
@@ -83,22 +104,67 @@ def triangle_metrics(test: str, axle: str, down: Leg, up: Leg, window: float, ba
     steer = lambda g: deg(0.5 * (g("steer", L) + g("steer", R)))
     # right minus left: the right wheel is the outer one in roll, and +Fy points inboard on it
     camber = lambda g: deg(g("camber", R) - g("camber", L)) / 2
+    same = lambda v: v
+    # the roll moment the pads take, and the lateral force the axle takes
+    roll_moment = lambda g: (g("pad_fz", R) - g("pad_fz", L)) * base / 2
     if test == "bump":
-        return {"bump_steer_deg_per_m": each("pad_height", "toe"), "bump_camber_deg_per_m": each("pad_height", "camber")}
+        return {"bump_steer_deg_per_m": each("pad_height", "toe"), "bump_camber_deg_per_m": each("pad_height", "camber"),
+                "wheel_rate_n_per_mm": 1e-3 * each("wheel_travel", "pad_fz", same),
+                "half_track_change_mm_per_m": 1e3 * each("wheel_travel", "half_track", same),
+                "wheel_recession_mm_per_m": -1e3 * each("wheel_travel", "wheel_centre_x", same)}
     if test == "roll":
         roll = lambda g: deg((g("pad_height", R) - g("pad_height", L)) / base)
         # the outer wheel's camber to the ground gains the roll angle itself
-        return {"roll_steer_deg_per_deg": slope(roll, steer), "roll_camber_deg_per_deg": 1.0 + slope(roll, camber)}
+        m = {"roll_steer_deg_per_deg": slope(roll, steer), "roll_camber_deg_per_deg": 1.0 + slope(roll, camber),
+             "roll_stiffness_nm_per_deg": slope(roll, roll_moment)}
+        if not math.isnan(radius):
+            # the ground turns by −φ about the roll centre relative to the clamped body: the contact
+            # points (centre − r × the wheel's up direction) move by −h·φ together
+            contact_y = lambda g: 0.5 * sum(g("wheel_centre_y", c) - sign * radius * np.cos(g("toe", c))
+                                            * np.sin(g("camber", c)) for c, sign in ((L, 1.0), (R, -1.0)))
+            m["roll_centre_height_kinematic_mm"] = -1e3 * math.degrees(slope(roll, contact_y))
+        return m
     if test == "lateral":
         fy = lambda g: g("pad_fy", L)
+        # the ground forces' moment about (0, h) vanishes: h·ΣFy + (Fz_L − Fz_R)·base/2 = 0
         return {"lateral_force_compliance_steer_deg_per_kn": 1e3 * slope(fy, steer),
                 "lateral_force_compliance_camber_deg_per_kn": 1e3 * slope(fy, camber),
-                "lateral_compliance_mm_per_kn": 1e6 * each("pad_fy", "wheel_centre_y", lambda v: v)}
+                "lateral_compliance_mm_per_kn": 1e6 * each("pad_fy", "wheel_centre_y", same),
+                "roll_centre_height_force_mm": 0.5e3 * slope(lambda g: 0.5 * (g("pad_fy", L) + g("pad_fy", R)),
+                                                             roll_moment)}
     if test == "longitudinal":
-        return {"longitudinal_compliance_steer_deg_per_kn": -1e3 * each("pad_fx", "toe")}
+        return {"longitudinal_compliance_steer_deg_per_kn": -1e3 * each("pad_fx", "toe"),
+                "braking_pad_fz_ratio": -each("pad_fx", "pad_fz", same)}
     if test == "aligning":
         return {"aligning_torque_compliance_steer_deg_per_knm": 1e3 * slope(lambda g: g("pad_mz", L), steer)}
     raise ValueError(f"unknown K&C test {test!r}; expected one of {', '.join(t.name for t in TESTS)}")
+
+
+@dataclass(frozen=True)
+class CarFigures:
+    """What the car-level metrics of :func:`car_metrics` read of the vehicle."""
+
+    wheelbase_m: float
+    cg_height_m: float                       #: the whole car's centre of mass above the ground at design
+    tyre_vertical_stiffness_n_per_m: float | None   #: None without a tyre property file
+
+
+def car_metrics(axles: dict[str, dict[str, float]], car: CarFigures) -> dict[str, dict[str, float]]:
+    """``axles`` (each axle's :func:`triangle_metrics` of every test) with the metrics that need
+    both axles or the car (:data:`METRICS`): each axle's share of the roll stiffness, its ride
+    rate (left out without a tyre stiffness) and its anti-dive (front) or anti-lift (rear)."""
+    total_roll = sum(m["roll_stiffness_nm_per_deg"] for m in axles.values())
+    out = {}
+    for axle, m in axles.items():
+        extra = {"roll_stiffness_share_pct": 100.0 * m["roll_stiffness_nm_per_deg"] / total_roll,
+                 # a pad Fz pushing the wheel down under braking lifts the front, pulls the rear down
+                 "braking_anti_pitch_pct": (1.0 if axle == "front" else -1.0) * 100.0 * m["braking_pad_fz_ratio"]
+                                           * car.wheelbase_m / car.cg_height_m}
+        if car.tyre_vertical_stiffness_n_per_m is not None:
+            tyre = 1e-3 * car.tyre_vertical_stiffness_n_per_m
+            extra["ride_rate_n_per_mm"] = 1.0 / (1.0 / m["wheel_rate_n_per_mm"] + 1.0 / tyre)
+        out[axle] = m | extra
+    return out
 
 
 def bump_loop_widths(axle: str, down: Leg, up: Leg, window: float) -> dict[str, float]:

@@ -9,20 +9,26 @@ import numpy as np
 
 from elastokin.vehicle.model.definition import VehicleDefinition
 from elastokin.vehicle.model.elements import BuildOptions
+from elastokin.vehicle.model.statics import cg_height
 from elastokin.vehicle.scenarios.channels import AXLES
 from elastokin.vehicle.scenarios.kc_tests import TEST, TESTS
 from elastokin.vehicle.simulation.kc_triangles import design_contact_base, run_triangle
 from elastokin.vehicle.simulation.outputs import RigOutputs, WheelOutputs
 from elastokin.vehicle.simulation.rig import KCRig
-from elastokin.analysis.kc_metrics import Leg, bump_loop_widths, fit_window, triangle_metrics
+from elastokin.analysis.kc_metrics import CarFigures, Leg, bump_loop_widths, car_metrics, fit_window, triangle_metrics
+from elastokin.tyres.magic_formula import coefficients
+from elastokin.tyres.tir_file import read_tir
 from elastokin.analysis.loops import Branches
 
 #: Per-wheel quantities the metric definitions read, from one rig sample's wheel (SI).
 WHEEL_QUANTITIES: dict[str, Callable[[WheelOutputs], float]] = {
     "pad_height": lambda w: w.pad_height, "toe": lambda w: w.toe, "camber": lambda w: w.camber,
-    "steer": lambda w: w.steer, "wheel_centre_y": lambda w: w.wheel_centre[1],
-    "pad_fx": lambda w: w.pad_force[0], "pad_fy": lambda w: w.pad_force[1], "pad_mz": lambda w: w.pad_torque,
+    "steer": lambda w: w.steer, "wheel_travel": lambda w: w.travel, "half_track": lambda w: w.half_track,
+    "wheel_centre_x": lambda w: w.wheel_centre[0], "wheel_centre_y": lambda w: w.wheel_centre[1],
+    "pad_fx": lambda w: w.pad_force[0], "pad_fy": lambda w: w.pad_force[1], "pad_fz": lambda w: w.pad_force[2],
+    "pad_mz": lambda w: w.pad_torque,
 }
+
 
 def rig_leg(samples: list[RigOutputs]) -> Leg:
     """The :data:`Leg` of samples measured on the rig."""
@@ -37,16 +43,26 @@ def branches(down: list[RigOutputs], up: list[RigOutputs], x, y) -> Branches:
 
 def kc_metrics(rig: KCRig) -> dict[str, dict[str, float]]:
     """Run the K&C sequence (:data:`TESTS`) on ``rig``; metrics per axle (keys of :data:`elastokin.analysis.kc_metrics.METRICS`)."""
-    base = design_contact_base(rig)
+    base, radius = design_contact_base(rig), rig.vehicle.tyre.radius
     legs = {t.name: [rig_leg(samples) for samples in run_triangle(rig, t)] for t in TESTS}
     out: dict[str, dict[str, float]] = {}
     for axle in AXLES:
         m = {}
         for t in TESTS:
-            m |= triangle_metrics(t.name, axle, *legs[t.name], fit_window(t.name, t.amplitude, base[axle]), base[axle])
+            m |= triangle_metrics(t.name, axle, *legs[t.name], fit_window(t.name, t.amplitude, base[axle]),
+                                  base[axle], radius)
         out[axle] = m | bump_loop_widths(axle, *legs["bump"], fit_window("bump", TEST["bump"].amplitude, base[axle]))
     rig.reset()
-    return out
+    return car_metrics(out, car_figures(rig.vehicle))
+
+
+def car_figures(vehicle: VehicleDefinition) -> CarFigures:
+    """The wheelbase, centre-of-mass height and tyre vertical stiffness (at its nominal load, from
+    the tyre's .tir when the vehicle names one) of ``vehicle``."""
+    tyre = vehicle.tyre.property_file
+    return CarFigures(vehicle.front.hardpoints["wheel_centre"][0] - vehicle.rear.hardpoints["wheel_centre"][0],
+                      cg_height(vehicle),
+                      None if tyre is None else float(coefficients(read_tir(tyre))["VERTICAL_STIFFNESS"]))
 
 
 def vehicle_kc(vehicle: VehicleDefinition, options: BuildOptions = BuildOptions()) -> dict[str, dict[str, float]]:

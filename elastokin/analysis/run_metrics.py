@@ -200,13 +200,11 @@ def contact_base_m(run: Run, radius_m: float | None = None) -> dict[str, float]:
     the design pose first) and the tyre radius ``radius_m`` (default: that of the run's vehicle):
     contact = centre − r × the wheel plane's up direction. InputError for a run without a vehicle
     (a rig recording) and no radius given."""
-    try:
-        radius = float(Document(run.metadata.vehicle_yaml, str(run.path)).data["tyre"]["radius"]) \
-            if radius_m is None else float(radius_m)
-    except (TypeError, KeyError, ValueError) as exc:  # an InputError (not YAML) is a ValueError
+    radius = tyre_radius_m(run) if radius_m is None else float(radius_m)
+    if radius is None:
         raise InputError("roll metrics need the design contact-point base, from the tyre radius of the measured "
                          "vehicle, and a rig recording holds no vehicle: give the vehicle (Run.metrics(vehicle=...))",
-                         source=str(run.path)) from exc
+                         source=str(run.path))
     out = {}
     for axle in ("front", "rear"):
         left, right = (CORNER_TAGS[f"{axle}_{side}"] for side in ("left", "right"))
@@ -217,6 +215,14 @@ def contact_base_m(run: Run, radius_m: float | None = None) -> dict[str, float]:
     return out
 
 
+def tyre_radius_m(run: Run) -> float | None:
+    """The tyre radius [m] of the vehicle the run recorded, None for a run without one (a rig recording)."""
+    try:
+        return float(Document(run.metadata.vehicle_yaml, str(run.path)).data["tyre"]["radius"])
+    except (TypeError, KeyError, ValueError):  # an InputError (not YAML) is a ValueError
+        return None
+
+
 def _leg(run: Run, mask: np.ndarray) -> Leg:
     """The :data:`elastokin.analysis.kc_metrics.Leg` of the recorded samples ``mask``, in SI."""
     def signal(quantity: str, corner: str) -> np.ndarray:
@@ -225,16 +231,23 @@ def _leg(run: Run, mask: np.ndarray) -> Leg:
     return signal
 
 
-def case_metrics(run: Run, case: Mapping[str, Any],
-                 contact_base: Mapping[str, float] | None = None) -> dict[str, dict[str, float]]:
+def case_metrics(run: Run, case: Mapping[str, Any], contact_base: Mapping[str, float] | None = None,
+                 radius_m: float | None = None) -> dict[str, dict[str, float]]:
     """The named K&C metrics (keys, units and signs of :data:`elastokin.analysis.kc_metrics.METRICS`) that ``case``
-    gives per axle of the run: pumping → bump steer and camber and the toe and camber loop
-    widths; roll → roll steer and camber per degree of body roll; lateral force → its three
-    compliances; longitudinal force, aligning torque → their compliance steer. Empty for inputs
+    gives per axle of the run (:data:`elastokin.analysis.kc_metrics.TEST_METRICS`): pumping → bump
+    steer and camber, wheel rate, half-track change, recession and the toe and camber loop widths;
+    roll → roll steer, camber and stiffness per degree of body roll and the kinematic roll centre;
+    lateral force → its three compliances and the force roll centre; longitudinal force → its
+    compliance steer and the braking pad-force ratio; aligning torque → its compliance steer; a
+    metric the run cannot give (a roll centre without the tyre radius) left out. Empty for inputs
     without K&C metrics (rack steps, CSV) or a case without both branches recorded.
 
-    ``contact_base`` [m] per axle defines the roll angle (default: :func:`contact_base_m`).
+    ``contact_base`` [m] per axle defines the roll angle (default: :func:`contact_base_m`);
+    ``radius_m``, the tyre radius, the contact points of roll's kinematic roll centre (default:
+    the run's vehicle's; without either, that metric is left out).
     """
+    if radius_m is None:
+        radius_m = tyre_radius_m(run)
     test = KC_TESTS.get(input_kind(run))
     out: dict[str, dict[str, float]] = {}
     if test is None:
@@ -245,24 +258,25 @@ def case_metrics(run: Run, case: Mapping[str, Any],
         legs = _legs(run, case, driver)
         if legs is None:
             continue
-        if test == "roll" and contact_base is None:
-            contact_base = contact_base_m(run)
+        if contact_base is None and (test == "roll" or (test == "lateral" and radius_m is not None)):
+            contact_base = contact_base_m(run, radius_m)   # roll's angle; lateral's force roll centre
         down, up = (_leg(run, m) for m in legs)
-        base = contact_base[axle] if test == "roll" else math.nan
+        base = contact_base[axle] if contact_base is not None and test in ("roll", "lateral") else math.nan
         amplitude = float(np.abs(run.signals[driver][legs[0] | legs[1]]).max()) * units.si(run.units[driver])
         window = fit_window(test, amplitude, base)
         if test == "bump":
             window = min(window, BUMP_WINDOW_M)
         try:
-            m = triangle_metrics(test, axle, down, up, window, base)
+            m = triangle_metrics(test, axle, down, up, window, base, math.nan if radius_m is None else radius_m)
             if test == "bump":
                 m |= bump_loop_widths(axle, down, up, window)
         except KeyError:  # a rig recording may lack this axle's wheels
             continue
-        out[axle] = m
+        out[axle] = {k: v for k, v in m.items() if not math.isnan(v)}   # those the run cannot give left out
     return out
 
 
-def run_metrics(run: Run, contact_base: Mapping[str, float] | None = None) -> dict[int, dict[str, dict[str, float]]]:
+def run_metrics(run: Run, contact_base: Mapping[str, float] | None = None,
+                radius_m: float | None = None) -> dict[int, dict[str, dict[str, float]]]:
     """:func:`case_metrics` of every case, by case number (1-based)."""
-    return {case["case"]: case_metrics(run, case, contact_base) for case in cases(run)}
+    return {case["case"]: case_metrics(run, case, contact_base, radius_m) for case in cases(run)}

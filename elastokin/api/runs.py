@@ -12,7 +12,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from elastokin.analysis.road_metrics import road_metrics
-from elastokin.analysis.run_metrics import cases, contact_base_m, is_road, run_metrics
+from elastokin.analysis.run_metrics import cases, is_road, run_metrics
 from elastokin.api.vehicles import Vehicle
 from elastokin.core.units import in_si
 from elastokin.presentation.run_plots import pair_figures, time_figures
@@ -159,7 +159,8 @@ class Run:
 
         Args:
             vehicle: the car a rig recording measured: its tyre radius gives the design
-                contact-point base that defines the roll angle (a simulated run carries its own).
+                contact-point base that defines the roll angle and the contact points of the
+                roll centres (a simulated run carries its own).
 
         Returns:
             On the road, ``{case: {metric: value}}`` (ISO 7401 / 4138 definitions,
@@ -172,15 +173,16 @@ class Run:
         """
         if is_road(self.recorded):
             return _plain(road_metrics(self.recorded))
-        return _plain(run_metrics(self.recorded, self._contact_base(vehicle)))
+        return _plain(run_metrics(self.recorded, radius_m=self._radius(vehicle)))
 
     def summary(self, vehicle: Vehicle | None = None) -> str:
         """The text summary ``vsim run`` prints (gradients, loop widths, metrics, peak deflections);
         ``vehicle`` as for :meth:`metrics`."""
-        return summary(self.recorded, self._contact_base(vehicle))
+        return summary(self.recorded, self._radius(vehicle))
 
-    def _contact_base(self, vehicle: Vehicle | None) -> dict[str, float] | None:
-        return None if vehicle is None else contact_base_m(self.recorded, vehicle.definition.tyre.radius)
+    @staticmethod
+    def _radius(vehicle: Vehicle | None) -> float | None:
+        return None if vehicle is None else vehicle.definition.tyre.radius
 
     def plot(self, what: str = "pairs", *, log_time: bool = False, t0_s: float = 0.0) -> dict[str, Figure]:
         """Matplotlib figures of the run, in the recording's units (as ``vsim plot`` draws them).

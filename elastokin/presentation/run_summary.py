@@ -50,8 +50,8 @@ def _loop_table(run: Run) -> list[str]:
     return rows
 
 
-def _kc_table(run: Run, contact_base: Mapping[str, float] | None) -> list[str]:
-    metrics = run_metrics(run, contact_base)
+def _kc_table(run: Run, radius_m: float | None) -> list[str]:
+    metrics = run_metrics(run, radius_m=radius_m)
     labels = {case["case"]: case["label"][:16] for case in cases(run)}
     keys = [(key, unit) for key, unit, _ in METRICS if any(key in m for c in metrics.values() for m in c.values())]
     if not keys:
@@ -114,9 +114,9 @@ def _peak_table(run: Run) -> list[str]:
     return rows
 
 
-def summary(run: Run, contact_base: Mapping[str, float] | None = None) -> str:
-    """The text summary of a recorded run (simulated, or measured on a rig: its roll metrics need
-    the design ``contact_base`` [m] per axle, :func:`elastokin.analysis.run_metrics.contact_base_m`)."""
+def summary(run: Run, radius_m: float | None = None) -> str:
+    """The text summary of a recorded run (simulated, or measured on a rig: its roll and roll-centre
+    metrics need the measured car's tyre radius ``radius_m`` [m], which a simulated run carries)."""
     extra = run.metadata.extra
     status = "complete" if run.complete else f"INCOMPLETE ({run.reason})"
     origin = f"bushings: {extra['bushing_model']}" if "bushing_model" in extra else "measured on a rig"
@@ -130,7 +130,7 @@ def summary(run: Run, contact_base: Mapping[str, float] | None = None) -> str:
     if is_road(run):
         lines += _road_table(run)
     elif extra["x_quantity"] is not None:
-        lines += _loop_table(run) + _kc_table(run, contact_base)
+        lines += _loop_table(run) + _kc_table(run, radius_m)
     else:
         lines += _drift_table(run)
     return "\n".join(lines + _peak_table(run))

@@ -106,6 +106,13 @@ def _checked(v: VehicleDefinition, axle: str, preload: float) -> float:
     return float(preload)
 
 
+def cg_height(v: VehicleDefinition) -> float:
+    """Height of the whole car's centre of mass (body and every part of the axles and wheels)
+    above the ground at design [m]."""
+    bodies, total, _ = _masses(v)
+    return sum(mass * com[2] for mass, com in bodies.values()) / total
+
+
 def axle_loads(v: VehicleDefinition) -> tuple[float, float, float]:
     """(total weight, front axle load, rear axle load) [N] of the model built from ``v``."""
     _, total, x_cg = _masses(v)

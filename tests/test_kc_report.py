@@ -1,0 +1,156 @@
+"""The K&C report's rates, roll centres and anti-pitch against closed forms and independent
+computations on the default car (spec vehicle.md §4; the definitions in
+elastokin.analysis.kc_metrics.METRICS): the springs and the bar enter the wheel rate and the roll
+stiffness through their motion ratio squared, the roll centre found by the lateral-force test is the
+one the roll test's kinematics give, and the trailing arm's recession and anti-lift follow from its
+pivot's place."""
+
+from __future__ import annotations
+
+import math
+import os
+
+import numpy as np
+import pytest
+
+from elastokin.analysis.kc_metrics import fit_window, triangle_metrics
+from elastokin.analysis.kc_test import car_figures, rig_leg, vehicle_kc
+from elastokin.analysis.loops import Branches, centre_slope
+from elastokin.core.shipped import DEFAULT_VEHICLE
+from elastokin.tyres.magic_formula import coefficients
+from elastokin.tyres.tir_file import read_tir
+from elastokin.vehicle.model.vehicle_file import load_vehicle
+from elastokin.vehicle.scenarios.kc_tests import TEST
+from elastokin.vehicle.simulation.kc_triangles import design_contact_base, run_triangle
+from elastokin.vehicle.simulation.rig import KCRig
+
+SEED = int(os.environ.get("VSIM_TEST_SEED", "0"))
+SPRINGS = {"front": ("front_left_spring", "front_right_spring"), "rear": ("rear_spring_left", "rear_spring_right")}
+
+
+def vehicle_with(tmp_path, name: str, replacements: dict[str, str]):
+    """The default car with its file's text replaced (each old text must be there once)."""
+    text = DEFAULT_VEHICLE.read_text()
+    for old, new in replacements.items():
+        assert text.count(old) == 1, old
+        text = text.replace(old, new)
+    path = tmp_path / f"{name}.yaml"
+    path.write_text(text)
+    return load_vehicle(path)
+
+
+def metrics_of(rig: KCRig, test: str) -> tuple[dict[str, dict[str, float]], tuple]:
+    """(per axle, ``test``'s metrics; its (down, up) samples) on ``rig``."""
+    down, up = run_triangle(rig, TEST[test])
+    base = design_contact_base(rig)
+    return ({axle: triangle_metrics(test, axle, rig_leg(down), rig_leg(up),
+                                    fit_window(test, TEST[test].amplitude, base[axle]), base[axle],
+                                    rig.vehicle.tyre.radius) for axle in base}, (down, up))
+
+
+def spring_ratio(samples: tuple, spring: str, x, rate: float, window: float) -> float:
+    """A spring's compression per unit of ``x(sample)``, from its force [N] and rate [N/m]."""
+    down, up = samples
+    b = Branches(np.array([x(o) for o in down]), np.array([o.spring_force[spring] for o in down]) / rate,
+                 np.array([x(o) for o in up]), np.array([o.spring_force[spring] for o in up]) / rate)
+    return centre_slope(b, window)
+
+
+@pytest.fixture(scope="module")
+def default_rig():
+    return KCRig(load_vehicle(DEFAULT_VEHICLE))
+
+
+def test_springs_and_bar_enter_wheel_rate_and_roll_stiffness_by_their_motion_ratio_squared(tmp_path, default_rig):
+    """Springs ×1.5 and the bar ×2: the wheel rate gains Δk·MR², the roll stiffness Δk·MR²·t²/2
+    from the springs plus Δk_bar·MR²·t² from the bar (a tendon of left-minus-right strut length),
+    with MR each spring's compression per metre of wheel travel (bump) or of pad height (roll)
+    read from its own force, t the contact base; the bar leaves the wheel rate alone."""
+    v = default_rig.vehicle
+    stiffer = KCRig(vehicle_with(tmp_path, "stiffer", {"rate: 28000.0": "rate: 42000.0",
+                                                        "rate: 36000.0": "rate: 54000.0",
+                                                        "rate: 10000.0": "rate: 20000.0"}))
+    base = design_contact_base(default_rig)
+    bump0, bump_samples = metrics_of(default_rig, "bump")
+    roll0, roll_samples = metrics_of(default_rig, "roll")
+    bump1, _ = metrics_of(stiffer, "bump")
+    roll1, _ = metrics_of(stiffer, "roll")
+    window = fit_window("bump", TEST["bump"].amplitude, math.nan)
+    for axle, k in (("front", v.front.spring.rate), ("rear", v.rear.spring.rate)):
+        left, right = SPRINGS[axle]
+        mr = spring_ratio(bump_samples, left, lambda o: o.wheels[f"{axle}_left"].travel, k, window)
+        assert 0.5 < mr < 1.2, mr   # a strut or a spring on the arm
+        gain = 1e-3 * 0.5 * k * mr ** 2   # Δk = k/2 [N/mm]
+        assert bump1[axle]["wheel_rate_n_per_mm"] - bump0[axle]["wheel_rate_n_per_mm"] == pytest.approx(gain, rel=0.01)
+        # roll: right pads up; each spring's compression per metre of its own pad
+        mr_roll = 0.5 * (spring_ratio(roll_samples, right, lambda o: o.wheels[f"{axle}_right"].pad_height, k, window)
+                         + spring_ratio(roll_samples, left, lambda o: o.wheels[f"{axle}_left"].pad_height, k, window))
+        per_rad = 0.5 * k * mr_roll ** 2 * base[axle] ** 2 / 2
+        if axle == "front":   # the bar acts on the strut's length, the spring's axis
+            per_rad += v.front.anti_roll_rate * mr_roll ** 2 * base[axle] ** 2
+        assert (roll1[axle]["roll_stiffness_nm_per_deg"] - roll0[axle]["roll_stiffness_nm_per_deg"]
+                == pytest.approx(math.radians(per_rad), rel=0.01)), axle
+    # the bar alone: the wheel rate in bump as without it
+    bar_only = KCRig(vehicle_with(tmp_path, "bar", {"rate: 10000.0": "rate: 20000.0"}))
+    bump2, _ = metrics_of(bar_only, "bump")
+    assert bump2["front"]["wheel_rate_n_per_mm"] == pytest.approx(bump0["front"]["wheel_rate_n_per_mm"], rel=1e-3)
+
+
+def test_the_force_and_kinematic_roll_centres_agree(default_rig):
+    """The lateral-force test's roll centre (where the ground forces' resultant crosses the centre
+    plane) is the roll test's (the contact points' common lateral motion per radian of roll), by
+    virtual work on a linkage whose joints do no work; on the independent front it is also the
+    instant-centre construction from the bump test: h = t/2 × the contact point's outward motion per
+    metre of bump, the wheel centre's half-track change less r × the camber gain."""
+    roll, _ = metrics_of(default_rig, "roll")
+    lateral, _ = metrics_of(default_rig, "lateral")
+    bump, _ = metrics_of(default_rig, "bump")
+    base, r = design_contact_base(default_rig), default_rig.vehicle.tyre.radius
+    for axle in ("front", "rear"):
+        kinematic, force = roll[axle]["roll_centre_height_kinematic_mm"], lateral[axle]["roll_centre_height_force_mm"]
+        assert 20.0 < kinematic < 300.0, (axle, kinematic)   # above the ground, below the wheel centres' 303 mm
+        assert force == pytest.approx(kinematic, abs=3.0), axle   # the bushings' compliance: 1.4 mm here
+    outward = bump["front"]["half_track_change_mm_per_m"] * 1e-3 - r * math.radians(bump["front"]["bump_camber_deg_per_m"])
+    assert 1e3 * base["front"] / 2 * outward == pytest.approx(roll["front"]["roll_centre_height_kinematic_mm"], abs=3.0)
+
+
+def test_the_trailing_arm_recession_and_anti_lift_follow_its_pivot(tmp_path):
+    """In parallel bump the twist beam turns about its arms' pivots: the wheel centre recedes by
+    (z_c − z_p)/(x_c − x_p) per metre of bump; braking at the contact point with the pads held, the
+    arm's moment about its pivot gives the pad ΔFz = −z_p/(x_p − x_c) per N of braking force, the
+    side-view tan θ, and an anti-lift of tan θ·L/h. The pivot is drawn from the seed."""
+    rng = np.random.default_rng(SEED)
+    dz = float(rng.uniform(-0.030, 0.030))
+    pivot = load_vehicle(DEFAULT_VEHICLE).rear.hardpoints["arm_pivot"]
+    moved = (pivot[0], pivot[1], round(pivot[2] + dz, 4))
+    old = f"arm_pivot:           [{pivot[0]:.3f}, {pivot[1]:.3f}, {pivot[2]:.3f}]"
+    v = vehicle_with(tmp_path, "pivot", {old: f"arm_pivot:           [{moved[0]:.3f}, {moved[1]:.3f}, {moved[2]:.4f}]"})
+    rig = KCRig(v)
+    bump, _ = metrics_of(rig, "bump")
+    braking, _ = metrics_of(rig, "longitudinal")
+    (xc, _, zc), (xp, _, zp) = v.rear.hardpoints["wheel_centre"], v.rear.hardpoints["arm_pivot"]
+    assert bump["rear"]["wheel_recession_mm_per_m"] == pytest.approx(1e3 * (zc - zp) / (xc - xp), rel=0.02)
+    tan_theta = -zp / (xp - xc)
+    assert braking["rear"]["braking_pad_fz_ratio"] == pytest.approx(tan_theta, rel=0.015)
+    car = car_figures(v)
+    assert car.wheelbase_m == pytest.approx(2.608)
+    # the whole car's centre of mass: under the body's (543 mm), lowered by the wheels and axles
+    assert 0.50 < car.cg_height_m < 0.543
+    assert car.tyre_vertical_stiffness_n_per_m == coefficients(read_tir(v.tyre.property_file))["VERTICAL_STIFFNESS"]
+
+
+def test_the_car_level_metrics_of_vsim_kc():
+    """Shares add up to 100 %; the ride rate is the wheel rate in series with the tyre; anti-dive
+    and anti-lift are the braking ratios scaled by L/h with their signs (a rear arm pulling its
+    wheel up under braking holds the tail down)."""
+    v = load_vehicle(DEFAULT_VEHICLE)
+    m, car = vehicle_kc(v), car_figures(v)
+    assert m["front"]["roll_stiffness_share_pct"] + m["rear"]["roll_stiffness_share_pct"] == pytest.approx(100.0)
+    kt = car.tyre_vertical_stiffness_n_per_m * 1e-3
+    for axle in ("front", "rear"):
+        kw = m[axle]["wheel_rate_n_per_mm"]
+        assert m[axle]["ride_rate_n_per_mm"] == pytest.approx(kw * kt / (kw + kt), rel=1e-12)
+        assert m[axle]["ride_rate_n_per_mm"] < kw
+    assert m["rear"]["braking_pad_fz_ratio"] < 0 < m["rear"]["braking_anti_pitch_pct"]
+    assert m["front"]["braking_anti_pitch_pct"] == pytest.approx(
+        100 * m["front"]["braking_pad_fz_ratio"] * car.wheelbase_m / car.cg_height_m, rel=1e-12)
