@@ -13,14 +13,15 @@ import os
 import numpy as np
 import pytest
 
-from elastokin.analysis.kc_metrics import fit_window, triangle_metrics
+from elastokin.analysis.kc_metrics import CarFigures, fit_window, steering_metrics, triangle_metrics
 from elastokin.analysis.kc_test import car_figures, rig_leg, vehicle_kc
 from elastokin.analysis.loops import Branches, centre_slope
 from elastokin.core.shipped import DEFAULT_VEHICLE
 from elastokin.tyres.magic_formula import coefficients
 from elastokin.tyres.tir_file import read_tir
+from elastokin.vehicle.model.geometry import contact_point
 from elastokin.vehicle.model.vehicle_file import load_vehicle
-from elastokin.vehicle.scenarios.kc_tests import TEST
+from elastokin.vehicle.scenarios.kc_tests import STEERING, TEST, triangle_input
 from elastokin.vehicle.simulation.kc_triangles import design_contact_base, run_triangle
 from elastokin.vehicle.simulation.rig import KCRig
 
@@ -154,3 +155,66 @@ def test_the_car_level_metrics_of_vsim_kc():
     assert m["rear"]["braking_pad_fz_ratio"] < 0 < m["rear"]["braking_anti_pitch_pct"]
     assert m["front"]["braking_anti_pitch_pct"] == pytest.approx(
         100 * m["front"]["braking_pad_fz_ratio"] * car.wheelbase_m / car.cg_height_m, rel=1e-12)
+
+
+def test_the_front_wheels_steer_about_the_axis_their_hardpoints_give(tmp_path):
+    """The steering sweep's measured wheel motion against the design axis of `vsim kc` (lower ball
+    joint to top mount, the top mount moved fore-aft by an offset drawn from the seed): turning by δ
+    about an axis of caster τ and inclination σ, a wheel's camber goes as ±tan τ·δ + tan σ·δ²/2
+    (+ on the left) and its centre moves by (−tan σ·r_z − r_y, r_x + tan τ·r_z) per radian, with
+    r = centre − the axis's ground point."""
+    rng = np.random.default_rng(SEED + 1)
+    dx = float(rng.uniform(-0.030, 0.030))
+    top = load_vehicle(DEFAULT_VEHICLE).front.hardpoints["strut_top"]
+    old = f"strut_top:           [{top[0]:.3f}, {top[1]:.3f}, {top[2]:.3f}]"
+    v = vehicle_with(tmp_path, "caster", {old: f"strut_top:           [{top[0] + dx:.4f}, {top[1]:.3f}, {top[2]:.3f}]"})
+    design = vehicle_kc(v)["front"]
+    rig = KCRig(v)
+    down, up = run_triangle(rig, STEERING)
+    grid = np.linspace(-0.8 * STEERING.amplitude, 0.8 * STEERING.amplitude, 81)
+
+    def centre_line(corner: str, y) -> np.ndarray:
+        b = Branches(*[np.array(a) for a in (
+            [triangle_input(STEERING, o.time) for o in down], [y(o.wheels[corner]) for o in down],
+            [triangle_input(STEERING, o.time) for o in up], [y(o.wheels[corner]) for o in up])])
+        return np.mean(b.on(grid), axis=0)
+
+    f = v.front
+    contact = contact_point(f.hardpoints["wheel_centre"], f.static_toe, f.static_camber, 1.0, v.tyre.radius)
+    for corner, sign in (("front_left", 1.0), ("front_right", -1.0)):
+        steer = centre_line(corner, lambda w: w.steer)
+        camber = np.polyfit(steer, centre_line(corner, lambda w: w.camber), 3)
+        assert math.degrees(math.atan(sign * camber[2])) == pytest.approx(design["caster_deg"], abs=0.15), corner
+        assert math.degrees(math.atan(2 * camber[1])) == pytest.approx(design["kingpin_inclination_deg"], abs=0.15)
+    steer = centre_line("front_left", lambda w: w.steer)
+    vx, vy = (np.polyfit(steer, centre_line("front_left", lambda w, i=i: w.wheel_centre[i]), 3)[2] for i in (0, 1))
+    tan_caster, tan_kpi = (math.tan(math.radians(design[k])) for k in ("caster_deg", "kingpin_inclination_deg"))
+    centre = np.array(f.hardpoints["wheel_centre"])
+    rz = centre[2] - contact[2]
+    ry, rx = -vx - tan_kpi * rz, vy - tan_caster * rz
+    assert 1e3 * (contact[1] - centre[1] + ry) == pytest.approx(design["scrub_radius_mm"], abs=0.5)
+    assert 1e3 * (centre[0] - contact[0] - rx) == pytest.approx(design["mechanical_trail_mm"], abs=0.5)
+
+
+@pytest.mark.parametrize("share", [0.0, 0.5, 1.0])
+def test_ackermann_is_the_share_of_the_ideal_steer_difference(share):
+    """On legs whose outer wheel steers ``share`` of the way from parallel to Ackermann's angle
+    (cot δo − cot δi = base / wheelbase) at either end of the sweep, the metric is 100·share %;
+    the rack gain and the steering ratio are those of the mean steer's slope."""
+    base, car = 1.5, CarFigures(2.6, 0.5, None, 0.05)
+    rack = np.linspace(-STEERING.amplitude, STEERING.amplitude, 201)
+
+    def steers(r: float) -> tuple[float, float]:
+        inner = math.atan(10.0 * abs(r))   # 10 rad per m of rack at the centre
+        if inner == 0.0:
+            return 0.0, 0.0
+        outer = inner - share * (inner - math.atan(1.0 / (1.0 / math.tan(inner) + base / car.wheelbase_m)))
+        return (inner, outer) if r > 0 else (-outer, -inner)   # (left, right)
+
+    table = np.array([steers(r) for r in rack])
+    leg = lambda q, c: rack if q == "rack" else table[:, 0 if c == "front_left" else 1]
+    m = steering_metrics(leg, leg, 0.8 * STEERING.amplitude, base, car)
+    assert m["ackermann_pct"] == pytest.approx(100.0 * share, abs=0.05)
+    gain = np.polyfit(rack[np.abs(rack) <= 0.032], np.degrees(table.mean(axis=1))[np.abs(rack) <= 0.032], 1)[0]
+    assert 1e3 * m["rack_gain_deg_per_mm"] == pytest.approx(gain, rel=0.01)
+    assert m["steering_ratio"] == pytest.approx(360.0 / car.rack_travel_per_rev_m / gain, rel=0.01)

@@ -53,10 +53,23 @@ METRICS = (
                                           "crosses the centre plane under Fy (lateral test, pad heights held)"),
     ("braking_pad_fz_ratio", "N/N", "pad Fz per N of braking force (−x) at the contact point, pad heights held "
                                     "(side-view tan θ; + pushes the wheel down)"),
+    ("rack_gain_deg_per_mm", "deg/mm", "mean road-wheel steer (left +) per mm of rack (left +), steering sweep"),
+    ("steering_ratio", "-", "steering-wheel angle (the rack's travel per revolution) per road-wheel angle, "
+                            "at straight ahead"),
+    ("ackermann_pct", "%", "inner minus outer wheel's steer over that of Ackermann geometry (cot δo − cot δi = "
+                           "contact base / wheelbase) at the sweep's ±80 % rack"),
+    ("caster_deg", "deg", "steering axis (lower ball joint to top mount), its top rearward +, at design"),
+    ("kingpin_inclination_deg", "deg", "steering axis, its top inboard +, at design"),
+    ("scrub_radius_mm", "mm", "contact point's lateral offset outboard of where the axis meets the ground, at design"),
+    ("mechanical_trail_mm", "mm", "where the axis meets the ground ahead of the contact point, at design"),
     ("braking_anti_pitch_pct", "%", "front: anti-dive, rear: anti-lift (SAE J670), the share of the braking "
                                     "load transfer h/L the linkage carries, this axle braking alone at the contact "
                                     "point (outboard brakes)"),
 )
+
+#: The front axle's metrics of the steering sweep and of its steering axis at design (none for the rear).
+STEERING_METRICS = ("rack_gain_deg_per_mm", "steering_ratio", "ackermann_pct", "caster_deg", "kingpin_inclination_deg",
+                    "scrub_radius_mm", "mechanical_trail_mm")
 
 #: The metrics (keys of :data:`METRICS`) each test gives for an axle, the bump test's loop widths included.
 TEST_METRICS = {
@@ -147,6 +160,7 @@ class CarFigures:
     wheelbase_m: float
     cg_height_m: float                       #: the whole car's centre of mass above the ground at design
     tyre_vertical_stiffness_n_per_m: float | None   #: None without a tyre property file
+    rack_travel_per_rev_m: float             #: rack travel per steering-wheel revolution
 
 
 def car_metrics(axles: dict[str, dict[str, float]], car: CarFigures) -> dict[str, dict[str, float]]:
@@ -165,6 +179,25 @@ def car_metrics(axles: dict[str, dict[str, float]], car: CarFigures) -> dict[str
             extra["ride_rate_n_per_mm"] = 1.0 / (1.0 / m["wheel_rate_n_per_mm"] + 1.0 / tyre)
         out[axle] = m | extra
     return out
+
+
+def steering_metrics(down: Leg, up: Leg, window: float, base: float, car: CarFigures) -> dict[str, float]:
+    """The front axle's rack gain, steering ratio and Ackermann (:data:`METRICS`) from the steering
+    sweep's legs (their ``rack`` quantity: the rack displacement [m], any corner), fitted over
+    ±``window`` [m of rack]; ``base`` [m] is the front contact base."""
+    L, R = "front_left", "front_right"
+    branches = lambda y: Branches(down("rack", L), y(down), up("rack", L), y(up))
+    gain = centre_slope(branches(lambda g: np.degrees(0.5 * (g("steer", L) + g("steer", R)))), window)  # deg/m
+    ends = np.array([-window, window])
+    left, right = (np.mean(branches(lambda g, c=c: g("steer", c)).on(ends), axis=0) for c in (L, R))
+    ratios = []
+    for i in range(2):   # each end: the inner wheel is on the side the car turns to
+        inner, outer = (left[i], right[i]) if left[i] + right[i] > 0 else (-right[i], -left[i])
+        ackermann_outer = math.atan(1.0 / (1.0 / math.tan(inner) + base / car.wheelbase_m))
+        ratios.append((inner - outer) / (inner - ackermann_outer))
+    return {"rack_gain_deg_per_mm": 1e-3 * gain,
+            "steering_ratio": 360.0 / car.rack_travel_per_rev_m / gain,
+            "ackermann_pct": 100.0 * float(np.mean(ratios))}
 
 
 def bump_loop_widths(axle: str, down: Leg, up: Leg, window: float) -> dict[str, float]:

@@ -3,6 +3,7 @@ turned into the legs the metric definitions read."""
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Callable
 
 import numpy as np
@@ -11,11 +12,13 @@ from elastokin.vehicle.model.definition import VehicleDefinition
 from elastokin.vehicle.model.elements import BuildOptions
 from elastokin.vehicle.model.statics import cg_height
 from elastokin.vehicle.scenarios.channels import AXLES
-from elastokin.vehicle.scenarios.kc_tests import TEST, TESTS
+from elastokin.vehicle.model.steering_axis import steering_axis
+from elastokin.vehicle.scenarios.kc_tests import STEERING, TEST, TESTS, Triangle, triangle_input
 from elastokin.vehicle.simulation.kc_triangles import design_contact_base, run_triangle
 from elastokin.vehicle.simulation.outputs import RigOutputs, WheelOutputs
 from elastokin.vehicle.simulation.rig import KCRig
-from elastokin.analysis.kc_metrics import CarFigures, Leg, bump_loop_widths, car_metrics, fit_window, triangle_metrics
+from elastokin.analysis.kc_metrics import (CarFigures, Leg, bump_loop_widths, car_metrics, fit_window, steering_metrics,
+                                          triangle_metrics)
 from elastokin.tyres.magic_formula import coefficients
 from elastokin.tyres.tir_file import read_tir
 from elastokin.analysis.loops import Branches
@@ -30,9 +33,14 @@ WHEEL_QUANTITIES: dict[str, Callable[[WheelOutputs], float]] = {
 }
 
 
-def rig_leg(samples: list[RigOutputs]) -> Leg:
-    """The :data:`Leg` of samples measured on the rig."""
-    return lambda quantity, corner: np.array([WHEEL_QUANTITIES[quantity](o.wheels[corner]) for o in samples])
+def rig_leg(samples: list[RigOutputs], test: Triangle | None = None) -> Leg:
+    """The :data:`Leg` of samples measured on the rig; with the ``test`` that made them, its input
+    as quantity ``rack`` (the rack displacement [m], at the samples' times)."""
+    def leg(quantity: str, corner: str) -> np.ndarray:
+        if quantity == "rack" and test is not None:
+            return np.array([triangle_input(test, o.time) for o in samples])
+        return np.array([WHEEL_QUANTITIES[quantity](o.wheels[corner]) for o in samples])
+    return leg
 
 
 def branches(down: list[RigOutputs], up: list[RigOutputs], x, y) -> Branches:
@@ -52,8 +60,12 @@ def kc_metrics(rig: KCRig) -> dict[str, dict[str, float]]:
             m |= triangle_metrics(t.name, axle, *legs[t.name], fit_window(t.name, t.amplitude, base[axle]),
                                   base[axle], radius)
         out[axle] = m | bump_loop_widths(axle, *legs["bump"], fit_window("bump", TEST["bump"].amplitude, base[axle]))
+    car = car_figures(rig.vehicle)
+    sweep = [rig_leg(samples, STEERING) for samples in run_triangle(rig, STEERING)]
+    out["front"] |= (steering_metrics(*sweep, fit_window("steering", STEERING.amplitude, base["front"]), base["front"], car)
+                     | dataclasses.asdict(steering_axis(rig.vehicle)))
     rig.reset()
-    return car_metrics(out, car_figures(rig.vehicle))
+    return car_metrics(out, car)
 
 
 def car_figures(vehicle: VehicleDefinition) -> CarFigures:
@@ -62,7 +74,8 @@ def car_figures(vehicle: VehicleDefinition) -> CarFigures:
     tyre = vehicle.tyre.property_file
     return CarFigures(vehicle.front.hardpoints["wheel_centre"][0] - vehicle.rear.hardpoints["wheel_centre"][0],
                       cg_height(vehicle),
-                      None if tyre is None else float(coefficients(read_tir(tyre))["VERTICAL_STIFFNESS"]))
+                      None if tyre is None else float(coefficients(read_tir(tyre))["VERTICAL_STIFFNESS"]),
+                      vehicle.front.rack_travel_per_rev)
 
 
 def vehicle_kc(vehicle: VehicleDefinition, options: BuildOptions = BuildOptions()) -> dict[str, dict[str, float]]:

@@ -1,1 +1,1 @@
-"""The vehicle model: the vehicle file and its values set by place, its MuJoCo model (MjSpec), rigid kinematics and static preloads."""
+"""The vehicle model: the vehicle file and its values set by place, its MuJoCo model (MjSpec), rigid kinematics, static preloads and the steering axis."""

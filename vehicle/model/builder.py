@@ -39,7 +39,8 @@ import numpy as np
 from elastokin.bushings.effects import NO_EFFECTS
 from elastokin.vehicle.model.definition import DIRECTIONS, SIDES, BushingDef, Spring, VehicleDefinition
 from elastokin.vehicle.model.elements import BuildOptions, Channel, CrossTerm, Element, joint_stiffness
-from elastokin.vehicle.model.geometry import frame_from, mirror, mirror_axes, mirror_signs, mirrored_law, wheel_axis
+from elastokin.vehicle.model.geometry import (contact_point, frame_from, mirror, mirror_axes, mirror_signs, mirrored_law,
+                                             wheel_axis)
 from elastokin.core.errors import InputError
 
 #: Stiffness of a "rigid" bushing translation [N/m] (kinematics mode).
@@ -382,8 +383,7 @@ class _Builder:
         self.bodies[name].add_geom(type=mujoco.mjtGeom.mjGEOM_CYLINDER, size=[t.radius, 0.095, 0],
                                    quat=_quat(frame_from(np.array([0, 1.0, 0]), np.array([1.0, 0, 0]))),
                                    rgba=[0.1, 0.1, 0.1, 0.6], **_NO_COLLISION)
-        up = np.array([0, 0, 1.0]) - spin_left * spin_left[2]
-        contact = np.asarray(centre) - t.radius * up / np.linalg.norm(up)
+        contact = contact_point(centre, toe, camber, sign, t.radius)
         self.site(name, f"contact_{corner}", contact)
         self.site(name, f"centre_{corner}", centre)
         names = {"wheel": name, "contact_site": f"contact_{corner}", "centre_site": f"centre_{corner}"}

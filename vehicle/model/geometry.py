@@ -68,6 +68,15 @@ def wheel_axis(toe: float, camber: float, sign: float) -> np.ndarray:
                      -math.sin(camber)])
 
 
+def contact_point(centre, toe: float, camber: float, sign: float, radius: float) -> np.ndarray:
+    """Where a wheel of ``radius`` [m] at ``centre`` [m] with toe-in ``toe`` and camber ``camber``
+    [rad] (side ``sign``: +1 left) touches the ground: the centre less the radius along the wheel
+    plane's up direction [m]."""
+    spin_left = sign * wheel_axis(toe, camber, sign)
+    up = np.array([0, 0, 1.0]) - spin_left * spin_left[2]
+    return np.asarray(centre, float) - radius * up / np.linalg.norm(up)
+
+
 def frame_from(primary: np.ndarray, secondary: np.ndarray, order: str = "zx") -> np.ndarray:
     """Rotation matrix (columns = local axes in world) with ``order[0]`` along ``primary``."""
     a = primary / np.linalg.norm(primary)

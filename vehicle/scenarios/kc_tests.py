@@ -13,7 +13,10 @@ roll      pads in opposite phase, right up         25 mm         25 mm/s        
 lateral   Fy at the contact points, +y (left)      2 kN/wheel    2 kN/s                  5 s
 longit.   Fx at the contact points, −x (braking)   1.5 kN/wheel  2 kN/s                  3.75 s
 aligning  Mz about the vertical, +z (to the left)  150 N·m       200 N·m/s               3.75 s
+steering  rack displacement, +y (to the left)      40 mm         40 mm/s                 4.5 s
 ========  ======================================  ============  ======================  =========
+
+The steering sweep (:data:`STEERING`) runs on the front axle's rack alone, pads held at design.
 """
 
 from __future__ import annotations
@@ -29,8 +32,8 @@ class Triangle:
     """One quasi-static triangle applied to all four wheels."""
 
     name: str
-    input: str               #: ``pads``, ``fx``, ``fy`` or ``mz`` (see :meth:`elastokin.vehicle.simulation.rig.KCRig.ramp`)
-    pattern: tuple[float, float, float, float]   #: per corner (order of CORNERS), times the amplitude
+    input: str               #: ``pads``, ``fx``, ``fy``, ``mz`` or ``rack`` (see :meth:`elastokin.vehicle.simulation.rig.KCRig.ramp`)
+    pattern: tuple[float, float, float, float]   #: per corner (order of CORNERS), times the amplitude; the rack: its first
     amplitude: float         #: [m, N or N·m]
     rate: float              #: [m/s, N/s or N·m/s]
 
@@ -43,4 +46,19 @@ TESTS = (
     Triangle("aligning", "mz", (1, 1, 1, 1), 150.0, 200.0),
 )
 TEST = {t.name: t for t in TESTS}   #: the tests by name
+STEERING = Triangle("steering", "rack", (1, 0, 0, 0), 0.040, 0.040)   #: the rack sweep
+
+
+def triangle_input(test: Triangle, t: float) -> float:
+    """``test``'s input [m, N or N·m; times each corner's pattern] at ``t`` [s] from the test's
+    start (the rig's reset): held at zero for :data:`SETTLE`, then 0 → +A → −A → +A."""
+    leg = test.amplitude / test.rate
+    s = t - SETTLE
+    if s <= 0.0:
+        return 0.0
+    if s <= leg:
+        return test.amplitude * s / leg
+    if s <= 3 * leg:
+        return test.amplitude * (1.0 - (s - leg) / leg)
+    return test.amplitude * (-1.0 + (s - 3 * leg) / leg)
 

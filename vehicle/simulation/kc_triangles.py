@@ -18,6 +18,8 @@ def run_triangle(rig: KCRig, test: Triangle) -> tuple[list[RigOutputs], list[Rig
     rig.settle(SETTLE)
     peak = test.amplitude * np.asarray(test.pattern, float)
     zero = np.zeros(4)
+    if test.input == "rack":
+        peak, zero = peak[0], 0.0
     leg = test.amplitude / test.rate
     rig.ramp(leg, 0, **{test.input: (zero, peak)})
     down = rig.ramp(2 * leg, SAMPLES_PER_LEG, **{test.input: (peak, -peak)})

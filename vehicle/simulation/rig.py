@@ -123,20 +123,23 @@ class KCRig(MountedCar):
         """Move the pads linearly from ``start`` to ``end`` [m] in ``duration`` [s], sampling."""
         return self.ramp(duration, samples, pads=(start, end))
 
-    def ramp(self, duration: float, samples: int = 0, pads=None, fx=None, fy=None, mz=None) -> list[RigOutputs]:
+    def ramp(self, duration: float, samples: int = 0, pads=None, fx=None, fy=None, mz=None,
+             rack=None) -> list[RigOutputs]:
         """Move inputs linearly over ``duration`` [s], measuring every ⌊steps/samples⌋ steps.
 
         Each input given is a (start, end) pair of four values (order of ``CORNERS``): ``pads``
         contact-point displacements [m], ``fx``/``fy`` contact-point forces [N], ``mz`` aligning
-        torques [N·m]; inputs not given are held.
+        torques [N·m]; ``rack`` a (start, end) pair of rack displacements [m, to the left]; inputs
+        not given are held.
         """
         h = self.model.opt.timestep
         n = max(1, int(round(duration / h)))
         every = max(1, n // samples) if samples else n + 1
         groups = (pads, fx, fy, mz)
-        active = np.array([g is not None for g in groups] + [False])  # the rack is held
-        start = np.concatenate([np.zeros(4) if g is None else np.asarray(g[0], float) for g in groups] + [[0.0]])
-        end = np.concatenate([np.zeros(4) if g is None else np.asarray(g[1], float) for g in groups] + [[0.0]])
+        active = np.array([g is not None for g in groups] + [rack is not None])
+        rack_ends = (0.0, 0.0) if rack is None else (float(rack[0]), float(rack[1]))
+        start = np.concatenate([np.zeros(4) if g is None else np.asarray(g[0], float) for g in groups] + [[rack_ends[0]]])
+        end = np.concatenate([np.zeros(4) if g is None else np.asarray(g[1], float) for g in groups] + [[rack_ends[1]]])
         out = []
         done = 0
         while done < n:
