@@ -4,7 +4,7 @@ turned into the legs the metric definitions read."""
 from __future__ import annotations
 
 import dataclasses
-from typing import Callable
+from typing import Callable, Mapping
 
 import numpy as np
 
@@ -13,7 +13,7 @@ from elastokin.vehicle.model.elements import BuildOptions
 from elastokin.vehicle.model.statics import cg_height
 from elastokin.vehicle.scenarios.channels import AXLES
 from elastokin.vehicle.model.steering_axis import steering_axis
-from elastokin.vehicle.scenarios.kc_tests import STEERING, TEST, TESTS, Triangle, triangle_input
+from elastokin.vehicle.scenarios.kc_tests import STEERING, TESTS, Triangle, triangle_input
 from elastokin.vehicle.simulation.kc_triangles import design_contact_base, run_triangle
 from elastokin.vehicle.simulation.outputs import RigOutputs, WheelOutputs
 from elastokin.vehicle.simulation.rig import KCRig
@@ -49,23 +49,49 @@ def branches(down: list[RigOutputs], up: list[RigOutputs], x, y) -> Branches:
                     np.array([x(o) for o in up]), np.array([y(o) for o in up]))
 
 
-def kc_metrics(rig: KCRig) -> dict[str, dict[str, float]]:
-    """Run the K&C sequence (:data:`TESTS`) on ``rig``; metrics per axle (keys of :data:`elastokin.analysis.kc_metrics.METRICS`)."""
-    base, radius = design_contact_base(rig), rig.vehicle.tyre.radius
-    legs = {t.name: [rig_leg(samples) for samples in run_triangle(rig, t)] for t in TESTS}
-    out: dict[str, dict[str, float]] = {}
+#: Each test's (down, up) legs, by test name (:data:`TESTS` and :data:`STEERING`).
+Legs = Mapping[str, tuple[Leg, Leg]]
+#: Each test's (down, up) rig samples, by test name.
+Samples = dict[str, tuple[list[RigOutputs], list[RigOutputs]]]
+SEQUENCE = (*TESTS, STEERING)   #: the tests of `vsim kc`, in their order
+
+
+def rig_samples(rig: KCRig) -> Samples:
+    """Run the K&C sequence (:data:`SEQUENCE`) on ``rig``, each test from design with virgin bushings."""
+    out = {t.name: run_triangle(rig, t) for t in SEQUENCE}
+    rig.reset()
+    return out
+
+
+def legs_of(samples: Samples) -> dict[str, tuple[Leg, Leg]]:
+    """The :data:`Legs` of rig samples."""
+    test = {t.name: t for t in SEQUENCE}
+    return {name: (rig_leg(down, test[name]), rig_leg(up, test[name])) for name, (down, up) in samples.items()}
+
+
+def metrics_of_legs(legs: Legs, amplitude: Mapping[str, float], vehicle: VehicleDefinition,
+                    base: Mapping[str, float]) -> dict[str, dict[str, float]]:
+    """The metrics per axle (keys of :data:`elastokin.analysis.kc_metrics.METRICS`) of every test's
+    legs, fitted over ±80 % of its ``amplitude`` [m, N, N·m], for ``vehicle`` (tyre radius, car
+    figures, steering axis) with contact bases ``base`` [m]."""
+    radius, out = vehicle.tyre.radius, {}
     for axle in AXLES:
         m = {}
         for t in TESTS:
-            m |= triangle_metrics(t.name, axle, *legs[t.name], fit_window(t.name, t.amplitude, base[axle]),
+            m |= triangle_metrics(t.name, axle, *legs[t.name], fit_window(t.name, amplitude[t.name], base[axle]),
                                   base[axle], radius)
-        out[axle] = m | bump_loop_widths(axle, *legs["bump"], fit_window("bump", TEST["bump"].amplitude, base[axle]))
-    car = car_figures(rig.vehicle)
-    sweep = [rig_leg(samples, STEERING) for samples in run_triangle(rig, STEERING)]
-    out["front"] |= (steering_metrics(*sweep, fit_window("steering", STEERING.amplitude, base["front"]), base["front"], car)
-                     | dataclasses.asdict(steering_axis(rig.vehicle)))
-    rig.reset()
+        out[axle] = m | bump_loop_widths(axle, *legs["bump"], fit_window("bump", amplitude["bump"], base[axle]))
+    car = car_figures(vehicle)
+    window = fit_window(STEERING.name, amplitude[STEERING.name], base["front"])
+    out["front"] |= (steering_metrics(*legs[STEERING.name], window, base["front"], car)
+                     | dataclasses.asdict(steering_axis(vehicle)))
     return car_metrics(out, car)
+
+
+def kc_metrics(rig: KCRig) -> dict[str, dict[str, float]]:
+    """Run the K&C sequence (:data:`SEQUENCE`) on ``rig``; metrics per axle (keys of :data:`elastokin.analysis.kc_metrics.METRICS`)."""
+    return metrics_of_legs(legs_of(rig_samples(rig)), {t.name: t.amplitude for t in SEQUENCE}, rig.vehicle,
+                           design_contact_base(rig))
 
 
 def car_figures(vehicle: VehicleDefinition) -> CarFigures:
@@ -78,6 +104,13 @@ def car_figures(vehicle: VehicleDefinition) -> CarFigures:
                       vehicle.front.rack_travel_per_rev)
 
 
-def vehicle_kc(vehicle: VehicleDefinition, options: BuildOptions = BuildOptions()) -> dict[str, dict[str, float]]:
-    """K&C metrics of ``vehicle`` built with ``options`` (on a fresh rig)."""
-    return kc_metrics(KCRig(vehicle, options))
+def vehicle_kc(vehicle: VehicleDefinition, options: BuildOptions = BuildOptions(),
+               keep: Callable[[Samples], object] | None = None) -> dict[str, dict[str, float]]:
+    """K&C metrics of ``vehicle`` built with ``options`` (on a fresh rig); ``keep`` is given the
+    tests' samples (to write the curves)."""
+    rig = KCRig(vehicle, options)
+    samples = rig_samples(rig)
+    if keep is not None:
+        keep(samples)
+    return metrics_of_legs(legs_of(samples), {t.name: t.amplitude for t in SEQUENCE}, rig.vehicle,
+                           design_contact_base(rig))

@@ -10,6 +10,7 @@ from pathlib import Path
 from elastokin.core.errors import InputError
 from elastokin.core.files import atomic_output
 from elastokin.core.shipped import DEFAULT_VEHICLE
+from elastokin.analysis.kc_curves import curves_metrics, write_curves
 from elastokin.analysis.kc_test import vehicle_kc
 from elastokin.vehicle.model.definition import BUSHING_MODELS, VehicleDefinition
 from elastokin.vehicle.model.elements import BuildOptions
@@ -116,24 +117,52 @@ class Vehicle:
             raise InputError(str(exc), source=VALUES_SOURCE) from None
         return Vehicle(changed)
 
-    def kc_metrics(self, bushings: str | None = None) -> dict[str, dict[str, float]]:
+    def kc_metrics(self, bushings: str | None = None, curves: str | Path | None = None) -> dict[str, dict[str, float]]:
         """The standard K&C metrics of the car on the virtual rig (``vsim kc``): bump, roll,
-        lateral-force, longitudinal-force and aligning-torque triangles on both axles.
+        lateral-force, longitudinal-force and aligning-torque triangles on both axles, a rack
+        sweep, and the steering axis at design.
 
         Args:
             bushings: one bushing model on every direction (``linear``, ``sts``, ``rt``, ``stvs``);
                 None: as the vehicle file says.
+            curves: a folder to write the curves behind the metrics in, one CSV per test as a K&C
+                rig delivers them (:mod:`elastokin.analysis.kc_curves`); None: not written.
 
         Returns:
             ``{"front": {metric: value}, "rear": {...}}``, the unit in each metric's name
             (``bump_camber_deg_per_m``; ISO 8855 signs: toe-in and camber top-out positive;
-            definitions in :data:`elastokin.analysis.kc_metrics.METRICS`).
+            definitions in :data:`elastokin.analysis.kc_metrics.METRICS`; the steering's on the
+            front only).
 
         Raises:
             InputError: an unknown bushing model.
         """
         check_bushing_model(bushings)
-        return vehicle_kc(self.definition, BuildOptions(bushing_model=bushings))
+        options = BuildOptions(bushing_model=bushings)
+        if curves is None:
+            return vehicle_kc(self.definition, options)
+        return vehicle_kc(self.definition, options, lambda samples: write_curves(Path(curves), samples))
+
+    def compare_kc(self, curves: str | Path, bushings: str | None = None) -> dict[str, dict[str, dict[str, float]]]:
+        """The K&C metrics of curves measured on this car by a rig, beside the simulated car's.
+
+        Args:
+            curves: a folder of one CSV per test in the layout of ``vsim kc --curves``
+                (:mod:`elastokin.analysis.kc_curves`).
+            bushings: as for :meth:`kc_metrics`, for the simulated car.
+
+        Returns:
+            ``{axle: {metric: {"sim": value, "rig": value, "difference": rig − sim}}}`` for every
+            metric both give (units in the names, :data:`elastokin.analysis.kc_metrics.METRICS`).
+
+        Raises:
+            InputError: a missing curve file or column, a non-number, a test without both legs,
+                an unknown bushing model.
+        """
+        rig = curves_metrics(Path(curves), self.definition)
+        sim = self.kc_metrics(bushings)
+        return {axle: {key: {"sim": sim[axle][key], "rig": value, "difference": value - sim[axle][key]}
+                       for key, value in rig[axle].items() if key in sim[axle]} for axle in sim}
 
     def save(self, path: str | Path, *, overwrite: bool = False) -> Path:
         """Write the vehicle file (as changed) to ``path``; its relative references (the tyre's

@@ -61,3 +61,15 @@ def add_strict_option(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--strict", action="store_true",
                         help="refuse a damaged recording (cut short, a chunk failing its CRC) instead of reading it "
                              "as far as it goes with a warning")
+
+
+def add_vehicle_options(parser: argparse.ArgumentParser, scope: str = "") -> None:
+    """``--vehicle`` (a file or a built-in name) and ``--bushing-model`` (one model on every
+    bushing direction); ``scope`` prefixes their help (``with --kc: ``)."""
+    from elastokin.core.shipped import DEFAULT_VEHICLE
+    from elastokin.vehicle.model.definition import BUSHING_MODELS
+
+    parser.add_argument("--vehicle", default=DEFAULT_VEHICLE.stem, metavar="VEHICLE",
+                        help=f"{scope}vehicle file, or the name of a built-in one (default: %(default)s)")
+    parser.add_argument("--bushing-model", choices=BUSHING_MODELS, default=None,
+                        help=f"{scope}put this model on every bushing direction (models/vehicles/README.md)")

@@ -1,11 +1,14 @@
-"""`vsim compare SIM.mcap RIG.mcap [-o DIR]`: a simulated run against a measured rig recording."""
+"""`vsim compare SIM.mcap RIG.mcap [-o DIR]`: a simulated run against a measured rig recording;
+`vsim compare --kc DIR [--vehicle VEHICLE]`: a rig's K&C curves' metrics beside `vsim kc`'s."""
 
 from __future__ import annotations
 
 import argparse
+import json
 from pathlib import Path
 
-from elastokin.cli.arguments import add_strict_option, output_folder
+from elastokin.cli.arguments import add_strict_option, add_vehicle_options, output_folder
+from elastokin.core.errors import InputError
 
 
 def _compare(args: argparse.Namespace) -> int:
@@ -13,12 +16,25 @@ def _compare(args: argparse.Namespace) -> int:
     from elastokin.presentation.comparison_report import format_table, write_outputs
     from elastokin.recordings.run_reader import load_run
 
+    if args.kc is not None:
+        return _compare_kc(args)
+    if args.sim is None or args.rig is None:
+        raise InputError("give SIM.mcap and RIG.mcap, or --kc DIR (a rig's K&C curves)", source="vsim compare")
     sim, rig = load_run(args.sim, strict=args.strict), load_run(args.rig, strict=args.strict)
     comparison = compare_runs(sim, rig)
     print(format_table(comparison))
     if args.output is not None:
         written = write_outputs(comparison, sim, rig, args.output)
         print(f"wrote {written[0]} and {len(written) - 1} PNG(s) in {args.output}")
+    return 0
+
+
+def _compare_kc(args: argparse.Namespace) -> int:
+    from elastokin.api.vehicles import load_vehicle
+    from elastokin.presentation.kc_table import format_comparison
+
+    comparison = load_vehicle(args.vehicle).compare_kc(args.kc, args.bushing_model)
+    print(json.dumps(comparison, indent=2) if args.json else format_comparison(comparison))
     return 0
 
 
@@ -30,8 +46,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                     "force of each wheel in both files): gradient, loop width at design, loop area, RMS error, "
                     "relaxation over a final hold and first-harmonic dynamic stiffness for sine inputs; "
                     "simulation, rig and their difference (elastokin/analysis/compare.py).")
-    compare.add_argument("sim", type=Path, metavar="SIM.mcap", help="simulated run (vsim run)")
-    compare.add_argument("rig", type=Path, metavar="RIG.mcap", help="measured rig recording of the same scenario")
+    compare.add_argument("sim", type=Path, metavar="SIM.mcap", nargs="?", help="simulated run (vsim run)")
+    compare.add_argument("rig", type=Path, metavar="RIG.mcap", nargs="?",
+                         help="measured rig recording of the same scenario")
+    compare.add_argument("--kc", type=Path, metavar="DIR", default=None,
+                         help="instead: a rig's K&C curves (one CSV per test, as vsim kc --curves writes them), "
+                              "their metrics beside vsim kc's of --vehicle")
+    add_vehicle_options(compare, "with --kc, the car measured and simulated: ")
+    compare.add_argument("--json", action="store_true", help="with --kc: the table as JSON")
     compare.add_argument("-o", "--output", type=output_folder, metavar="DIR",
                          help="also write DIR/comparison.json and loop and time-history overlays (PNG)")
     add_strict_option(compare)
