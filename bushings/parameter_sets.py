@@ -11,7 +11,7 @@ from typing import Any, Mapping
 
 
 from elastokin.bushings.effects import Effects, effects_to_si
-from elastokin.bushings.parameters import MODELS, ChannelParams, model_keys, to_si
+from elastokin.bushings.parameters import MODELS, ChannelParams, check_one_elastic_law, model_keys, to_si
 from elastokin.core.documents import Document, dump_yaml
 from elastokin.core.errors import InputError
 from elastokin.core.files import atomic_output, is_file, read_text
@@ -44,6 +44,7 @@ class ParameterSet:
         """
         target = model or self.model
         values = dict(self.values)
+        check_one_elastic_law(self.model, values, str(self.path or self.name))   # before another model drops one
         if target != self.model:
             if target in ("sts_continuous", "stsn") and "Ct" not in values and {"Ff", "Kr"} <= set(values):
                 values["Ct"] = 2.0 * values["Ff"] * values["Kr"]

@@ -61,11 +61,19 @@ MAX_CURVE_POINTS = 1000
 CURVE_ELASTIC = ("sts", "sts_continuous", "stsn", "rt", "stvs", "tvs")
 
 
-def model_keys(model: str, values: Mapping[str, Any] = {}) -> tuple[tuple[str, ...], tuple[str, ...]]:
-    """(required, optional) keys of ``model`` for ``values``: :data:`MODELS`'s, with a ladder's K0
-    and elastic keys replaced by ``curve`` when ``values`` give one."""
+def model_keys(model: str, values: Mapping[str, Any] | None = None) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """The keys of a model's parameters.
+
+    Args:
+        model: a key of :data:`MODELS`.
+        values: the parameters given, or None.
+
+    Returns:
+        (required, optional) keys: :data:`MODELS`'s, with a ladder's K0 and elastic keys replaced
+        by ``curve`` when ``values`` give one (``curve`` optional otherwise).
+    """
     required, optional = MODELS[model]
-    if model in CURVE_ELASTIC and "curve" in values:
+    if model in CURVE_ELASTIC and values is not None and "curve" in values:
         return (tuple(k for k in required if k != "K0"),
                 tuple(k for k in optional if k not in _ELASTIC_KEYS) + ("curve",))
     return required, optional + (("curve",) if model in CURVE_ELASTIC else ())
@@ -136,6 +144,18 @@ def _number(value: Any, source: str, key: str) -> float:
     return float(value)
 
 
+def check_one_elastic_law(model: str, values: Mapping[str, object], source: str | None = None) -> None:
+    """Refuse ``values`` of ``model`` that give a ladder model's elastic law twice, as K0 (and the
+    elastic keys) and as a curve.
+
+    Raises:
+        InputError: naming ``source`` and the key ``curve``.
+    """
+    if model in CURVE_ELASTIC and "curve" in values and ({"K0", *_ELASTIC_KEYS} & set(values)):
+        raise InputError("give the elastic law as K0 (and the elastic keys) or as a curve, not both",
+                         source=source, key="curve")
+
+
 def to_si(model: str, values: Mapping[str, Any], quantity: str = "translation",
           source: str = "<parameters>") -> ChannelParams:
     """Validate a user-facing parameter mapping (thesis units) and convert it to SI.
@@ -152,9 +172,7 @@ def to_si(model: str, values: Mapping[str, Any], quantity: str = "translation",
         raise InputError(f"unknown quantity {quantity!r}; expected translation or rotation",
                          source=source, key="quantity")
     required, optional = model_keys(model, values)
-    if model in CURVE_ELASTIC and "curve" in values and ({"K0", *_ELASTIC_KEYS} & set(values)):
-        raise InputError("give the elastic law as K0 (and the elastic keys) or as a curve, not both",
-                         source=source, key="curve")
+    check_one_elastic_law(model, values, source)
     unknown = sorted(set(values) - set(required) - set(optional))
     if unknown:
         raise InputError(f"unknown parameter(s) {', '.join(unknown)} for model {model!r}; "

@@ -337,3 +337,43 @@ def test_a_fit_keeps_a_property_files_curve_as_its_elastic_law(tmp_path: Path, c
     assert fitted.values["Kr"] == pytest.approx(ladder["Kr"], rel=0.01)
     with pytest.raises(InputError, match="give the elastic law as K0 .* or as a curve, not both"):
         to_si("stvs", {**ladder, "K0": 500.0, "curve": [[0.0, 0.0], [1.0, 100.0]]})
+
+
+def test_a_whole_bushings_curve_as_the_elastic_law_leaves_no_ladder_and_says_so(tmp_path: Path, capsys) -> None:
+    """The shipped fig5_9.bus is the centre line of fig5_9's whole slow loop (725 N/mm at 1 mm against
+    its K0 of 508): held as the parallel spring beside a ladder fitted to fig5_9's own records, it
+    already holds the ladder's stiffness (thesis eq. 5.9), so the fit drives the ladder's Kr towards
+    nothing; the fit ends (its logs bounded, no parameter reaches 0) and the report says why."""
+    from elastokin.bushings.bench.programmes import sine, triangle
+    from elastokin.bushings.bench.records import simulate_record
+    from elastokin.core.tables import write_csv_columns
+
+    truth = load_parameter_set("fig5_9")
+    for name, (t, e) in {"tri": triangle(2e-3, 0.333e-3, 2, 0.01), "sin": sine(1e-3, 1.0, 3, 0.005)}.items():
+        write_csv_columns(tmp_path / f"{name}.csv", {"t_s": t, "e_mm": e * 1e3,
+                                                     "F_N": simulate_record([truth.channel()], t, e)[:, 0]})
+    assert main(["bushing", "fit", str(tmp_path / "tri.csv"), str(tmp_path / "sin.csv"), "--elastic",
+                 str(PARAMETER_SET_DIR / "fig5_9.bus"), "-o", str(tmp_path / "fitted.yaml")]) == 0
+    assert "the held curve likely holds the ladder's stiffness already" in capsys.readouterr().out
+    fitted = load_parameter_set(tmp_path / "fitted.yaml").values
+    assert 0.0 < fitted["Kr"] < 1e-3 * truth.values["Kr"]
+
+
+def test_a_set_with_both_elastic_laws_is_refused_read_as_another_model_too(tmp_path: Path) -> None:
+    """K0 and a curve in one STVS set: refused from its file, and a set built so in code refused as
+    STVS and as STS alike (reading as another model keeps one law only after the check, never
+    silently the curve's slope for K0)."""
+    import yaml
+
+    from elastokin.bushings.parameter_sets import ParameterSet
+
+    values = {"N": 15, "K0": 5000.0, "Kpa": 1051.0, "Kr": 2951.0, "Ff": 9.0, "Co": 32.0, "pw": 0.15,
+              "curve": [[0.0, 0.0], [1.0, 500.0]]}
+    path = tmp_path / "both.yaml"
+    path.write_text(yaml.safe_dump({"model": "stvs", "source": "test", "params": values}))
+    with pytest.raises(InputError, match="both.yaml: curve: .*not both"):
+        load_parameter_set(path)
+    both = ParameterSet("both", "stvs", "translation", values, "test")
+    for model in (None, "sts"):
+        with pytest.raises(InputError, match="not both"):
+            both.channel(model)

@@ -2,15 +2,16 @@
 beside the thesis's results (issue 52, item 3); and the thesis's measured figures of its bushing
 against the shipped sets, with a set identified to meet them (item 2).
 
-    python tools/thesis_identification.py [--out tools/thesis]
+    python tools/thesis_identification.py [--out tools/thesis] [--write-set]
 
-Writes ``identification.md`` into ``--out`` and the identified set to
+Writes ``identification.md`` into ``--out`` and, with ``--write-set``, the identified set over
 ``models/bushings/measured_figures_stvs.yaml``. About half a minute on one core.
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 from pathlib import Path
 
 from elastokin.bushings.bench import measured_figures
@@ -31,7 +32,10 @@ def _row(name: str, values: tuple[float, ...], extra: str) -> str:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=ROOT / "tools" / "thesis")
-    out = parser.parse_args().out
+    parser.add_argument("--write-set", action="store_true",
+                        help="also write the identified set over models/bushings/measured_figures_stvs.yaml")
+    args = parser.parse_args()
+    out = args.out
     rows, worst = [], {}
     truth = (TRUTH["Kpa"], TRUTH["Kr"], TRUTH["pw"], TRUTH["Co"])
     for name in THESIS_RESULTS:
@@ -79,7 +83,7 @@ regularisation, after a first attempt by a fixed point on an explicit, regularis
 With {NOISE:.0%} of white noise on the force (last row) the fit lands at a = {noisy.ours[2]:.3f}, b =
 {noisy.ours[3]:.1f}, every parameter within {off:.1f} of its standard errors of the truth.
 """
-    text += _figures()
+    text += _figures(args.write_set)
     out.mkdir(parents=True, exist_ok=True)
     (out / "identification.md").write_text(text)
     print(f"wrote {out / 'identification.md'}")
@@ -91,15 +95,16 @@ _LABELS = {"k_dyn_1hz_1mm_n_per_mm": "K_dyn at 1 Hz, 1 mm [N/mm]", "tan_delta_1h
            "payne_loss_10hz": "Payne: loss 0.1 → 2 mm at 10 Hz", "frequency_loss_0p5mm": "loss 100 → 1 Hz at 0.5 mm"}
 
 
-def _figures() -> str:
-    """The section on the thesis's measured figures; writes the identified set."""
+def _figures(write_set: bool) -> str:
+    """The section on the thesis's measured figures; with ``write_set``, writes the identified set."""
     found, m = measured_figures.identify(load_parameter_set("fig5_9"))
-    found = type(found)(found.name, found.model, found.quantity, found.values, (
+    found = dataclasses.replace(found, source=(
         "identified by vsim to the thesis's measured figures (Bourgeteau 2009: 920 N/mm and tan delta 0.12 at 1 Hz, "
-        "1 mm, figs. 5.18-5.23 captions; about 50 % lost from 0.1 to 2 mm at 10 Hz and 20 % between 100 and 1 Hz "
+        "1 mm, figs. 5.18–5.19 captions; about 50 % lost from 0.1 to 2 mm at 10 Hz and 20 % between 100 and 1 Hz "
         "at 0.5 mm, §3.3.1) together with the slow 20 mm/min loops of fig. 5.6's STS (fig5_6) at 0.5, 1 and 2 mm; "
         "fitted from fig5_9 by elastokin.bushings.bench.measured_figures.identify (tools/thesis_identification.py)"))
-    save_parameter_set(found, PARAMETER_SET_DIR / "measured_figures_stvs.yaml")
+    if write_set:
+        save_parameter_set(found, PARAMETER_SET_DIR / "measured_figures_stvs.yaml")
     sets = {name: measured_figures.measures(load_parameter_set(name).channel()) for name in COMPARED_SETS}
     sets["measured_figures_stvs"] = m
     head = "| figure | thesis | " + " | ".join(f"`{n}`" for n in sets) + " |"
@@ -121,7 +126,7 @@ def _figures() -> str:
 ## The thesis's measured figures of its bushing
 
 The thesis gives, for the front wishbone bushing whose slow loop fig. 5.6 shows: 920 N/mm and
-tan δ = 0.12 at 1 Hz, 1 mm (the captions of figs. 5.18–5.23); "about 50 %" of its stiffness lost
+tan δ = 0.12 at 1 Hz, 1 mm (the captions of figs. 5.18–5.19); "about 50 %" of its stiffness lost
 from 0.1 to 2 mm at 10 Hz and "only 20 %" between 100 Hz and 1 Hz at 0.5 mm (§3.3.1), read here
 as 1 − K(2 mm)/K(0.1 mm) and 1 − K(1 Hz)/K(100 Hz). The shipped sets, initialised from the slow loop
 alone as in §5.2, beside a set identified here to all of them at once together with fig. 5.6's slow

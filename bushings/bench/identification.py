@@ -37,6 +37,7 @@ TG2_SPAN_FRACTION = 0.1
 # Forward-difference step of the Jacobian, in log-parameter (relative) or pw units: large enough
 # to dominate the implicit solver's 1e-13 tolerance, small enough for a 0.1 % derivative error.
 _FD_STEP = 1e-3
+LOG_SPAN = 6.0   #: decades a positive parameter may move from its starting value in a fit
 
 
 # --- 1. Direct STS identification -------------------------------------------------------------
@@ -354,8 +355,11 @@ def fit(records: Sequence[BenchRecord], model: str = "stvs", initial: Sequence[P
         fixed = {k: v for k, v in init_values.items() if k not in FIT_PARAMETERS[model] or k in hold}
         problem = _Problem(model, fixed, [r.subsampled(max_samples) for r in records])
         is_pw = np.array(problem.names) == "pw"
-        lower, upper = np.where(is_pw, PW_MIN, -np.inf), np.where(is_pw, 1.0, np.inf)
-        sol = least_squares(problem.residuals, np.clip(problem.encode(init_values), lower, upper),
+        x0 = problem.encode(init_values)
+        # a positive parameter stays within LOG_SPAN decades of its start: its log cannot run to −∞ (exp → 0)
+        lower = np.where(is_pw, PW_MIN, x0 - LOG_SPAN * math.log(10.0))
+        upper = np.where(is_pw, 1.0, x0 + LOG_SPAN * math.log(10.0))
+        sol = least_squares(problem.residuals, np.clip(x0, lower, upper),
                             jac=problem.jacobian, bounds=(lower, upper), method="trf", x_scale="jac",
                             max_nfev=max_iterations, xtol=1e-6, ftol=1e-8)
         evaluations += problem.evaluations

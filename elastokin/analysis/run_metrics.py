@@ -216,11 +216,15 @@ def contact_base_m(run: Run, radius_m: float | None = None) -> dict[str, float]:
 
 
 def tyre_radius_m(run: Run) -> float | None:
-    """The tyre radius [m] of the vehicle the run recorded, None for a run without one (a rig recording)."""
+    """The tyre radius [m] of the vehicle the run recorded, None for a run without one (a rig
+    recording). InputError naming the recording and the key for a vehicle without a numeric one."""
+    if not run.metadata.vehicle_yaml:
+        return None
     try:
         return float(Document(run.metadata.vehicle_yaml, str(run.path)).data["tyre"]["radius"])
-    except (TypeError, KeyError, ValueError):  # an InputError (not YAML) is a ValueError
-        return None
+    except (TypeError, KeyError, ValueError) as exc:  # an InputError (not YAML) is a ValueError
+        raise InputError(f"the recorded vehicle has no tyre radius to read ({exc}); expected a number in metres",
+                         source=str(run.path), key="vehicle.tyre.radius") from None
 
 
 def _leg(run: Run, mask: np.ndarray) -> Leg:

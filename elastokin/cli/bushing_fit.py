@@ -47,7 +47,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                                                  "path); an STS set is converted by eq. 5.10 for STVS/RT")
     p.add_argument("--elastic", type=Path, metavar="F.bus",
                    help="take the elastic law from an Adams bushing property file's curve (held; the ladder is "
-                        "fitted beside it)")
+                        "fitted beside it, in parallel). The curve must be the parallel elastic part alone: a "
+                        "curve of the whole bushing (as vsim bushing export writes, the centre line of its slow "
+                        "loop) already holds the ladder's stiffness (thesis eq. 5.9), and the fit then finds "
+                        "little ladder left")
     p.add_argument("--direction", choices=("x", "y", "z"), default="x", help="the --elastic file's direction (default x)")
     p.add_argument("--max-samples", type=int, default=3000,
                    help="subsample longer records to about this many samples (default 3000)")

@@ -3,7 +3,7 @@ standard errors, and the fit error per record."""
 
 from __future__ import annotations
 
-from elastokin.bushings.bench.identification import FIT_PARAMETERS, FitResult
+from elastokin.bushings.bench.identification import FIT_PARAMETERS, LOG_SPAN, FitResult
 from elastokin.bushings.parameters import parameter_unit
 
 
@@ -21,6 +21,13 @@ def format_result(result: FitResult) -> str:
         points = result.values["curve"]
         lines.append(f"  elastic law: the curve of {len(points)} points from {points[0][0]:g} to {points[-1][0]:g} mm "
                      f"(held)")
+    lost = [n for n in result.std_errors if n != "pw" and result.values[n] <= result.initial[n] * 10 ** (1 - LOG_SPAN)]
+    if lost:
+        why = (" the held curve likely holds the ladder's stiffness already (a whole bushing's centre line, "
+               "thesis eq. 5.9): give the parallel elastic part" if "curve" in result.values else "")
+        lines.append(f"WARNING: {', '.join(lost)} fell over {LOG_SPAN - 1:g} decades below the start (the fit stops at "
+                     f"{LOG_SPAN:g}): the records do not need {'them' if len(lost) > 1 else 'it'};"
+                     f"{why or ' a simpler model may do'}")
     lines.append("fit error (RMS of simulated − measured force):")
     for e in result.errors:
         lines.append(f"  {e.source}: {e.rms_N:.3g} N ({e.percent:.2f} % of the {e.range_N:.4g} N range)")
