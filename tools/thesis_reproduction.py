@@ -338,9 +338,10 @@ def report(r: dict, files: dict[str, str]) -> str:
         f"{_fmt(r['speeds_sts_no_dampers'][3]['camber_fl_loop_deg'])} − "
         f"{_fmt(r['speeds_linear'][3]['camber_fl_loop_deg'])} against "
         f"{_fmt(r['speeds_sts'][3]['camber_fl_loop_deg'])} with both). STVS's own viscous branch thins the "
-        "loop too (without dampers). The loops are smooth at every speed: the thesis's numerical "
-        "instabilities at the fastest came from its own integration of the laws, an explicit Euler without "
-        "corrector inside Adams's VARSUB routine (§3.4.3, §3.5.2, §4.3); here they are stepped implicitly.",
+        "loop too (without dampers). The loops are smooth at every speed: the thesis observes numerical "
+        "instabilities at the fastest (§4.4.1) without naming their cause; they likely came from its own "
+        "integration of the laws, an explicit Euler without error corrector inside Adams's VARSUB routine "
+        "(§3.4.3, §3.5.2); here they are stepped implicitly.",
         "",
         "The rear (twist-beam) camber loop [deg] is "
         + ", ".join(_fmt(v, 5) for v in speeds_rear)
