@@ -41,7 +41,8 @@ METRICS = (
     ("toe_loop_width_max_deg", "deg", "largest toe loop width over ±20 mm of bump"),
     ("camber_loop_width_max_deg", "deg", "largest camber loop width over ±20 mm of bump"),
     ("wheel_rate_n_per_mm", "N/mm", "pad Fz per mm of wheel-centre travel in bump (wheel-centre rate; rigid rig wheels)"),
-    ("ride_rate_n_per_mm", "N/mm", "the wheel rate in series with the tyre's vertical stiffness (VERTICAL_STIFFNESS of its .tir)"),
+    ("ride_rate_n_per_mm", "N/mm", "the wheel rate in series with the tyre's vertical stiffness at its nominal load "
+                                  "(VERTICAL_STIFFNESS of its .tir)"),
     ("half_track_change_mm_per_m", "mm/m", "wheel-centre half-track (outward +) per metre of wheel-centre travel in bump"),
     ("wheel_recession_mm_per_m", "mm/m", "wheel-centre rearward (−x) travel per metre of wheel-centre travel in bump"),
     ("roll_stiffness_nm_per_deg", "N·m/deg", "axle's roll moment (right minus left pad Fz × half the contact base) "
@@ -118,7 +119,7 @@ def triangle_metrics(test: str, axle: str, down: Leg, up: Leg, window: float, ba
     # right minus left: the right wheel is the outer one in roll, and +Fy points inboard on it
     camber = lambda g: deg(g("camber", R) - g("camber", L)) / 2
     same = lambda v: v
-    # the roll moment the pads take, and the lateral force the axle takes
+    # the roll moment the axle's pads take about its centre line [N·m]
     roll_moment = lambda g: (g("pad_fz", R) - g("pad_fz", L)) * base / 2
     if test == "bump":
         return {"bump_steer_deg_per_m": each("pad_height", "toe"), "bump_camber_deg_per_m": each("pad_height", "camber"),
@@ -171,7 +172,8 @@ def car_metrics(axles: dict[str, dict[str, float]], car: CarFigures) -> dict[str
     out = {}
     for axle, m in axles.items():
         extra = {"roll_stiffness_share_pct": 100.0 * m["roll_stiffness_nm_per_deg"] / total_roll,
-                 # a pad Fz pushing the wheel down under braking lifts the front, pulls the rear down
+                 # a linkage pushing its wheel down under braking (pad Fz up) pushes the body up:
+                 # anti-dive at the front, pro-lift at the rear
                  "braking_anti_pitch_pct": (1.0 if axle == "front" else -1.0) * 100.0 * m["braking_pad_fz_ratio"]
                                            * car.wheelbase_m / car.cg_height_m}
         if car.tyre_vertical_stiffness_n_per_m is not None:

@@ -88,9 +88,13 @@ def metrics_of_legs(legs: Legs, amplitude: Mapping[str, float], vehicle: Vehicle
     return car_metrics(out, car)
 
 
-def kc_metrics(rig: KCRig) -> dict[str, dict[str, float]]:
-    """Run the K&C sequence (:data:`SEQUENCE`) on ``rig``; metrics per axle (keys of :data:`elastokin.analysis.kc_metrics.METRICS`)."""
-    return metrics_of_legs(legs_of(rig_samples(rig)), {t.name: t.amplitude for t in SEQUENCE}, rig.vehicle,
+def kc_metrics(rig: KCRig, keep: Callable[[Samples], object] | None = None) -> dict[str, dict[str, float]]:
+    """Run the K&C sequence (:data:`SEQUENCE`) on ``rig``; metrics per axle (keys of
+    :data:`elastokin.analysis.kc_metrics.METRICS`). ``keep`` is given the tests' samples (to write the curves)."""
+    samples = rig_samples(rig)
+    if keep is not None:
+        keep(samples)
+    return metrics_of_legs(legs_of(samples), {t.name: t.amplitude for t in SEQUENCE}, rig.vehicle,
                            design_contact_base(rig))
 
 
@@ -106,11 +110,5 @@ def car_figures(vehicle: VehicleDefinition) -> CarFigures:
 
 def vehicle_kc(vehicle: VehicleDefinition, options: BuildOptions = BuildOptions(),
                keep: Callable[[Samples], object] | None = None) -> dict[str, dict[str, float]]:
-    """K&C metrics of ``vehicle`` built with ``options`` (on a fresh rig); ``keep`` is given the
-    tests' samples (to write the curves)."""
-    rig = KCRig(vehicle, options)
-    samples = rig_samples(rig)
-    if keep is not None:
-        keep(samples)
-    return metrics_of_legs(legs_of(samples), {t.name: t.amplitude for t in SEQUENCE}, rig.vehicle,
-                           design_contact_base(rig))
+    """K&C metrics of ``vehicle`` built with ``options`` (on a fresh rig); ``keep`` as for :func:`kc_metrics`."""
+    return kc_metrics(KCRig(vehicle, options), keep)

@@ -7,7 +7,6 @@ solve did not converge, if any."""
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 
 import numpy as np
 

@@ -13,7 +13,7 @@ roll      pads in opposite phase, right up         25 mm         25 mm/s        
 lateral   Fy at the contact points, +y (left)      2 kN/wheel    2 kN/s                  5 s
 longit.   Fx at the contact points, −x (braking)   1.5 kN/wheel  2 kN/s                  3.75 s
 aligning  Mz about the vertical, +z (to the left)  150 N·m       200 N·m/s               3.75 s
-steering  rack displacement, +y (to the left)      40 mm         40 mm/s                 4.5 s
+steering  rack displacement, +y (to the left)      40 mm         40 mm/s                 5 s
 ========  ======================================  ============  ======================  =========
 
 The steering sweep (:data:`STEERING`) runs on the front axle's rack alone, pads held at design.
