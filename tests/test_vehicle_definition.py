@@ -89,3 +89,22 @@ def test_override_uses_the_family_set_scaled_to_the_direction(model):
     assert rot.Kpa / rot.K0 == pytest.approx(ref.Kpa / ref.K0)
     # the slider slip angle is the reference's slip deflection over the lever arm
     assert rot.Ff / rot.Kr == pytest.approx(ref.Ff / ref.Kr / lever)
+
+
+def test_the_override_on_the_translations_alone_gives_the_theses_18_stvs_models():
+    """Bourgeteau 2009 §6.3's configuration: STVS on the three principal directions of E1 and E2
+    front and E1 rear, both sides (18 models), every rotation as the vehicle file has it."""
+    from elastokin.vehicle.model.builder import build
+    from elastokin.vehicle.model.elements import BuildOptions
+
+    v = load_vehicle()
+    filed = {c.name: c.params for c in build(v, BuildOptions()).channels}
+    channels = build(v, BuildOptions(bushing_model="stvs", bushing_model_directions=("x", "y", "z"))).channels
+    stvs = sorted(c.name for c in channels if c.params.model == "stvs")
+    assert stvs == sorted(f"{b}_{side}.{d}" for b in ("e1_front", "e2_front", "e1_rear") for side in ("left", "right")
+                          for d in "xyz")
+    for c in channels:
+        if c.name.split(".")[1].startswith("r"):
+            assert c.params == filed[c.name], c.name
+    with pytest.raises(ValueError, match="unknown bushing direction.*w"):
+        BuildOptions(bushing_model="stvs", bushing_model_directions=("x", "w"))

@@ -8,6 +8,12 @@
   (``--bushing-model stvs``: 36 channels, models/vehicles/README.md); best of five periods, the two
   cars alternating, after a warm-up period each;
 * ``ratio_stvs_to_linear``: ratio of their step times; ``step_us_*``: the step times [µs];
+* ``rtf_stvs_18``, ``ratio_stvs_18_to_linear``: the same with STVS on the translations only, the
+  thesis's 18 models (Bourgeteau 2009, §6.3: the three principal directions of E1 and E2 front and
+  E1 rear, both sides; rotations as filed, linear); ``wall_s_per_simulated_minute_*`` the linear and
+  18-STVS cars' stepping time per simulated minute beside the thesis's ADAMS figures
+  (``thesis_s_per_simulated_minute_*``: §6.3's about 15 min without bushing models and 2 h with the
+  18 STVS, §4.5's about 1 h for a minute of transient loading);
 * ``camber_change_on_half_step_deg``: largest difference between the camber loops computed at H
   and at H/2 (60 mm, 0.1 Hz pumping, elastokin.vehicle.simulation.kc_triangles.run_triangle, STVS; both branches compared at
   the same pad heights over ±55 mm, four wheels); ``closure_error_max_m``: largest loop-closure error on that loop at H;
@@ -45,7 +51,7 @@ from pathlib import Path
 import numpy as np
 from processes import run_measured
 
-from elastokin.vehicle.model.definition import CORNERS
+from elastokin.vehicle.model.definition import CORNERS, DIRECTIONS
 from elastokin.vehicle.model.elements import BuildOptions
 from elastokin.vehicle.model.vehicle_file import load_vehicle
 from elastokin.vehicle.scenarios.kc_tests import Triangle
@@ -57,6 +63,13 @@ from elastokin.recordings.run_reader import load_run
 AMPLITUDE = 0.06     #: pumping amplitude [m]
 PERIOD = 10.0        #: [s] (0.1 Hz)
 PUMPING = Triangle("pumping", "pads", (1, 1, 1, 1), AMPLITUDE, 4 * AMPLITUDE / PERIOD)
+#: The cars timed side by side: (bushing model put on, the directions it goes on).
+CARS = {"linear": ("linear", DIRECTIONS), "stvs": ("stvs", DIRECTIONS), "stvs_18": ("stvs", ("x", "y", "z"))}
+#: Bourgeteau 2009, §6.3: ADAMS's wall time per simulated minute of the car without fine bushing
+#: models ("environ 15 minutes") and with 18 STVS models (the three principal directions of E1 and
+#: E2 front and E1 rear, both sides: "2 heures"); §4.5: its car with its bushing models, "une heure
+#: de simulation pour une sollicitation transitoire de une minute environ" [s].
+THESIS_S_PER_MINUTE = {"linear": 15 * 60.0, "stvs_18": 2 * 3600.0, "transient": 3600.0}
 
 
 def period(rig: KCRig) -> float:
@@ -96,8 +109,9 @@ def camber_loop(h: float) -> tuple[np.ndarray, float]:
 def bench(h: float) -> dict[str, float]:
     """The benchmark's JSON object at time step ``h`` [s]."""
     vehicle = load_vehicle()
-    steps = step_times({model: KCRig(vehicle, BuildOptions(bushing_model=model, timestep=h))
-                        for model in ("linear", "stvs")})
+    steps = step_times({name: KCRig(vehicle, BuildOptions(bushing_model=model, bushing_model_directions=directions,
+                                                          timestep=h))
+                        for name, (model, directions) in CARS.items()})
     coarse, closure = camber_loop(h)
     fine, _ = camber_loop(h / 2)
     widths = {f"camber_loop_width_deg_{axle}{suffix}": float(np.nanmax(np.abs(loops[k, 0] - loops[k, 1])))
@@ -109,6 +123,15 @@ def bench(h: float) -> dict[str, float]:
         "ratio_stvs_to_linear": steps["stvs"] / steps["linear"],
         "step_us_linear": 1e6 * steps["linear"],
         "step_us_stvs_all": 1e6 * steps["stvs"],
+        "rtf_stvs_18": h / steps["stvs_18"],
+        # per simulated minute, beside Bourgeteau 2009 §6.3 (ADAMS: ~15 min without bushing models, 2 h with 18 STVS)
+        "wall_s_per_simulated_minute_linear": 60.0 * steps["linear"] / h,
+        "wall_s_per_simulated_minute_stvs_18": 60.0 * steps["stvs_18"] / h,
+        "thesis_s_per_simulated_minute_linear": THESIS_S_PER_MINUTE["linear"],
+        "thesis_s_per_simulated_minute_stvs_18": THESIS_S_PER_MINUTE["stvs_18"],
+        "thesis_s_per_simulated_minute_transient": THESIS_S_PER_MINUTE["transient"],
+        "thesis_ratio_stvs_18_to_linear": THESIS_S_PER_MINUTE["stvs_18"] / THESIS_S_PER_MINUTE["linear"],
+        "ratio_stvs_18_to_linear": steps["stvs_18"] / steps["linear"],
         "camber_change_on_half_step_deg": float(np.abs(coarse - fine).max()),
         "closure_error_max_m": closure,
         **widths,

@@ -183,7 +183,8 @@ class _Builder:
         signs = dict(zip(DIRECTIONS, mirror_signs(bushing.axes, sign)))
         for i, d in enumerate(DIRECTIONS):
             direction = bushing.directions[d]
-            params, effects = mirrored_law(direction.channel(self.o.bushing_model), direction.effects_si(), signs[d])
+            model = self.o.bushing_model if d in self.o.bushing_model_directions else None
+            params, effects = mirrored_law(direction.channel(model), direction.effects_si(), signs[d])
             if self.o.rigid_bushings and len(d) == 1:
                 params = params.replace(model="linear", K0=RIGID_TRANSLATION, C=0.0, n_cells=0,
                                         S_sup=math.inf, S_inf=-math.inf)

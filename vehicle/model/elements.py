@@ -9,7 +9,7 @@ from dataclasses import dataclass
 
 from elastokin.bushings.effects import NO_EFFECTS, Effects
 from elastokin.bushings.parameters import ChannelParams
-from elastokin.vehicle.model.definition import Curve, Spring
+from elastokin.vehicle.model.definition import DIRECTIONS, Curve, Spring
 
 
 @dataclass(frozen=True)
@@ -20,11 +20,19 @@ class BuildOptions:
     clamped: bool = True                #: body fixed to the world; otherwise a free joint
     road: bool = False                  #: on a flat road: free body, rack drive, ground plane (tyres: elastokin.vehicle.simulation.road)
     bushing_model: str | None = None    #: read every named bushing set as this model
+    #: the directions ``bushing_model`` applies to (the others keep the vehicle file's law):
+    #: ``("x", "y", "z")`` gives the thesis's 18 STVS models (Bourgeteau 2009, §6.3)
+    bushing_model_directions: tuple[str, ...] = DIRECTIONS
     rigid_bushings: bool = False        #: translations rigid (kinematics); rotations unchanged
     #: [s]: the longest step of a run (a scenario's divides its output interval and resolves its
     #: inputs: elastokin.vehicle.scenarios.schedule.timestep). At 2 ms the rig's camber loop moves by
     #: < 0.005° and the road's yaw-rate response time by < 0.1 ms when it halves (tools/benchmarks).
     timestep: float = 2e-3
+
+    def __post_init__(self):
+        unknown = sorted(set(self.bushing_model_directions) - set(DIRECTIONS))
+        if unknown:
+            raise ValueError(f"unknown bushing direction(s) {', '.join(unknown)}; expected some of {', '.join(DIRECTIONS)}")
 
 
 @dataclass
