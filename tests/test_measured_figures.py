@@ -66,3 +66,21 @@ def test_the_identification_meets_the_figures_from_another_start() -> None:
 def test_the_identification_refuses_a_start_it_cannot_fit() -> None:
     with pytest.raises(InputError, match=r"fig5_8.*expected an STVS set .* got a 'rt' set"):
         identify(load_parameter_set("fig5_8"))
+
+
+def test_the_default_cars_ladder_laws_are_less_lossy_than_the_thesis_car() -> None:
+    """The thesis's car ran lossy bushings ("angle de perte élevé", tan δ ≈ 0.3, §4.4.1); the default
+    car's front ladder laws lose two thirds of that or less (0.06–0.17), at the lateral test's 0.2 mm,
+    0.1 Hz and at 1 Hz, 1 mm."""
+    import numpy as np
+
+    from elastokin.bushings.frequency import first_harmonic
+    from elastokin.vehicle.model.vehicle_file import load_vehicle
+
+    bushings = {b.name: b for b in load_vehicle().bushings}
+    for place in ("e1_front.y", "e1_front.z", "e2_front.x", "e2_front.y", "e2_front.z"):
+        name, direction = place.split(".")
+        law = bushings[name].directions[direction].channel()
+        for amplitude_m, frequency_hz in ((0.2e-3, 0.1), (1e-3, 1.0)):
+            k = first_harmonic(law, np.array([amplitude_m]), np.array([frequency_hz])).k_complex_n_per_m[0]
+            assert 0.03 < k.imag / k.real < 0.2, (place, amplitude_m, frequency_hz, k.imag / k.real)

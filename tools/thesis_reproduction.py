@@ -33,6 +33,9 @@ from elastokin.cluster.executor import executor  # noqa: E402
 from elastokin.core.shipped import DEFAULT_VEHICLE  # noqa: E402
 from elastokin.recordings.recorder import simulate  # noqa: E402
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import thesis_numbers  # noqa: E402  (tools/: the opening table's rows)
+
 ROOT = Path(__file__).resolve().parents[1]
 #: The dampers reduced to 1 N at 1 m/s (they must still dissipate): the car without its dampers.
 NO_DAMPERS = {f"{axle}.damper.curve.{i}.1": value for axle in ("front", "rear") for i, value in ((0, -1.0), (2, 1.0))}
@@ -274,6 +277,8 @@ def report(r: dict, files: dict[str, str]) -> str:
     bent_rear = [r["speeds_stvs_bending"][c]["camber_rr_loop_deg"] for c in (1, 2, 3)]
     bent_rear_free = [r["speeds_stvs_bending_no_dampers"][c]["camber_rr_loop_deg"] for c in (1, 2, 3)]
     rigid_range, bent_range = (r[label][1]["camber_rr_range_deg"] for label in ("speeds_stvs", "speeds_stvs_bending"))
+    stvs_fl = [r["speeds_stvs"][c]["camber_fl_loop_deg"] for c in (1, 2, 3)]
+    file_loss = [loss[d][0][0] for d in FRONT_LADDERS]
     lines = [
         "# The thesis's vehicle-level phenomena, reproduced",
         "",
@@ -282,6 +287,16 @@ def report(r: dict, files: dict[str, str]) -> str:
         "`python tools/thesis_reproduction.py`; every number below comes from that run. The thesis's "
         "statements are paraphrased from the French; it gives shapes, not numbers, so the verdicts "
         "compare directions and orders of size.",
+        "",
+        "## The thesis's numbers",
+        "",
+        "The numbers the thesis does give (chapters 3 to 6), each beside this project's and held by the "
+        "test named (`tools/thesis_numbers.py`; the bench rows in detail in `identification.md`):",
+        "",
+        *thesis_numbers.HEADER,
+        *thesis_numbers.bench_rows(),
+        *thesis_numbers.car_rows(pp[2] / pp[0], 100 * (r["speeds_rt"][1]["camber_fl_loop_deg"] / stvs_fl[0] - 1),
+                                 100 * (stvs_fl[2] / stvs_fl[0] - 1), (min(file_loss), max(file_loss))),
         "",
         "## Fig. 4.28 — the E1 rear bushing follows the pumping triangle",
         "",
