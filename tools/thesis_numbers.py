@@ -6,6 +6,7 @@ rows and the run time are measured here (:func:`bench_rows`, a few seconds)."""
 
 from __future__ import annotations
 
+import math
 import sys
 from pathlib import Path
 
@@ -19,6 +20,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parent / "benchmarks"))
 import vehicle_speed  # noqa: E402  (tools/benchmarks: the run-time figures, timed side by side)
 
 HEADER = ["| thesis | where | ours | verdict | held by |", "|---|---|---|---|---|"]
+#: The slow loops' speed of §5.2.5 [mm/s] and fig. 5.6's STS threshold there [N] (eq. 3.16's Fs).
+V0_MM_S, FIG5_8_FS_N = 0.3, 40.6
+#: §4.2.2's wheel unbalance: K0 = 493 daN/mm [N/m], m_ns [kg], m [kg], R [m], tan δ.
+UNBALANCE = (493e4, 45.0, 0.010, 0.200, 0.15)
 #: The shipped sets whose bench figures stand beside the thesis's measured part.
 SETS = ("fig5_6", "fig5_9", "fig5_9_equations", "measured_figures_stvs")
 
@@ -36,6 +41,13 @@ def bench_rows() -> list[str]:
     def figure(key: str, digits: str) -> str:
         return ", ".join(f"{name} {round(m[name].figures[key], 3) + 0.0:{digits}}" for name in SETS)
 
+    caption, equations = (load_parameter_set(name).values for name in ("fig5_9", "fig5_9_equations"))
+    viscous = {name: v["Co"] * V0_MM_S ** v["pw"] for name, v in (("caption", caption), ("equations", equations))}
+    co_fig5_8 = FIG5_8_FS_N / V0_MM_S ** 0.1   # eq. 3.16 with the caption's pw
+    pw_of_41 = math.log(FIG5_8_FS_N / 41.1) / math.log(V0_MM_S)
+    k, m_ns, mass, radius, tan_delta = UNBALANCE
+    f_n = math.sqrt(k / m_ns) / (2 * math.pi)
+    peak_mm = 1e3 * radius * mass / (m_ns * tan_delta)
     rt = thesis_identification.identify("swept sine + step")
     k1, k2, a, b = rt.ours
     v = load_vehicle()
@@ -52,17 +64,20 @@ def bench_rows() -> list[str]:
         _row("≈ 20 % from 100 to 1 Hz at 0.5 mm", "§3.3.1", figure("frequency_loss_0p5mm", ".2f"),
              "the figures' sets lose little (0–0.11); the identified set meets it", held),
         _row("the STS threshold shared 80 / 20, slider / viscous, at 0.3 mm/s", "§5.2.5, eq. 5.10",
-             "fig5_9 (caption): slider 9 N, viscous 26.7 N; fig5_9_equations: 32.48 N, 8.12 N",
+             f"fig5_9 (caption): slider {caption['Ff']:g} N, viscous {viscous['caption']:.1f} N; fig5_9_equations: "
+             f"{equations['Ff']:g} N, {viscous['equations']:.2f} N",
              "the caption's numbers read 25 / 75; the equations' set ships beside it",
              "`tests/test_measured_figures.py::test_the_equations_reading_of_figs_5_8_and_5_9`"),
         _row("fig. 5.8: Co = 41.1 with pw = 0.1", "fig. 5.8 caption, eq. 3.16",
-             "Co = 40.6 / 0.3^0.1 = 45.79 (41.1 is pw = 0.01)", "the caption's pw or Co misprinted",
+             f"Co = {FIG5_8_FS_N:g} / 0.3^0.1 = {co_fig5_8:.2f} (41.1 is pw = {pw_of_41:.2f})",
+             "the caption's pw or Co misprinted",
              "`tests/test_measured_figures.py::test_the_equations_reading_of_figs_5_8_and_5_9`"),
         _row("2-cell RT identified to a = 0.567–0.586, b = 63–66.6 (truth 0.5, 50)", "§5.4.2",
              f"a = {a:.3f}, b = {b:.1f} (k1 {k1:.0f}, k2 {k2:.0f} N/mm; truth 1200, 800)",
              "ours finds the truth; the thesis's fits stopped short", "`tests/test_identification.py`"),
         _row("wheel unbalance: 0.3 mm peak near 20 Hz (45 kg, 493 daN/mm, tan δ 0.15)", "§4.2.2, fig. 4.14",
-             "0.296 mm at 52.7 Hz = √(K/m)/2π", "the peak agrees; 20 Hz is not the linear K0's frequency "
+             f"{peak_mm:.3f} mm = R·m/(m_ns·tan δ) at {f_n:.1f} Hz = √(K/m_ns)/2π",
+             "the peak agrees; 20 Hz is not the linear K0's frequency "
              "(the thesis ties it to its nonlinear stiffness)", "`tests/test_vehicle_coupling.py`"),
         _row("one simulated minute: 2 h in ADAMS with 18 STVS, 15 min without", "§6.3",
              f"{per_minute['stvs_18']:.1f} s and {per_minute['linear']:.1f} s of stepping (pumping on the rig), "
