@@ -19,20 +19,19 @@ def test_the_identified_set_meets_the_thesis_figures_and_fig_5_6s_slow_loop() ->
     assert m.loop_departure <= LOOP_TOLERANCE
 
 
-@pytest.mark.parametrize("name, tan_delta, payne, frequency", [
-    ("fig5_9", 0.169, 0.385, 0.106), ("fig5_8", 0.166, 0.394, 0.086), ("fig5_6", 0.131, 0.425, 0.0),
-    ("fig5_9_equations", 0.144, 0.411, 0.038), ("fig5_8_equations", 0.164, 0.389, 0.085)])
-def test_the_figures_own_sets_miss_the_measured_figures(name: str, tan_delta: float, payne: float,
-                                                        frequency: float) -> None:
+@pytest.mark.parametrize("name", ["fig5_9", "fig5_8", "fig5_6", "fig5_9_equations", "fig5_8_equations"])
+def test_the_figures_own_sets_miss_the_measured_figures(name: str) -> None:
     """As initialised from the slow loop (§5.2), in either reading of figs. 5.8-5.9's captions, the
-    sets of figs. 5.6, 5.8 and 5.9 are lossier at
-    1 Hz, 1 mm than the part measured and lose less stiffness with amplitude and frequency; their
-    slow loops stay fig. 5.6's."""
+    sets of figs. 5.6, 5.8 and 5.9 keep the part's stiffness within 3 % but are lossier at 1 Hz,
+    1 mm than the part measured (tan δ 0.13-0.17 against 0.12) and lose less stiffness with
+    amplitude (0.38-0.44 against 0.50) and with frequency (at most 0.12 against 0.20), each beyond
+    the figure's tolerance, as the report's table says; their slow loops stay fig. 5.6's."""
     m = measures(load_parameter_set(name).channel())
-    assert m.figures["tan_delta_1hz_1mm"] == pytest.approx(tan_delta, abs=0.001)
-    assert m.figures["payne_loss_10hz"] == pytest.approx(payne, abs=0.001)
-    assert m.figures["frequency_loss_0p5mm"] == pytest.approx(frequency, abs=0.001)
-    assert abs(m.figures["tan_delta_1hz_1mm"] - 0.12) > FIGURES["tan_delta_1hz_1mm"][1]
+    (k, _), (tan_delta, tan_tol), (payne, payne_tol), (frequency, frequency_tol) = FIGURES.values()
+    assert abs(m.figures["k_dyn_1hz_1mm_n_per_mm"] / k - 1.0) < 0.03
+    assert tan_delta + tan_tol < m.figures["tan_delta_1hz_1mm"] < 0.175
+    assert 0.38 < m.figures["payne_loss_10hz"] < payne - payne_tol
+    assert -0.01 < m.figures["frequency_loss_0p5mm"] < min(0.12, frequency - frequency_tol)
     assert m.loop_departure <= LOOP_TOLERANCE
 
 
