@@ -93,6 +93,13 @@ TEST_METRICS = {
 Leg = Callable[[str, str], np.ndarray]
 
 
+def contact_y(centre_y, toe, camber, sign: float, radius: float):
+    """Lateral position [m] of a wheel's contact point, its centre less the radius along the wheel
+    plane's up direction (``elastokin.vehicle.model.geometry.contact_point``'s y), from the centre's
+    ``centre_y`` [m], toe-in and camber [rad] (scalars or arrays) on side ``sign`` (+1 left)."""
+    return centre_y - sign * radius * np.cos(toe) * np.sin(camber)
+
+
 def fit_window(test: str, amplitude: float, base: float) -> float:
     """Half-width of the fits of ``test`` [its fitted input's unit: m, N, N·m; roll: deg of roll]
     for an input of ``amplitude`` [m, N or N·m] and an axle's contact-point base ``base`` [m]."""
@@ -134,9 +141,9 @@ def triangle_metrics(test: str, axle: str, down: Leg, up: Leg, window: float, ba
         if not math.isnan(radius):
             # the ground turns by −φ about the roll centre relative to the clamped body: the contact
             # points (centre − r × the wheel's up direction) move by −h·φ together
-            contact_y = lambda g: 0.5 * sum(g("wheel_centre_y", c) - sign * radius * np.cos(g("toe", c))
-                                            * np.sin(g("camber", c)) for c, sign in ((L, 1.0), (R, -1.0)))
-            m["roll_centre_height_kinematic_mm"] = -1e3 * math.degrees(slope(roll, contact_y))
+            mean_y = lambda g: 0.5 * sum(contact_y(g("wheel_centre_y", c), g("toe", c), g("camber", c), sign, radius)
+                                         for c, sign in ((L, 1.0), (R, -1.0)))
+            m["roll_centre_height_kinematic_mm"] = -1e3 * math.degrees(slope(roll, mean_y))
         return m
     if test == "lateral":
         fy = lambda g: g("pad_fy", L)

@@ -27,7 +27,8 @@ from elastokin.vehicle.scenarios.channels import CORNER_TAGS
 from elastokin.vehicle.scenarios.road_scenario import ROAD_TYPES
 from elastokin.vehicle.scenarios.scenario import SIGNAL_TYPES
 from elastokin.vehicle.scenarios.schedule import PHASES, ROAD_PHASES
-from elastokin.analysis.kc_metrics import BUMP_WINDOW_M, FIT_FRACTION, Leg, bump_loop_widths, fit_window, triangle_metrics
+from elastokin.analysis.kc_metrics import (BUMP_WINDOW_M, FIT_FRACTION, Leg, bump_loop_widths, contact_y, fit_window,
+                                          triangle_metrics)
 from elastokin.analysis.loops import (Branches, centre_slope, common_range, dynamic_stiffness, loop_area, loop_width,
                                  relaxation_amplitude)
 from elastokin.core import units
@@ -205,13 +206,14 @@ def contact_base_m(run: Run, radius_m: float | None = None) -> dict[str, float]:
         raise InputError("roll metrics need the design contact-point base, from the tyre radius of the measured "
                          "vehicle, and a rig recording holds no vehicle: give the vehicle (Run.metrics(vehicle=...))",
                          source=str(run.path))
+    def first(quantity: str, tag: str) -> float:   # the design pose, in SI
+        return float(run.signals[f"{quantity}_{tag}"][0]) * units.si(run.units[f"{quantity}_{tag}"])
+
     out = {}
     for axle in ("front", "rear"):
-        left, right = (CORNER_TAGS[f"{axle}_{side}"] for side in ("left", "right"))
-        offset = [radius * math.cos(run.signals[f"toe_{t}"][0] * units.DEG)
-                  * math.sin(run.signals[f"camber_{t}"][0] * units.DEG) for t in (left, right)]
-        centres = [run.signals[f"wheel_centre_y_{t}"][0] * units.MM for t in (left, right)]
-        out[axle] = centres[0] - centres[1] - offset[0] - offset[1]
+        left, right = (contact_y(first("wheel_centre_y", t), first("toe", t), first("camber", t), sign, radius)
+                       for t, sign in ((CORNER_TAGS[f"{axle}_left"], 1.0), (CORNER_TAGS[f"{axle}_right"], -1.0)))
+        out[axle] = float(left - right)
     return out
 
 
@@ -283,4 +285,5 @@ def case_metrics(run: Run, case: Mapping[str, Any], contact_base: Mapping[str, f
 def run_metrics(run: Run, contact_base: Mapping[str, float] | None = None,
                 radius_m: float | None = None) -> dict[int, dict[str, dict[str, float]]]:
     """:func:`case_metrics` of every case, by case number (1-based)."""
+    radius_m = tyre_radius_m(run) if radius_m is None else radius_m   # the recorded vehicle's, read once
     return {case["case"]: case_metrics(run, case, contact_base, radius_m) for case in cases(run)}
