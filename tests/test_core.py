@@ -59,6 +59,7 @@ def test_the_units_table_gives_the_exact_factors_of_the_boundary():
     assert units.factor("m", "mm") == 1000.0 and units.factor("rad", "deg") == math.degrees(1.0)
     assert units.per_si("deg") == math.degrees(1.0) and units.si("daN") == 10.0 and units.si("kN·m") == 1e3
     assert units.factor("arcmin", "deg") == 1.0 / 60.0 and units.factor("ms", "s") == 1e-3
+    assert units.si("deg/s") == math.pi / 180.0 and units.factor("g", "m/s²") == 9.80665 == units.si("g")
     for unit in units.UNITS:   # every unit goes to SI and back
         assert units.si(unit) * units.per_si(unit) == pytest.approx(1.0, rel=1e-15)
     with pytest.raises(ValueError, match="does not convert"):

@@ -40,7 +40,7 @@ from elastokin.analysis.loops import rms_error
 from elastokin.analysis.run_metrics import (STIFFNESS_PAIRS, case_dynamic_stiffness, case_loop, case_mask, case_relaxation,
                                        cases, gradient_unit, loop_axes)
 from elastokin.core.errors import InputError
-from elastokin.recordings.run_format import Run
+from elastokin.recordings.run_format import MEASURED_SOURCES, Run
 
 #: Compared quantities, each recorded per wheel as ``<quantity>_<wheel>``.
 QUANTITIES = ("camber", "toe", "steer", "half_track", "wheel_centre_x", "wheel_centre_y", "wheel_centre_z", "pad_fz")
@@ -121,10 +121,10 @@ def _check_run(run: Run) -> None:
 
 
 def _check_order(sim: Run, rig: Run) -> None:
-    """Differences are simulation minus rig: swapped files would change their sign unnoticed."""
-    if sim.metadata.source == "rig" and rig.metadata.source == "simulation":
-        raise InputError(f"the files are swapped: this is a measured rig recording and {rig.path} a simulated run; "
-                         "expected the simulated run first, the rig recording second", source=str(sim.path))
+    """Differences are simulation minus measurement: swapped files would change their sign unnoticed."""
+    if sim.metadata.source in MEASURED_SOURCES and rig.metadata.source == "simulation":
+        raise InputError(f"the files are swapped: this is a measured {sim.metadata.source} recording and {rig.path} a "
+                         f"simulated run; expected the simulated run first, the measured one second", source=str(sim.path))
 
 
 def _check_cases(sim: Run, rig: Run) -> None:
@@ -141,6 +141,15 @@ def _check_cases(sim: Run, rig: Run) -> None:
             if not case_mask(run, case).any():
                 raise InputError(f"case {case['case']} '{case['label']}' has no input samples (the run is "
                                  f"{'complete' if run.complete else f'incomplete: {run.reason}'})", source=str(run.path))
+
+
+def check_pair(sim: Run, rig: Run) -> None:
+    """InputError (naming the file) if either is not a run of a scenario, the files are swapped (a
+    measured recording first, a simulated run second) or the second plays other cases."""
+    for run in (sim, rig):
+        _check_run(run)
+    _check_order(sim, rig)
+    _check_cases(sim, rig)
 
 
 def common_channels(sim: Run, rig: Run) -> list[str]:
@@ -224,10 +233,7 @@ def compare_runs(sim: Run, rig: Run) -> Comparison:
     a run of a scenario, the files are swapped (a rig recording first, a simulated run second), the rig
     plays other cases, or they share no channel. Two runs of the same source compare too (two variants of
     the car, two rig sessions)."""
-    for run in (sim, rig):
-        _check_run(run)
-    _check_order(sim, rig)
-    _check_cases(sim, rig)
+    check_pair(sim, rig)
     names = common_channels(sim, rig)
     out = []
     for sim_case, rig_case in zip(cases(sim), cases(rig)):

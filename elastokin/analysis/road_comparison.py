@@ -1,7 +1,12 @@
-"""What the bushings do on the road: one road scenario run on variants of its car (the bushings
-linear, as the scenario or the vehicle file defines them, every direction STVS, and any other
-vehicle file, such as the ``extended_vehicle.yaml`` a K&C diagnosis writes), each variant's
-road metrics (:mod:`elastokin.analysis.road_metrics`) and their differences from the linear car."""
+"""Road runs side by side, each with its road metrics (:mod:`elastokin.analysis.road_metrics`) and
+their differences from the first:
+
+* what the bushings do on the road: one road scenario run on variants of its car (the bushings
+  linear, as the scenario or the vehicle file defines them, every direction STVS, and any other
+  vehicle file, such as the ``extended_vehicle.yaml`` a K&C diagnosis writes), the linear car first;
+* a simulated road run against the measured one of the same ``measured_steer`` scenario (``vsim
+  compare``), the measurement first, with the RMS error of every response both hold.
+"""
 
 from __future__ import annotations
 
@@ -12,9 +17,12 @@ from typing import Callable, Sequence
 
 from elastokin.vehicle.model.definition import VehicleDefinition
 from elastokin.vehicle.model.vehicle_file import load_vehicle
-from elastokin.vehicle.scenarios.road_scenario import RoadScenario
+from elastokin.vehicle.scenarios.road_scenario import ROAD_TYPES, RoadScenario
 from elastokin.vehicle.scenarios.schedule import Progress
+from elastokin.analysis.compare import aligned, check_pair
+from elastokin.analysis.loops import rms_error
 from elastokin.analysis.road_metrics import METRICS, road_metrics
+from elastokin.core.errors import InputError
 from elastokin.recordings.recorder import simulate
 from elastokin.recordings.run_format import Run
 
@@ -76,4 +84,35 @@ def differences(variants: Sequence[Variant]) -> list[dict[str, object]]:
                 rows.append({"case": label, "metric": key, "variant": v.label, "value": value,
                              "difference": value - ref,
                              "difference_ms": 1e3 * (value - ref) if is_time(key) else math.nan})
+    return rows
+
+
+#: The responses a simulated and a measured road run are compared on, where both hold them.
+COMPARED = ("yaw_rate", "lateral_acceleration", "longitudinal_acceleration", "roll", "pitch", "sideslip", "speed")
+
+
+def compare_road_runs(sim: Run, measured: Run) -> list[Variant]:
+    """``measured`` (a road test, or any run of the same scenario) and ``sim`` as the variants of a
+    comparison, the measurement first (differences are simulation minus measurement). InputError
+    naming the file when either is not a road run of a scenario, the files are swapped or the
+    measurement plays other cases (:func:`elastokin.analysis.compare.check_pair`)."""
+    check_pair(sim, measured)
+    for run in (sim, measured):
+        if run.metadata.extra["type"] not in ROAD_TYPES:
+            raise InputError(f"a {run.metadata.extra['type']} run is not a road run; expected two road runs of one "
+                             f"scenario", source=str(run.path))
+    return [Variant(f"measured ({measured.metadata.source})", measured, road_metrics(measured)),
+            Variant(f"simulated ({sim.metadata.source})", sim, road_metrics(sim))]
+
+
+def response_errors(sim: Run, measured: Run) -> list[dict[str, object]]:
+    """One row per (case, response of :data:`COMPARED` both runs hold): the RMS of simulation −
+    measurement over the measurement's input samples, in the response's unit."""
+    rows = []
+    for case in measured.metadata.extra["cases"]:
+        for name in COMPARED:
+            if name in sim.signals and name in measured.signals:
+                _, a, b = aligned(sim, measured, case["case"], name)
+                rows.append({"case": case["label"], "signal": name, "unit": measured.units[name],
+                             "rms_error": rms_error(a, b) if a.size else math.nan})
     return rows

@@ -6,8 +6,9 @@ ISO 7401 for the step and sinusoidal steering inputs, ISO 4138 for steady-state 
   reaches 90 % of its steady-state value, its **peak response time** until its extreme, its
   **overshoot** the extreme beyond the steady value in per cent of that value; steady values are
   the means over the last second of the hold (the last quarter of a shorter hold); **gains** are
-  steady values per degree of steering-wheel angle. A step on top of another is measured from the
-  values just before it. The responses are low-pass filtered first, zero phase (2nd-order
+  steady values per degree of steering-wheel angle. Responses are measured from their mean before
+  the steering moves (has made :data:`ONSET_FRACTION` of its step): a step on top of another from
+  the values just before it, a logged step from the straight running logged before it. The responses are low-pass filtered first, zero phase (2nd-order
   Butterworth forwards and backwards at :data:`RESPONSE_FILTER_HZ`, from :data:`FILTER_LEAD_S`
   before the step); an overshoot below :data:`MIN_OVERSHOOT` does not count. The instantaneous
   acceleration of the body carries the suspension's and tyres' vibrations, which would move a
@@ -21,6 +22,10 @@ ISO 7401 for the step and sinusoidal steering inputs, ISO 4138 for steady-state 
   over 0.5 … 4 m/s² (the linear range) of the steering-wheel angle, of the **understeer** quantity
   δ_H / i_s − L / R (i_s the overall steering ratio, L the wheelbase, R = V / r the path radius),
   of the roll angle and of the sideslip, in deg/g; and the largest lateral acceleration reached.
+
+A logged run (a ``measured_steer`` scenario's, simulated or imported from the road test) is read
+as the manoeuvre its scenario names; the metrics of a response it does not hold (a road test
+rarely logs toe or sideslip) are left out.
 """
 
 from __future__ import annotations
@@ -49,6 +54,9 @@ MIN_OVERSHOOT = 1e-3
 FILTER_LEAD_S = 0.5
 #: Length of the window of steady values at the end of a hold [s].
 STEADY_WINDOW_S = 1.0
+#: The steering has moved once it has made this fraction of its step: a response's zero is its
+#: mean before.
+ONSET_FRACTION = 0.05
 
 #: (metric, unit, meaning) of the metrics of a step steer, of a sine steer and of a circle.
 STEP_METRICS = (
@@ -82,11 +90,12 @@ CIRCLE_METRICS = (
 )
 #: Every road metric, for tables and the command line.
 METRICS = STEP_METRICS + SINE_METRICS + CIRCLE_METRICS
-#: The metrics each road scenario type can give (a double step's second step: prefix ``second_``).
+#: The metrics each manoeuvre can give (a double step's second step: prefix ``second_``; a logged
+#: run read as no manoeuvre, none).
 TYPE_METRICS = {"step_steer": tuple(m[0] for m in STEP_METRICS),
                 "double_step_steer": tuple(p + m[0] for p in ("", "second_") for m in STEP_METRICS),
                 "sine_steer": tuple(m[0] for m in SINE_METRICS),
-                "steady_state_circular": tuple(m[0] for m in CIRCLE_METRICS)}
+                "steady_state_circular": tuple(m[0] for m in CIRCLE_METRICS), "none": ()}
 
 
 def _crossing(t: np.ndarray, y: np.ndarray, level: float) -> float | None:
@@ -180,26 +189,30 @@ def low_pass(y: np.ndarray, rate_hz: float) -> np.ndarray:
 
 def _step_metrics(run: Run, start: float, end: float, case_start: float) -> dict[str, float]:
     # responses are filtered from FILTER_LEAD_S before the step (within its case) and measured from
-    # their mean there: a second step is measured on top of the first
+    # their mean before the steering moves: a second step is measured on top of the first, a
+    # logged step (whose input starts before the driver steers) from the straight running it logs
     lead = _window(run, max(start - FILTER_LEAD_S, case_start), end)
     before = max(int(np.searchsorted(run.t_s, start - 1e-9)) - 1, int(np.argmax(lead)))
     mask = _window(run, start, end)
     mask[before] = True
-    settled = lead & (run.t_s < start - 1e-9)
-    settled[before] = True
     inside = mask[lead]
     t = run.t_s[mask]
+    x = run.signals["steering_wheel"][mask] - run.signals["steering_wheel"][before]
+    moves = _crossing(t, np.sign(x[-1]) * x, ONSET_FRACTION * abs(x[-1])) if x[-1] != 0.0 else t[0]
+    settled = lead & (run.t_s < max(start, moves) - 1e-9)
+    settled[before] = True
     steady_from = max(t[-1] - STEADY_WINDOW_S, t[0] + 0.75 * (t[-1] - t[0]))
     rate = run.metadata.extra["output_rate_hz"]
 
     def zero(y: np.ndarray) -> np.ndarray:
-        """The response ``y`` over the step, filtered, from its mean before the step (unfiltered:
-        the zero-phase filter already feels the step there)."""
+        """The response ``y`` over the step, filtered, from its mean before the steering moves
+        (unfiltered: the zero-phase filter already feels the step there)."""
         return low_pass(y[lead], rate)[inside] - float(np.mean(y[settled]))
 
-    x = run.signals["steering_wheel"][mask] - run.signals["steering_wheel"][before]
     out: dict[str, float] = {}
     for name in RESPONSES:
+        if name not in run.signals:
+            continue   # a road test that did not log it
         r = step_response(t, x, zero(run.signals[name]), steady_from)
         if r is None:
             continue
@@ -210,12 +223,14 @@ def _step_metrics(run: Run, start: float, end: float, case_start: float) -> dict
     steady = t >= steady_from
     for name, key in (("lateral_acceleration", "steady_lateral_acceleration_mps2"), ("sideslip", "steady_sideslip_deg"),
                       ("roll", "steady_roll_deg")):
-        out[key] = float(np.mean(run.signals[name][mask][steady]))
-    toe = _front_toe(run)
-    out["steady_front_toe_deg"] = float(np.mean(toe[mask][steady]))
-    lag = step_response(t, x, zero(toe), steady_from)
-    if lag is not None:
-        out["front_toe_lag_s"] = lag["response_time_s"]
+        if name in run.signals:
+            out[key] = float(np.mean(run.signals[name][mask][steady]))
+    if "toe_fl" in run.signals and "toe_fr" in run.signals:
+        toe = _front_toe(run)
+        out["steady_front_toe_deg"] = float(np.mean(toe[mask][steady]))
+        lag = step_response(t, x, zero(toe), steady_from)
+        if lag is not None:
+            out["front_toe_lag_s"] = lag["response_time_s"]
     return out
 
 
@@ -228,6 +243,8 @@ def _sine_metrics(run: Run, case: Mapping[str, Any]) -> dict[str, float]:
     out = {"frequency_hz": f}
     for name, gain_key in (("yaw_rate", "yaw_rate_gain_at_frequency_per_s"),
                            ("lateral_acceleration", "lateral_acceleration_gain_at_frequency_mps2_per_deg")):
+        if name not in run.signals:
+            continue
         h = first_harmonic(t, run.signals[name][mask], f) / x
         out[gain_key] = abs(h)
         out[f"{name}_phase_deg"] = float(np.degrees(np.angle(h)))
@@ -236,21 +253,22 @@ def _sine_metrics(run: Run, case: Mapping[str, Any]) -> dict[str, float]:
 
 def _circle_metrics(run: Run, case: Mapping[str, Any]) -> dict[str, float]:
     extra = run.metadata.extra
-    constant_steering = case["parameters"]["method"] == "constant_steering"
+    constant_steering = case["parameters"].get("method") == "constant_steering"   # a log's: constant speed
     # a constant-steering circle turns its wheel in first: its quasi-steady states come after
     start = case["input_start_s"] + (2.0 * CIRCLE_STEER_IN_S * extra["duration_scale"] if constant_steering else 0.0)
     mask = _window(run, start, case["end_s"])
     s = {k: run.signals[k][mask] for k in ("lateral_acceleration", "steering_wheel", "yaw_rate", "speed", "roll",
-                                          "sideslip")}
+                                          "sideslip") if k in run.signals}
     ay = s["lateral_acceleration"]
     linear = (np.abs(ay) >= LINEAR_RANGE_MPS2[0]) & (np.abs(ay) <= LINEAR_RANGE_MPS2[1])
-    speed = s["speed"] / 3.6
-    curvature = np.radians(s["yaw_rate"]) / speed                           # 1/R = r/V [1/m]
-    understeer = s["steering_wheel"] / extra["steering_ratio"] - np.degrees(extra["wheelbase_m"] * curvature)
     g = lambda y: G * _slope(ay[linear], y[linear])
-    out = {"understeer_gradient_deg_per_g": g(understeer), "roll_gradient_deg_per_g": g(s["roll"]),
-           "sideslip_gradient_deg_per_g": g(s["sideslip"]),
-           "max_lateral_acceleration_mps2": float(np.max(np.abs(ay))) if ay.size else float("nan")}
+    out = {}
+    if "yaw_rate" in s and "steering_ratio" in extra:   # a road test without them has no understeer
+        curvature = np.radians(s["yaw_rate"]) / (s["speed"] / 3.6)                           # 1/R = r/V [1/m]
+        understeer = s["steering_wheel"] / extra["steering_ratio"] - np.degrees(extra["wheelbase_m"] * curvature)
+        out["understeer_gradient_deg_per_g"] = g(understeer)
+    out |= {f"{name}_gradient_deg_per_g": g(s[name]) for name in ("roll", "sideslip") if name in s}
+    out["max_lateral_acceleration_mps2"] = float(np.max(np.abs(ay))) if ay.size else float("nan")
     if not constant_steering:   # the angle held has no gradient
         out["steering_wheel_angle_gradient_deg_per_g"] = g(s["steering_wheel"])
     return out
@@ -260,12 +278,14 @@ def road_metrics(run: Run) -> dict[int, dict[str, float]]:
     """Every finished case's metrics (module docstring; names and units in :data:`METRICS`), by case
     number; a double step's second-step metrics carry the prefix ``second_``."""
     extra = run.metadata.extra
-    kind = extra["type"]
+    kind = extra.get("manoeuvre", extra["type"])   # a logged run's is what it performs
     out: dict[int, dict[str, float]] = {}
     for case in extra["cases"]:
         if run.t_s.size == 0 or run.t_s[-1] < case["end_s"] - 1e-9:
             continue   # an incomplete run did not finish this case
-        if kind in ("step_steer", "double_step_steer"):
+        if kind == "none":
+            metrics = {}
+        elif kind in ("step_steer", "double_step_steer"):
             metrics: dict[str, float] = {}
             for k, (start, end) in enumerate(_steps(run, case)):
                 metrics |= {("second_" if k else "") + key: v

@@ -18,18 +18,23 @@ _SIZES: dict[str, tuple[str, float]] = {
        for dot in ("·", ".", "")},
     "s": ("time", 1.0), "ms": ("time", 1e-3),
     "km/h": ("speed", 1.0), "m/s": ("speed", 3.6),
+    "deg/s": ("angular_rate", 1.0), "rad/s": ("angular_rate", 180.0 / math.pi),
+    "m/s²": ("acceleration", 1.0), "m/s2": ("acceleration", 1.0), "g": ("acceleration", 9.80665),
 }
 #: The largest magnitude a measured or commanded value may take, per dimension, in SI: far beyond a
 #: car on a K&C rig or a part on a bushing bench, far below what a unit or typing error gives.
-_PLAUSIBLE_SI = {"length": 10.0, "angle": 2.0 * math.pi, "force": 1e7, "torque": 1e6, "time": 1e6, "speed": 100.0}
+_PLAUSIBLE_SI = {"length": 10.0, "angle": 2.0 * math.pi, "force": 1e7, "torque": 1e6, "time": 1e6, "speed": 100.0,
+                "angular_rate": 20.0, "acceleration": 100.0}
 #: The SI unit of each dimension.
-SI_UNIT = {"length": "m", "angle": "rad", "force": "N", "torque": "N·m", "time": "s", "speed": "m/s"}
+SI_UNIT = {"length": "m", "angle": "rad", "force": "N", "torque": "N·m", "time": "s", "speed": "m/s",
+           "angular_rate": "rad/s", "acceleration": "m/s²"}
 #: Every unit known, in the table's order.
 UNITS = tuple(_SIZES)
 
 
 def dimension(unit: str) -> str:
-    """``length``, ``angle``, ``force``, ``torque``, ``time`` or ``speed``; KeyError for an unknown unit."""
+    """``length``, ``angle``, ``force``, ``torque``, ``time``, ``speed``, ``angular_rate`` or
+    ``acceleration``; KeyError for an unknown unit."""
     return _SIZES[unit][0]
 
 

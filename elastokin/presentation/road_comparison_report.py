@@ -1,13 +1,14 @@
-"""The report of what the bushings do on the road (:mod:`elastokin.analysis.road_comparison`): a text
-table of every case's metrics per car with the differences from the linear car, a CSV of the same
-rows, and the overlay figures."""
+"""The report of road runs side by side (:mod:`elastokin.analysis.road_comparison`): a text table of
+every case's metrics per car with the differences from the first (the linear car, or the
+measurement), a CSV of the same rows, the overlay figures; and for a simulated run against a
+measured one, the responses' RMS errors."""
 
 from __future__ import annotations
 
 import csv
 import math
 from pathlib import Path
-from typing import Sequence
+from typing import Mapping, Sequence
 
 from elastokin.analysis.road_comparison import Variant, differences, is_time
 from elastokin.core.files import atomic_output
@@ -41,13 +42,27 @@ def format_table(variants: Sequence[Variant]) -> str:
     return "\n".join(lines)
 
 
-def write_report(variants: Sequence[Variant], out_dir: Path) -> list[Path]:
-    """``out_dir/metrics.csv`` (every row of :func:`differences`) and the overlay PNGs."""
-    out_dir.mkdir(parents=True, exist_ok=True)
-    path = out_dir / "metrics.csv"
-    rows = differences(variants)
+def format_errors(rows: Sequence[Mapping[str, object]]) -> str:
+    """The RMS errors of :func:`elastokin.analysis.road_comparison.response_errors`, a line each."""
+    lines = [f"{'case':<14} {'response':<28} {'RMS error':>12}"]
+    lines += [f"{str(r['case'])[:14]:<14} {r['signal']:<28} {r['rms_error']:>12.4g} {r['unit']}" for r in rows]
+    return "\n".join(lines)
+
+
+def _write_rows(path: Path, rows: Sequence[Mapping[str, object]]) -> Path:
     with atomic_output(path) as tmp, open(tmp, "w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=list(rows[0]))
+        writer = csv.DictWriter(f, fieldnames=list(rows[0]) if rows else [])
         writer.writeheader()
         writer.writerows(rows)
-    return [path, *overlay_variants(variants, out_dir)]
+    return path
+
+
+def write_report(variants: Sequence[Variant], out_dir: Path,
+                 errors: Sequence[Mapping[str, object]] = ()) -> list[Path]:
+    """``out_dir/metrics.csv`` (every row of :func:`differences`), ``out_dir/errors.csv`` when
+    ``errors`` are given, and the overlay PNGs."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    written = [_write_rows(out_dir / "metrics.csv", differences(variants))]
+    if errors:
+        written.append(_write_rows(out_dir / "errors.csv", errors))
+    return [*written, *overlay_variants(variants, out_dir)]

@@ -21,7 +21,8 @@ PANELS = (("steering_wheel", "steering wheel [deg]"), ("yaw_rate", "yaw rate [de
 
 
 def overlay_variants(variants: Sequence[Variant], out_dir: Path) -> list[Path]:
-    """One PNG per case: the panels of :data:`PANELS` for every variant, from 0.5 s before the input."""
+    """One PNG per case: the panels of :data:`PANELS` for every variant that holds them, from 0.5 s
+    before the input."""
     written = []
     reference = variants[0].run
     for case in reference.metadata.extra["cases"]:
@@ -32,9 +33,13 @@ def overlay_variants(variants: Sequence[Variant], out_dir: Path) -> list[Path]:
             mask = (run.t_s >= c["input_start_s"] - 0.5) & (run.t_s <= c["end_s"])
             t = run.t_s[mask] - c["input_start_s"]
             for ax, (name, label) in zip(axes, PANELS):
-                y = (0.5 * (run.signals["toe_fl"] + run.signals["toe_fr"]) if name == "front_toe"
-                     else run.signals[name])[mask]
-                ax.plot(t, y, lw=1.0, label=v.label)
+                if name == "front_toe" and "toe_fl" in run.signals and "toe_fr" in run.signals:
+                    y = 0.5 * (run.signals["toe_fl"] + run.signals["toe_fr"])
+                elif name in run.signals:
+                    y = run.signals[name]
+                else:
+                    continue   # a road test that did not log it
+                ax.plot(t, y[mask], lw=1.0, label=v.label)
                 ax.set_ylabel(label)
                 ax.grid(alpha=0.3)
         axes[0].legend(fontsize=8)

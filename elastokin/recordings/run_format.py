@@ -17,10 +17,10 @@ Layout of a run file (topics, encodings and why):
     one ``foxglove.SceneUpdate`` at t = 0 with each body's primitives locked to the body's frame,
     so Foxglove's 3D panel shows the car moving.
 metadata record ``vsim.run``
-    the source (``simulation`` or ``rig``), scenario and vehicle YAML, bushing parameter sets,
-    software version, git revision, free-form extras, the signal list (name, unit, group, x-axis
-    hint), the body list and the geometry (JSON). A ``rig`` record has no vehicle YAML and no
-    bushing parameters: measured data carries nothing about a model.
+    the source (``simulation``, ``rig`` or ``road test``), scenario and vehicle YAML, bushing
+    parameter sets, software version, git revision, free-form extras, the signal list (name, unit,
+    group, x-axis hint), the body list and the geometry (JSON). A measured record (``rig``, ``road
+    test``) has no vehicle YAML and no bushing parameters: measured data carries nothing about a model.
 metadata record ``vsim.status``
     written by :meth:`elastokin.recordings.run_writer.RunWriter.close`: ``complete`` (``"true"``/``"false"``),
     ``reason`` and ``unconverged`` (JSON: a list of
@@ -54,8 +54,11 @@ STATUS_RECORD = "vsim.status"
 FORMAT_VERSION = "vsim-run/1"
 PARTIAL_SUFFIX = ".partial"
 
-#: Where a run's signals come from: the simulator, or a rig (measured data, see ``data/README.md``).
-SOURCES = ("simulation", "rig")
+#: Where a run's signals come from: the simulator, a rig (measured data, see ``data/README.md``) or a
+#: test car on the road (a ``measured_steer`` scenario's logs, ``vsim road import``).
+SOURCES = ("simulation", "rig", "road test")
+#: The sources of measured runs: they carry no model.
+MEASURED_SOURCES = ("rig", "road test")
 
 #: Signal, group and body names become topics, frame ids and Rerun entity paths: keep them plain.
 NAME_PATTERN = re.compile(r"[A-Za-z0-9_.\-]+")
@@ -100,7 +103,7 @@ class GeomSpec:
 class RunMetadata:
     """What is needed to reproduce and identify a run; stored verbatim in the ``vsim.run`` record.
 
-    ``source`` is one of SOURCES; a ``rig`` run must leave ``vehicle_yaml`` and
+    ``source`` is one of SOURCES; a measured run (MEASURED_SOURCES) must leave ``vehicle_yaml`` and
     ``bushing_parameters`` empty (they are not stored).
     """
 

@@ -119,26 +119,30 @@ def road_facts(steering_ratio: float, wheelbase_m: float, tyre_file: Path) -> di
 
 def run_metadata(scenario: Scenario | RoadScenario, plan: list[CaseSchedule], duration_scale: float, dt: float,
                  channels: Sequence[Channel] | None = None, road: Mapping[str, Any] | None = None,
-                 vehicle_yaml: str = "") -> RunMetadata:
-    """The metadata of a run of ``scenario``: the scenario, the schedule of its cases, and (for a
-    simulated run, its bushing ``channels`` given) the vehicle file's text ``vehicle_yaml`` and the
-    bushing parameters; on the road,
-    the throttle and the facts of the car ``road`` gives (:func:`road_facts`); software version
-    and revision."""
+                 vehicle_yaml: str = "", source: str | None = None) -> RunMetadata:
+    """The metadata of a run of ``scenario``: the scenario, the schedule of its cases (a measured
+    road case's log with them), and (for a simulated run, its bushing ``channels`` given) the
+    vehicle file's text ``vehicle_yaml`` and the bushing parameters; on the road, the throttle, the
+    manoeuvre and the facts of the car ``road`` gives (:func:`road_facts`); software version and
+    revision; the ``source`` (default ``simulation`` for a simulated run, else ``rig``)."""
     cases = []
     for k, (case, s) in enumerate(zip(scenario.cases, plan), start=1):
         entry = {"case": k, "label": case.label, "parameters": dict(case.parameters), "cycles": case.cycles,
                  "start_s": s.start_s, "bushings_on_s": s.phase_start_s(1, dt),
                  "input_start_s": s.phase_start_s(len(s.steps) - 1, dt), "end_s": s.end_s(dt)}
         w = case.waveform
-        if w is not None and not w.sines and len(w.values) > 2 and w.values[-1] == w.values[-2]:
+        log = getattr(case, "log", None)
+        if log is not None:   # a measured case: the recording carries its log as read
+            entry["input_log"] = {"file": log.file, "csv": log.text, "filter_hz": log.filter_hz,
+                                  "log_rate_hz": log.log_rate_hz, "resampled_hz": log.rate_hz}
+        elif w is not None and not w.sines and len(w.values) > 2 and w.values[-1] == w.values[-2]:
             entry["hold_from_s"] = entry["input_start_s"] + w.times_s[-2] * duration_scale  # the final hold
         cases.append(entry)
     simulated = channels is not None
     model = {"vehicle_file": str(scenario.vehicle),
              "bushing_model": scenario.bushing_model or "as in the vehicle file"} if simulated else {}
     if isinstance(scenario, RoadScenario):
-        model |= {"throttle": scenario.throttle, **(road or {})}
+        model |= {"throttle": scenario.throttle, "manoeuvre": scenario.manoeuvre, **(road or {})}
     return RunMetadata(
         scenario_yaml=scenario.text,
         vehicle_yaml=vehicle_yaml if simulated else "",
@@ -151,5 +155,5 @@ def run_metadata(scenario: Scenario | RoadScenario, plan: list[CaseSchedule], du
                "x_quantity": getattr(scenario, "x_quantity", None), "duration_scale": duration_scale,
                "output_rate_hz": scenario.output_rate_hz, "timestep_s": dt,
                "limits": asdict(scenario.limits), "settle": asdict(scenario.settle), "cases": cases},
-        source="simulation" if simulated else "rig",
+        source=source or ("simulation" if simulated else "rig"),
     )

@@ -21,9 +21,9 @@ from elastokin.core.errors import InputError
 from elastokin.core.files import check_output
 from elastokin.vehicle.simulation.unconverged import UnconvergedSteps
 from elastokin.recordings.message_layouts import JOINT_STATE_SCHEMA, FrameTransformsLayout, JointStateLayout, timestamp_field
-from elastokin.recordings.run_format import (FORMAT_VERSION, GEOM_KINDS, GEOMETRY_TOPIC, NAME_PATTERN, PARTIAL_SUFFIX,
-                                        RUN_RECORD, SIGNAL_TOPIC_PREFIX, SOURCES, STATUS_RECORD, TF_TOPIC, GeomSpec,
-                                        Run, RunMetadata, SignalSpec, rotation_matrix, signal_label, to_json)
+from elastokin.recordings.run_format import (FORMAT_VERSION, GEOM_KINDS, GEOMETRY_TOPIC, MEASURED_SOURCES, NAME_PATTERN,
+                                        PARTIAL_SUFFIX, RUN_RECORD, SIGNAL_TOPIC_PREFIX, SOURCES, STATUS_RECORD, TF_TOPIC,
+                                        GeomSpec, Run, RunMetadata, SignalSpec, rotation_matrix, signal_label, to_json)
 
 
 #: Uncompressed size of a chunk [bytes]: the writer writes each chunk when it is full, so a killed
@@ -115,8 +115,9 @@ class RunWriter:
         _check_specs(signals, bodies, geometry)
         if metadata.source not in SOURCES:
             raise ValueError(f"run source {metadata.source!r}; expected one of {SOURCES}")
-        if metadata.source == "rig" and (metadata.vehicle_yaml or metadata.bushing_parameters):
-            raise ValueError("a rig recording carries no model: leave vehicle_yaml and bushing_parameters empty")
+        if metadata.source in MEASURED_SOURCES and (metadata.vehicle_yaml or metadata.bushing_parameters):
+            raise ValueError(f"a {metadata.source} recording carries no model: leave vehicle_yaml and "
+                             f"bushing_parameters empty")
         model = {"vehicle_yaml": metadata.vehicle_yaml, "bushing_parameters": to_json(metadata.bushing_parameters)}
         self.signals = list(signals)
         self.bodies = list(bodies)

@@ -128,7 +128,7 @@ def _parameters(top: Fields, vehicle: SourceFile) -> tuple[Parameter, ...]:
 def metrics_given(scenario: Scenario | RoadScenario) -> list[tuple[str | None, str]]:
     """(axle or None, metric) of every metric the scenario's cases can give."""
     if isinstance(scenario, RoadScenario):
-        return [(None, m) for m in TYPE_METRICS[scenario.type]]
+        return [(None, m) for m in TYPE_METRICS[scenario.manoeuvre]]
     test = KC_TESTS.get(scenario.type)
     return [(axle, m) for axle in scenario.axles for m in TEST_METRICS.get(test, ())]
 

@@ -11,10 +11,14 @@ Types (ISO 7401 for the transient tests, ISO 4138 for the steady state):
   frequency: gain and phase of the responses to the steering);
 * ``steady_state_circular``: ``method: constant_speed`` (the steering wheel turned slowly from 0 to
   ``steering_wheel_deg`` at constant speed) or ``constant_steering`` (the angle held, the speed
-  raised slowly from ``speed_kmh`` to ``end_speed_kmh``), over ``duration_s``: quasi-steady states.
+  raised slowly from ``speed_kmh`` to ``end_speed_kmh``), over ``duration_s``: quasi-steady states;
+* ``measured_steer``: a test car's logged steering-wheel angle (and speed, or a constant
+  ``speed_kmh``) from the CSV at ``path``, read and resampled as :mod:`elastokin.vehicle.scenarios.road_log`
+  says; ``manoeuvre`` says which of the types above it performs, for its metrics (``none``: none).
 
 Every case starts from the car settled at rest, then launched at ``speed_kmh`` and run straight
-(:class:`RoadSettle`). Angles are steering-wheel angles, positive to the left (ISO 8855).
+(:class:`RoadSettle`), the steering at the input's first angle. Angles are steering-wheel angles,
+positive to the left (ISO 8855).
 """
 
 from __future__ import annotations
@@ -27,15 +31,20 @@ from typing import Any, Mapping
 import numpy as np
 
 from elastokin.vehicle.model.definition import BUSHING_MODELS
+from elastokin.vehicle.scenarios.road_log import LOG_KEYS, RoadLog, read_road_log
 from elastokin.vehicle.scenarios.scenario import MAX_INPUT_S, MAX_SETTLE_S, Limits, Waveform
 from elastokin.vehicle.scenarios.scenario_fields import LIMIT_KEYS, case_fields, limit_values, output_rate, scenario_name, vehicle_file
 from elastokin.core.documents import Fields
 from elastokin.core.units import DEG, si
 
-ROAD_TYPES = ("step_steer", "double_step_steer", "sine_steer", "steady_state_circular")
+#: The manoeuvres a road scenario's metrics know (``elastokin.analysis.road_metrics``).
+MANOEUVRES = ("step_steer", "double_step_steer", "sine_steer", "steady_state_circular")
+ROAD_TYPES = (*MANOEUVRES, "measured_steer")
+#: What a measured_steer scenario's ``manoeuvre`` may say (``none``: no metrics).
+MEASURED_MANOEUVRES = ("step_steer", "sine_steer", "steady_state_circular", "none")
 #: Top-level keys of a road scenario file.
 ROAD_TOP_KEYS = ("name", "description", "type", "vehicle", "bushings", "output_rate_hz", "throttle", "settle",
-                 "limits", "defaults", "cases")
+                 "limits", "defaults", "cases", "manoeuvre")
 #: After the input starts, the driver holds the speed (its controller on), or holds the drive
 #: torque it had (ISO 7401's fixed throttle).
 THROTTLES = ("held_speed", "fixed")
@@ -45,6 +54,7 @@ _CASE_KEYS = {
     "double_step_steer": ("speed_kmh", "first_deg", "rest_s", "second_deg", "hold_s", "rise_time_s"),
     "sine_steer": ("speed_kmh", "amplitude_deg", "frequency_hz", "cycles"),
     "steady_state_circular": ("method", "speed_kmh", "end_speed_kmh", "steering_wheel_deg", "duration_s"),
+    "measured_steer": (*LOG_KEYS, "speed_kmh", "frequency_hz"),
 }
 KMH = si("km/h")
 MAX_SPEED_KMH = 250.0
@@ -88,6 +98,7 @@ class RoadCase:
     steering: Waveform                 #: steering-wheel angle [rad], + to the left
     speed: Waveform                    #: target speed [m/s]
     cycles: int = 1                    #: sine periods (1 otherwise)
+    log: RoadLog | None = None         #: a measured case's log (its steering and speed are those above)
 
     @property
     def duration_s(self) -> float:
@@ -120,6 +131,7 @@ class RoadScenario:
     settle: RoadSettle
     limits: RoadLimits
     cases: tuple[RoadCase, ...]
+    manoeuvre: str                     #: which of MANOEUVRES its metrics read it as, or none
 
 
 def _speed(f: Fields, key: str = "speed_kmh") -> float:
@@ -147,9 +159,47 @@ def _steps(rise: float, levels: list[tuple[float, float]]) -> Waveform:
     return Waveform(tuple(times), tuple(values))
 
 
-def _case(f: Fields, kind: str) -> RoadCase:
+def _measured(f: Fields, label: str, params: dict[str, Any], base_dir: Path, rate_hz: float,
+              manoeuvre: str, throttle: str) -> RoadCase:
+    """A measured_steer case: its log's steering, and its speed (its first, under a fixed
+    throttle) or ``speed_kmh``."""
+    log = read_road_log(f, base_dir, rate_hz)
+    if "steering_wheel" not in log.channels:
+        raise f.fail("columns" if f.has("columns") else "path",
+                     f"{log.file}: expected a column of the steering-wheel angle (channel steering_wheel; "
+                     f"steering_wheel_deg in the default header), got none")
+    times = tuple(log.t_s.tolist())
+    steering = Waveform(times, tuple((log.channels["steering_wheel"] * DEG).tolist()))
+    if np.max(np.abs(steering.values)) > MAX_STEERING_DEG * DEG:
+        raise f.fail("path", f"{log.file}: a steering-wheel angle beyond {MAX_STEERING_DEG:g} deg")
+    if "speed" in log.channels:
+        if f.has("speed_kmh"):
+            raise f.fail("speed_kmh", f"{log.file} logs the speed; give speed_kmh only for a log without one")
+        speeds = log.channels["speed"] * KMH
+        if not np.all((speeds > 0.0) & (speeds <= MAX_SPEED_KMH * KMH)):
+            raise f.fail("path", f"{log.file}: expected a logged speed above 0 and at most {MAX_SPEED_KMH:g} km/h, "
+                                 f"got {np.min(speeds) / KMH:.4g} to {np.max(speeds) / KMH:.4g}")
+        speed = (Waveform(times, tuple(speeds.tolist())) if throttle == "held_speed"
+                 else Waveform((0.0, times[-1]), (float(speeds[0]),) * 2))
+    else:
+        speed = Waveform((0.0, times[-1]), (_speed(f),) * 2)
+    cycles = 1
+    if manoeuvre == "sine_steer":
+        frequency = f.number("frequency_hz", positive=True, at_most=MAX_SINE_HZ, unit="Hz")
+        cycles = int(math.floor(round(times[-1] * frequency, 6)))
+        if cycles < 3:
+            raise f.fail("frequency_hz", f"{log.file} lasts {times[-1]:.6g} s, {cycles} period(s) at {frequency:g} "
+                                         f"Hz; expected at least 3 (the first settles)")
+    elif f.has("frequency_hz"):
+        raise f.fail("frequency_hz", f"a {manoeuvre} has no frequency; give frequency_hz with manoeuvre: sine_steer")
+    return RoadCase(label, params, float(speed.values[0]), steering, speed, cycles, log)
+
+
+def _case(f: Fields, kind: str, base_dir: Path, rate_hz: float, manoeuvre: str, throttle: str) -> RoadCase:
     params = {k: v for k, (v, _) in f.values.items() if k != "label"}
     label = f.text("label", ", ".join(f"{k}={v}" for k, (v, p) in f.values.items() if p[0] == "cases") or "case")
+    if kind == "measured_steer":
+        return _measured(f, label, params, base_dir, rate_hz, manoeuvre, throttle)
     speed = _speed(f)
     hold = lambda key: f.number(key, positive=True, at_most=MAX_INPUT_S, unit="s")
     cycles = 1
@@ -207,10 +257,18 @@ def parse_road_scenario(top: Fields, kind: str, path: Path, text: str) -> RoadSc
                                                 at_most=90.0, unit="deg") * DEG,
                         wheel_lift_s=lim.number("wheel_lift_s", RoadLimits.wheel_lift_s, positive=True, unit="s"))
     throttle = top.choice("throttle", THROTTLES, "held_speed")
+    if kind == "measured_steer":
+        manoeuvre = top.choice("manoeuvre", MEASURED_MANOEUVRES)
+    elif top.has("manoeuvre"):
+        raise top.fail("manoeuvre", f"a {kind} scenario is its own manoeuvre; give manoeuvre only with "
+                                    f"type: measured_steer")
+    else:
+        manoeuvre = kind
+    rate = _road_rate(top)
     allowed = (*_CASE_KEYS[kind], "label")
     cases = []
     for i, fields in case_fields(top, allowed):
-        case = _case(fields, kind)
+        case = _case(fields, kind, path.parent, rate, manoeuvre, throttle)
         if case.duration_s > MAX_INPUT_S:
             raise doc.error(("cases", i), f"its input lasts {case.duration_s:.6g} s; expected at most {MAX_INPUT_S:g} s "
                                           f"of simulated time per case")
@@ -221,7 +279,7 @@ def parse_road_scenario(top: Fields, kind: str, path: Path, text: str) -> RoadSc
     return RoadScenario(
         name=scenario_name(top, path), description=top.text("description", ""), path=path, text=text, type=kind,
         vehicle=vehicle_file(top, path), bushing_model=top.choice("bushings", BUSHING_MODELS, None),
-        output_rate_hz=_road_rate(top), throttle=throttle, settle=settle, limits=limits, cases=tuple(cases))
+        output_rate_hz=rate, throttle=throttle, settle=settle, limits=limits, cases=tuple(cases), manoeuvre=manoeuvre)
 
 
 def steering_and_speed(case: RoadCase, t_s: np.ndarray, throttle: str) -> tuple[np.ndarray, np.ndarray]:

@@ -4,8 +4,8 @@ car, yielding the samples that a recording keeps in blocks (:mod:`elastokin.reco
 Each case goes through :data:`elastokin.vehicle.scenarios.schedule.ROAD_PHASES`: 0, at rest and braked with
 every bushing direction linear (the car settles on its tyres); 1, at rest with the bushing laws on
 from their virgin state; 2, launched at the case's speed (wheels rolling without slip) and run
-straight with the speed held; 3, the input: the steering wheel and the driver's speed as the
-scenario says. The car runs in the world's x direction at the start of phase 2.
+straight with the speed held (the steering wheel at the input's first angle); 3, the input: the
+steering wheel and the driver's speed as the scenario says. The car runs in the world's x direction at the start of phase 2.
 
 A run stops with :class:`~elastokin.vehicle.simulation.runner.DivergenceError` when the suspension leaves
 its valid range (as on the rig) or, once at speed, when the body's sideslip exceeds the
@@ -74,11 +74,12 @@ class RoadRun(PlayedScenario):
         # at speed only: before, wheels touch down and the body's slip means nothing
         at_speed = lambda b: road_divergence(b, car.columns, scenario, lifted, every * dt)
 
-        def hold(phase: int, speed: float) -> Iterator[SampleBlock]:
+        def hold(phase: int, speed: float, angle: float = 0.0) -> Iterator[SampleBlock]:
             for samples in blocks_of(when.steps[phase] // every):
                 held = math.isnan(speed)   # the throttle held: no inputs, the speed controller idle
-                u = _NO_INPUTS if held else car.drive_inputs(np.zeros(samples * every), np.full(samples * every, speed))
-                yield from blocks.measure(phase, samples, every, u, np.array([[0.0, speed]] * samples),
+                u = _NO_INPUTS if held else car.drive_inputs(np.full(samples * every, angle),
+                                                             np.full(samples * every, speed))
+                yield from blocks.measure(phase, samples, every, u, np.array([[angle, speed]] * samples),
                                           at_speed if phase >= 2 else None)
 
         car.set_brakes(SETTLE_BRAKE_NM)
@@ -88,7 +89,7 @@ class RoadRun(PlayedScenario):
         yield from hold(1, math.nan)
         car.set_brakes(0.0)
         car.set_speed(case.speed_mps)
-        yield from hold(2, case.speed_mps)
+        yield from hold(2, case.speed_mps, float(case.steering(np.zeros(1))[0]))   # straight at the input's first angle
         for samples in blocks_of(when.steps[3] // every):
             t = (blocks.step - blocks.input_start + np.arange(1, samples * every + 1)) * dt / self.duration_scale
             steering, speed = steering_and_speed(case, t, scenario.throttle)
