@@ -129,10 +129,11 @@ def test_round_trip_of_every_channel(run_file: Path, trajectory: dict) -> None:
     with open(run_file, "rb") as stream:
         summary = make_reader(stream).get_summary()
     channels = {c.topic: c for c in summary.channels.values()}
-    assert set(channels) == {"/tf", "/geometry", "/signals/wheels", "/signals/bushings", "/signals/inputs"}
+    assert set(channels) == {"/tf", "/geometry", "/signals/wheels", "/signals/bushings", "/signals/inputs", "/plot"}
     assert channels["/signals/wheels"].metadata["units"] == '["mm", "deg", "deg"]'
     assert summary.schemas[channels["/tf"].schema_id].name == "foxglove.FrameTransforms"
     assert summary.schemas[channels["/signals/wheels"].schema_id].name == "sensor_msgs/msg/JointState"
+    assert summary.schemas[channels["/plot"].schema_id].name == "vsim_msgs/msg/Signals"
 
 
 def test_geometry_from_model_in_body_frames() -> None:

@@ -10,9 +10,16 @@ Layout of a run file (topics, encodings and why):
 ``/signals/<group>``
     ``sensor_msgs/msg/JointState`` (ROS 2 message definition, CDR), one message per step and
     group: ``position`` holds the group's values, ``name`` the labels ``"<signal> [<unit>]"``.
-    Rerun plots JointState arrays without any configuration (entity ``/signals/<group>/position``)
-    and Foxglove plots them too. The channel metadata repeats the bare names and the units as JSON
-    lists (``names``, ``units``) so every channel describes itself.
+    Rerun plots JointState arrays without any configuration (entity ``/signals/<group>/position``).
+    The channel metadata repeats the bare names and the units as JSON lists (``names``, ``units``)
+    so every channel describes itself. The project's readers read the signals from here.
+``/plot``
+    every signal again, by name: one message per step of the run's own ROS 2 type
+    (``vsim_msgs/msg/Signals``, CDR) with a field per group and, in each, a ``float64`` per
+    signal named ``<signal>_<unit>``
+    (:class:`elastokin.recordings.message_layouts.PlotLayout`), so that Foxglove's Plot panel offers
+    each by its name and unit (``/plot.camber.camber_fl_deg``) where a JointState gives
+    ``position[0]``. Files written before it existed lack it and read the same.
 ``/geometry``
     one ``foxglove.SceneUpdate`` at t = 0 with each body's primitives locked to the body's frame,
     so Foxglove's 3D panel shows the car moving.
@@ -48,6 +55,7 @@ from elastokin.vehicle.simulation.unconverged import UnconvergedSteps
 TF_TOPIC = "/tf"
 GEOMETRY_TOPIC = "/geometry"
 SIGNAL_TOPIC_PREFIX = "/signals/"
+PLOT_TOPIC = "/plot"
 WORLD_FRAME = "world"
 RUN_RECORD = "vsim.run"
 STATUS_RECORD = "vsim.status"

@@ -20,10 +20,12 @@ from foxglove.messages import (Color, CubePrimitive, CylinderPrimitive, Pose, Qu
 from elastokin.core.errors import InputError
 from elastokin.core.files import check_output
 from elastokin.vehicle.simulation.unconverged import UnconvergedSteps
-from elastokin.recordings.message_layouts import JOINT_STATE_SCHEMA, FrameTransformsLayout, JointStateLayout, timestamp_field
+from elastokin.recordings.message_layouts import (JOINT_STATE_SCHEMA, FrameTransformsLayout, JointStateLayout,
+                                               PlotLayout, timestamp_field)
 from elastokin.recordings.run_format import (FORMAT_VERSION, GEOM_KINDS, GEOMETRY_TOPIC, MEASURED_SOURCES, NAME_PATTERN,
-                                        PARTIAL_SUFFIX, RUN_RECORD, SIGNAL_TOPIC_PREFIX, SOURCES, STATUS_RECORD, TF_TOPIC,
-                                        GeomSpec, Run, RunMetadata, SignalSpec, rotation_matrix, signal_label, to_json)
+                                        PARTIAL_SUFFIX, PLOT_TOPIC, RUN_RECORD, SIGNAL_TOPIC_PREFIX, SOURCES, STATUS_RECORD,
+                                        TF_TOPIC, GeomSpec, Run, RunMetadata, SignalSpec, rotation_matrix, signal_label,
+                                        to_json)
 
 
 #: Uncompressed size of a chunk [bytes]: the writer writes each chunk when it is full, so a killed
@@ -171,6 +173,12 @@ class RunWriter:
             )
             layout = JointStateLayout([signal_label(s) for s in specs])
             self._groups.append((channel, layout, np.array(members, dtype=np.intp)))
+        # every signal again, by name, in one message a step: Foxglove's Plot panel
+        self._plot = PlotLayout(self.signals) if self.signals else None
+        if self._plot is not None:
+            self._plot_channel = foxglove.Channel(
+                PLOT_TOPIC, schema=foxglove.Schema(name=self._plot.type_name, encoding="ros2msg", data=self._plot.schema),
+                message_encoding="cdr", context=self._context)
         if geometry:
             scene = SceneUpdateChannel(GEOMETRY_TOPIC, context=self._context)
             with_geoms = [b for b in self.bodies if any(g.body == b for g in geometry)]
@@ -206,6 +214,8 @@ class RunWriter:
             raise ValueError(f"{self.path}: time {t_s[late[0]]} s is negative or not after the previous step")
         poses = np.concatenate([pos, quat[:, :, 1:], quat[:, :, :1]], axis=2)
         groups = [(channel, layout.encode_block(t_ns, values[:, members])) for channel, layout, members in self._groups]
+        if self._plot is not None:
+            groups.append((self._plot_channel, self._plot.encode_block(t_ns, values)))
         for k, t in enumerate(t_ns.tolist()):
             if n_bodies:
                 timestamp = timestamp_field(t)
