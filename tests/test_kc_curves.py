@@ -30,7 +30,7 @@ def curves(tmp_path_factory):
 def test_the_curves_read_back_give_vsim_kcs_metrics(curves, capsys):
     folder, metrics = curves
     assert sorted(p.name for p in folder.iterdir()) == [f"{t}.csv" for t in sorted(
-        ("bump", "roll", "lateral", "longitudinal", "aligning", "steering"))]
+        ("bump", "roll", "lateral", "longitudinal", "drive", "aligning", "steering"))]
     header = (folder / "bump.csv").read_text().splitlines()[0].split(",")
     assert header[0] == "time_s" and "pad_fz_rr_n" in header and "toe_fl_deg" in header
     assert main(["compare", "--kc", str(folder), "--json"]) == 0

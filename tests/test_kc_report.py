@@ -19,6 +19,7 @@ from elastokin.analysis.loops import Branches, centre_slope
 from elastokin.core.shipped import DEFAULT_VEHICLE
 from elastokin.tyres.magic_formula import coefficients
 from elastokin.tyres.tir_file import read_tir
+from elastokin.vehicle.model.elements import BuildOptions
 from elastokin.vehicle.model.geometry import contact_point
 from elastokin.vehicle.model.vehicle_file import load_vehicle
 from elastokin.vehicle.scenarios.kc_tests import STEERING, TEST, triangle_input
@@ -44,7 +45,7 @@ def metrics_of(rig: KCRig, test: str) -> tuple[dict[str, dict[str, float]], tupl
     """(per axle, ``test``'s metrics; its (down, up) samples) on ``rig``."""
     down, up = run_triangle(rig, TEST[test])
     base = design_contact_base(rig)
-    return ({axle: triangle_metrics(test, axle, rig_leg(down), rig_leg(up),
+    return ({axle: triangle_metrics(test, axle, rig_leg(down, TEST[test]), rig_leg(up, TEST[test]),
                                     fit_window(test, TEST[test].amplitude, base[axle]), base[axle],
                                     rig.vehicle.tyre.radius) for axle in base}, (down, up))
 
@@ -140,10 +141,43 @@ def test_the_trailing_arm_recession_and_anti_lift_follow_its_pivot(tmp_path):
     assert car.tyre_vertical_stiffness_n_per_m == coefficients(read_tir(v.tyre.property_file))["VERTICAL_STIFFNESS"]
 
 
+def test_the_drive_at_the_wheel_centre_is_the_bump_recession_by_reciprocity(tmp_path):
+    """A drive force Fx at a wheel centre with the pads held loads the pad by the wheel centre's
+    fore-aft motion per unit of pad travel in bump, by Maxwell-Betti reciprocity on the clamped
+    car (the bump test's pad force does no work in the drive test, whose pad does not move):
+    ΔFz/Fx = −dx_c/dz_pad, measured in the bump test, within 2 % (5e-4 where the ratio nears zero:
+    the soft closures and the fits). Reciprocity needs elastic laws: the bushings
+    are linear here (the default car's hysteretic front laws move the front's small ratio by 14 %).
+    On the twist beam the ratio is its arms' pivot's (z_c − z_p)/(x_c − x_p); the pivot is drawn
+    from the seed. Anti-squat (rear) and anti-lift (front), in
+    :func:`test_the_car_level_metrics_of_vsim_kc`, are these ratios scaled by L/h."""
+    rng = np.random.default_rng(SEED + 2)
+    dz = float(rng.uniform(-0.030, 0.030))
+    pivot = load_vehicle(DEFAULT_VEHICLE).rear.hardpoints["arm_pivot"]
+    old = f"arm_pivot:           [{pivot[0]:.3f}, {pivot[1]:.3f}, {pivot[2]:.3f}]"
+    v = vehicle_with(tmp_path, "pivot", {old: f"arm_pivot:           [{pivot[0]:.3f}, {pivot[1]:.3f}, {pivot[2] + dz:.4f}]"})
+    rig = KCRig(v, BuildOptions(bushing_model="linear"))
+    drive, _ = metrics_of(rig, "drive")
+    _, (down, up) = metrics_of(rig, "bump")
+    window = fit_window("bump", TEST["bump"].amplitude, math.nan)
+
+    def fore_aft_per_pad_travel(corner: str) -> float:
+        x = lambda leg: np.array([o.wheels[corner].pad_height for o in leg])
+        y = lambda leg: np.array([o.wheels[corner].wheel_centre[0] for o in leg])
+        return centre_slope(Branches(x(down), y(down), x(up), y(up)), window)
+
+    for axle in ("front", "rear"):
+        recession = -0.5 * (fore_aft_per_pad_travel(f"{axle}_left") + fore_aft_per_pad_travel(f"{axle}_right"))
+        assert drive[axle]["drive_pad_fz_ratio"] == pytest.approx(recession, rel=0.02, abs=5e-4), axle
+    (xc, _, zc), (xp, _, zp) = v.rear.hardpoints["wheel_centre"], v.rear.hardpoints["arm_pivot"]
+    assert drive["rear"]["drive_pad_fz_ratio"] == pytest.approx((zc - zp) / (xc - xp), rel=0.02, abs=5e-4)
+
+
 def test_the_car_level_metrics_of_vsim_kc():
     """Shares add up to 100 %; the ride rate is the wheel rate in series with the tyre; anti-dive
     and anti-lift are the braking ratios scaled by L/h with their signs (a rear arm pulling its
-    wheel up under braking holds the tail down)."""
+    wheel up under braking holds the tail down), anti-lift (front) and anti-squat (rear) under
+    drive the drive ratios."""
     v = load_vehicle(DEFAULT_VEHICLE)
     m, car = vehicle_kc(v), car_figures(v)
     assert m["front"]["roll_stiffness_share_pct"] + m["rear"]["roll_stiffness_share_pct"] == pytest.approx(100.0)
@@ -155,6 +189,10 @@ def test_the_car_level_metrics_of_vsim_kc():
     assert m["rear"]["braking_pad_fz_ratio"] < 0 < m["rear"]["braking_anti_pitch_pct"]
     assert m["front"]["braking_anti_pitch_pct"] == pytest.approx(
         100 * m["front"]["braking_pad_fz_ratio"] * car.wheelbase_m / car.cg_height_m, rel=1e-12)
+    # a wheel pushed down under drive holds the body up: anti-squat at the rear, pro-lift at the front
+    for axle, sign in (("front", -1.0), ("rear", 1.0)):
+        assert m[axle]["drive_anti_pitch_pct"] == pytest.approx(
+            sign * 100 * m[axle]["drive_pad_fz_ratio"] * car.wheelbase_m / car.cg_height_m, rel=1e-12)
 
 
 def test_the_front_wheels_steer_about_the_axis_their_hardpoints_give(tmp_path):

@@ -1,5 +1,5 @@
 """The curves behind `vsim kc`'s metrics as a K&C rig delivers them: one CSV per test (``bump.csv``,
-``roll.csv``, ``lateral.csv``, ``longitudinal.csv``, ``aligning.csv``, ``steering.csv``), a row per
+``roll.csv``, ``lateral.csv``, ``longitudinal.csv``, ``drive.csv``, ``aligning.csv``, ``steering.csv``), a row per
 sample of its unloading then loading leg, a column per quantity and wheel with its unit in its
 name (``time_s``, ``rack_mm``, ``toe_fl_deg``, ``pad_fz_rr_n`` …; ISO 8855 signs as in
 :data:`elastokin.analysis.kc_metrics.METRICS`). Read back, or read from a rig, each file's legs are
@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from elastokin.analysis.kc_metrics import Leg
-from elastokin.analysis.kc_test import SEQUENCE, WHEEL_QUANTITIES, Legs, Samples, metrics_of_legs, triangle_input
+from elastokin.analysis.kc_test import SEQUENCE, Legs, Samples, metrics_of_legs, rig_leg
 from elastokin.vehicle.model.definition import VehicleDefinition
 from elastokin.vehicle.model.geometry import contact_point
 from elastokin.core.errors import InputError
@@ -24,11 +24,14 @@ from elastokin.vehicle.scenarios.channels import AXLES, CORNER_TAGS
 UNITS = {"pad_height": ("mm", 1e3), "wheel_travel": ("mm", 1e3), "toe": ("deg", math.degrees(1.0)),
          "camber": ("deg", math.degrees(1.0)), "steer": ("deg", math.degrees(1.0)), "half_track": ("mm", 1e3),
          "wheel_centre_x": ("mm", 1e3), "wheel_centre_y": ("mm", 1e3), "pad_fx": ("n", 1.0), "pad_fy": ("n", 1.0),
-         "pad_fz": ("n", 1.0), "pad_mz": ("nm", 1.0)}
+         "pad_fz": ("n", 1.0), "pad_mz": ("nm", 1.0), "centre_fx": ("n", 1.0)}
+#: The quantity only a test at the wheel centres needs (its input, 0 in the others' files).
+CENTRE_INPUT = "centre_fx"
 #: The column of each test's input (a wheel whose input rises with the test's, or the rack) and its
 #: factor from the test's input in SI (the braking force: −Fx).
 INPUT_COLUMNS = {"bump": ("pad_height_fl_mm", 1e3), "roll": ("pad_height_fr_mm", 1e3), "lateral": ("pad_fy_fl_n", 1.0),
-                 "longitudinal": ("pad_fx_fl_n", -1.0), "aligning": ("pad_mz_fl_nm", 1.0), "steering": ("rack_mm", 1e3)}
+                 "longitudinal": ("pad_fx_fl_n", -1.0), "drive": ("centre_fx_fl_n", 1.0), "aligning": ("pad_mz_fl_nm", 1.0),
+                 "steering": ("rack_mm", 1e3)}
 _MIN_ROWS = 8   #: a leg needs a few samples on each side of design
 
 
@@ -44,13 +47,13 @@ def write_curves(folder: Path, samples: Samples) -> list[Path]:
     written = []
     for name, (down, up) in samples.items():
         rows = down + up
+        leg = rig_leg(rows, test[name])
         columns = {"time_s": np.array([o.time for o in rows])}
         if name == "steering":
-            columns["rack_mm"] = 1e3 * np.array([triangle_input(test[name], o.time) for o in rows])
+            columns["rack_mm"] = 1e3 * leg("rack", "front_left")
         for corner in CORNER_TAGS:
             for quantity, (_, factor) in UNITS.items():
-                columns[column(quantity, corner)] = factor * np.array([WHEEL_QUANTITIES[quantity](o.wheels[corner])
-                                                                       for o in rows])
+                columns[column(quantity, corner)] = factor * leg(quantity, corner)
         path = folder / f"{name}.csv"
         write_csv_columns(path, columns)
         written.append(path)
@@ -68,7 +71,7 @@ def read_curves(folder: Path) -> tuple[Legs, dict[str, float]]:
             raise InputError(f"no {t.name} curves; expected {path.name} ({', '.join(s.name + '.csv' for s in SEQUENCE)}, "
                              f"as vsim kc --curves writes them)", source=str(folder))
         needed = ["time_s"] + [INPUT_COLUMNS[t.name][0]] * (t.name == "steering") + [
-            column(q, c) for c in CORNER_TAGS for q in UNITS]
+            column(q, c) for c in CORNER_TAGS for q in UNITS if q != CENTRE_INPUT or t.at == "centre"]
         data = read_csv_columns(path, needed, 4 * _MIN_ROWS)
         name, factor = INPUT_COLUMNS[t.name]
         drive = data[name] / factor

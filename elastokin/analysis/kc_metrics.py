@@ -66,6 +66,11 @@ METRICS = (
     ("braking_anti_pitch_pct", "%", "front: anti-dive, rear: anti-lift (SAE J670), the share of the braking "
                                     "load transfer h/L the linkage carries, this axle braking alone at the contact "
                                     "point (outboard brakes)"),
+    ("drive_pad_fz_ratio", "N/N", "pad Fz per N of drive force (+x) at the wheel centre, pad heights held "
+                                  "(side-view tan θ of the wheel centre's path; + pushes the wheel down)"),
+    ("drive_anti_pitch_pct", "%", "front: anti-lift, rear: anti-squat (SAE J670), the share of the load transfer "
+                                  "h/L under drive the linkage carries, this axle driving alone at its wheel centres "
+                                  "(inboard drive shafts)"),
 )
 
 #: The front axle's metrics of the steering sweep and of its steering axis at design (none for the rear).
@@ -82,12 +87,14 @@ TEST_METRICS = {
     "lateral": ("lateral_force_compliance_steer_deg_per_kn", "lateral_force_compliance_camber_deg_per_kn",
                 "lateral_compliance_mm_per_kn", "roll_centre_height_force_mm"),
     "longitudinal": ("longitudinal_compliance_steer_deg_per_kn", "braking_pad_fz_ratio"),
+    "drive": ("drive_pad_fz_ratio",),
     "aligning": ("aligning_torque_compliance_steer_deg_per_knm",),
 }
 
 
 #: One leg of a triangle: ``leg(quantity, corner)`` is that quantity's samples on the leg (SI;
-#: quantities of :data:`elastokin.analysis.kc_test.WHEEL_QUANTITIES`, corners of
+#: quantities of :data:`elastokin.analysis.kc_test.WHEEL_QUANTITIES` and the tests' inputs ``rack``
+#: and ``centre_fx``, :func:`elastokin.analysis.kc_test.rig_leg`; corners of
 #: ``elastokin.vehicle.model.definition.CORNERS``). Rig samples and recorded runs both provide legs, so that
 #: both use the definitions below.
 Leg = Callable[[str, str], np.ndarray]
@@ -156,6 +163,8 @@ def triangle_metrics(test: str, axle: str, down: Leg, up: Leg, window: float, ba
     if test == "longitudinal":
         return {"longitudinal_compliance_steer_deg_per_kn": -1e3 * each("pad_fx", "toe"),
                 "braking_pad_fz_ratio": -each("pad_fx", "pad_fz", same)}
+    if test == "drive":
+        return {"drive_pad_fz_ratio": each("centre_fx", "pad_fz", same)}
     if test == "aligning":
         return {"aligning_torque_compliance_steer_deg_per_knm": 1e3 * slope(lambda g: g("pad_mz", L), steer)}
     raise ValueError(f"unknown K&C test {test!r}; expected one of {', '.join(t.name for t in TESTS)}")
@@ -174,7 +183,8 @@ class CarFigures:
 def car_metrics(axles: dict[str, dict[str, float]], car: CarFigures) -> dict[str, dict[str, float]]:
     """``axles`` (each axle's :func:`triangle_metrics` of every test) with the metrics that need
     both axles or the car (:data:`METRICS`): each axle's share of the roll stiffness, its ride
-    rate (left out without a tyre stiffness) and its anti-dive (front) or anti-lift (rear)."""
+    rate (left out without a tyre stiffness), its anti-dive (front) or anti-lift (rear) under
+    braking and its anti-lift (front) or anti-squat (rear) under drive."""
     total_roll = sum(m["roll_stiffness_nm_per_deg"] for m in axles.values())
     out = {}
     for axle, m in axles.items():
@@ -182,7 +192,11 @@ def car_metrics(axles: dict[str, dict[str, float]], car: CarFigures) -> dict[str
                  # a linkage pushing its wheel down under braking (pad Fz up) pushes the body up:
                  # anti-dive at the front, pro-lift at the rear
                  "braking_anti_pitch_pct": (1.0 if axle == "front" else -1.0) * 100.0 * m["braking_pad_fz_ratio"]
-                                           * car.wheelbase_m / car.cg_height_m}
+                                           * car.wheelbase_m / car.cg_height_m,
+                 # under drive the load moves the other way: pushing the wheel down is anti-squat at the
+                 # rear, pro-lift at the front
+                 "drive_anti_pitch_pct": (-1.0 if axle == "front" else 1.0) * 100.0 * m["drive_pad_fz_ratio"]
+                                         * car.wheelbase_m / car.cg_height_m}
         if car.tyre_vertical_stiffness_n_per_m is not None:
             tyre = 1e-3 * car.tyre_vertical_stiffness_n_per_m
             extra["ride_rate_n_per_mm"] = 1.0 / (1.0 / m["wheel_rate_n_per_mm"] + 1.0 / tyre)

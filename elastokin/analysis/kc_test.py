@@ -8,7 +8,7 @@ from typing import Callable, Mapping
 
 import numpy as np
 
-from elastokin.vehicle.model.definition import VehicleDefinition
+from elastokin.vehicle.model.definition import CORNERS, VehicleDefinition
 from elastokin.vehicle.model.elements import BuildOptions
 from elastokin.vehicle.model.statics import cg_height
 from elastokin.vehicle.scenarios.channels import AXLES
@@ -35,10 +35,12 @@ WHEEL_QUANTITIES: dict[str, Callable[[WheelOutputs], float]] = {
 
 def rig_leg(samples: list[RigOutputs], test: Triangle | None = None) -> Leg:
     """The :data:`Leg` of samples measured on the rig; with the ``test`` that made them, its input
-    as quantity ``rack`` (the rack displacement [m], at the samples' times)."""
+    at the samples' times as quantity ``rack`` (the rack displacement [m]) and ``centre_fx`` (the
+    force Fx at each wheel centre [N]: a test at the centres' input, else 0)."""
     def leg(quantity: str, corner: str) -> np.ndarray:
-        if quantity == "rack" and test is not None:
-            return np.array([triangle_input(test, o.time) for o in samples])
+        if quantity in ("rack", "centre_fx") and test is not None:
+            scale = 1.0 if quantity == "rack" else (test.at == "centre") * test.pattern[CORNERS.index(corner)]
+            return scale * np.array([triangle_input(test, o.time) for o in samples])
         return np.array([WHEEL_QUANTITIES[quantity](o.wheels[corner]) for o in samples])
     return leg
 

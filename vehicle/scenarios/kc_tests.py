@@ -12,11 +12,15 @@ bump      pad heights in phase (bump +)            25 mm         25 mm/s (≈ th
 roll      pads in opposite phase, right up         25 mm         25 mm/s                 5 s
 lateral   Fy at the contact points, +y (left)      2 kN/wheel    2 kN/s                  5 s
 longit.   Fx at the contact points, −x (braking)   1.5 kN/wheel  2 kN/s                  3.75 s
+drive     Fx at the wheel centres, +x (driving)    1.5 kN/wheel  2 kN/s                  3.75 s
 aligning  Mz about the vertical, +z (to the left)  150 N·m       200 N·m/s               3.75 s
 steering  rack displacement, +y (to the left)      40 mm         40 mm/s                 5 s
 ========  ======================================  ============  ======================  =========
 
-The steering sweep (:data:`STEERING`) runs on the front axle's rack alone, pads held at design.
+The braking test pushes the pads' carriages (the contact points: outboard brakes, the wheels
+braked); the drive test pushes the wheels at their centres with the carriages free fore and aft,
+as inboard drive shafts do (their torque reacted by the body). The steering sweep
+(:data:`STEERING`) runs on the front axle's rack alone, pads held at design.
 """
 
 from __future__ import annotations
@@ -36,6 +40,7 @@ class Triangle:
     pattern: tuple[float, float, float, float]   #: per corner (order of CORNERS), times the amplitude; the rack: its first
     amplitude: float         #: [m, N or N·m]
     rate: float              #: [m/s, N/s or N·m/s]
+    at: str = "contact"      #: where Fx and Fy push: ``"contact"`` (the contact points) or ``"centre"`` (the wheel centres)
 
 
 TESTS = (
@@ -43,6 +48,7 @@ TESTS = (
     Triangle("roll", "pads", (-1, 1, -1, 1), 0.025, 0.025),
     Triangle("lateral", "fy", (1, 1, 1, 1), 2000.0, 2000.0),
     Triangle("longitudinal", "fx", (-1, -1, -1, -1), 1500.0, 2000.0),
+    Triangle("drive", "fx", (1, 1, 1, 1), 1500.0, 2000.0, at="centre"),
     Triangle("aligning", "mz", (1, 1, 1, 1), 150.0, 200.0),
 )
 TEST = {t.name: t for t in TESTS}   #: the tests by name

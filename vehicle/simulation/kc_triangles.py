@@ -21,9 +21,9 @@ def run_triangle(rig: KCRig, test: Triangle) -> tuple[list[RigOutputs], list[Rig
     if test.input == "rack":
         peak, zero = peak[0], 0.0
     leg = test.amplitude / test.rate
-    rig.ramp(leg, 0, **{test.input: (zero, peak)})
-    down = rig.ramp(2 * leg, SAMPLES_PER_LEG, **{test.input: (peak, -peak)})
-    up = rig.ramp(2 * leg, SAMPLES_PER_LEG, **{test.input: (-peak, peak)})
+    rig.ramp(leg, 0, at=test.at, **{test.input: (zero, peak)})
+    down = rig.ramp(2 * leg, SAMPLES_PER_LEG, at=test.at, **{test.input: (peak, -peak)})
+    up = rig.ramp(2 * leg, SAMPLES_PER_LEG, at=test.at, **{test.input: (-peak, peak)})
     return down, up
 
 

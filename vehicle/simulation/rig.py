@@ -107,11 +107,12 @@ class KCRig(MountedCar):
             raise ValueError(f"expected rig inputs of shape (steps, {_NO_INPUTS.shape[1]}), got {inputs.shape}")
         self._run(len(inputs), inputs, _ALL_ACTIVE)
 
-    def _run(self, n: int, inputs: np.ndarray, active: np.ndarray) -> None:
-        """``n`` compiled steps (elastokin.vehicle.simulation.stepping.run) with ``inputs`` and ``active`` as it documents."""
+    def _run(self, n: int, inputs: np.ndarray, active: np.ndarray, force_body: np.ndarray | None = None) -> None:
+        """``n`` compiled steps (elastokin.vehicle.simulation.stepping.run) with ``inputs`` and ``active`` as it
+        documents, Fx and Fy pushing ``force_body`` (default: the pads' carriages, at the contact points)."""
         m, d = self.model, self.data
         self._timed(stepping.run, n, inputs, active, m.eq_data, self.pad_eq, self.rack_eq, d.xfrc_applied,
-                    self.carriage_body, self.wheel_body, self._efc_force, self._pad_row, self.pad_force, m._address,
+                    self.carriage_body if force_body is None else force_body, self.wheel_body, self._efc_force, self._pad_row, self.pad_force, m._address,
                     d._address, m.opt.timestep,
                     *self.coupling.kernel_arrays())
 
@@ -124,14 +125,19 @@ class KCRig(MountedCar):
         return self.ramp(duration, samples, pads=(start, end))
 
     def ramp(self, duration: float, samples: int = 0, pads=None, fx=None, fy=None, mz=None,
-             rack=None) -> list[RigOutputs]:
+             rack=None, at: str = "contact") -> list[RigOutputs]:
         """Move inputs linearly over ``duration`` [s], measuring every ⌊steps/samples⌋ steps.
 
         Each input given is a (start, end) pair of four values (order of ``CORNERS``): ``pads``
-        contact-point displacements [m], ``fx``/``fy`` contact-point forces [N], ``mz`` aligning
-        torques [N·m]; ``rack`` a (start, end) pair of rack displacements [m, to the left]; inputs
-        not given are held.
+        contact-point displacements [m], ``fx``/``fy`` forces [N] at the contact points (``at``
+        ``"contact"``: the pads' carriages) or at the wheel centres (``"centre"``: the wheels, the
+        carriages free, as a drive shaft pushes), ``mz`` aligning torques [N·m]; ``rack`` a (start,
+        end) pair of rack displacements [m, to the left]; inputs not given are held. Raises
+        ValueError for another ``at``.
         """
+        bodies = {"contact": self.carriage_body, "centre": self.wheel_body}
+        if at not in bodies:
+            raise ValueError(f"forces at {at!r}; expected one of {', '.join(bodies)}")
         h = self.model.opt.timestep
         n = max(1, int(round(duration / h)))
         every = max(1, n // samples) if samples else n + 1
@@ -145,7 +151,7 @@ class KCRig(MountedCar):
         while done < n:
             k = min(every - done % every, n - done)
             f = (done + np.arange(1, k + 1)) / n
-            self._run(k, start + (end - start) * f[:, None], active)
+            self._run(k, start + (end - start) * f[:, None], active, bodies[at])
             done += k
             if done % every == 0:
                 out.append(self.measure())

@@ -109,13 +109,14 @@ def coupling_step(h, qpos, qvel, qfrc, ten_length, ten_velocity, ten_J, ten_J_ro
 
 
 @nb.njit(cache=True)
-def _run(mj_step, n, inputs, active, eq_data, pad_eq, rack_eq, xfrc, carriage, wheel, efc_force, pad_row, pad_force,
+def _run(mj_step, n, inputs, active, eq_data, pad_eq, rack_eq, xfrc, force_body, wheel, efc_force, pad_row, pad_force,
          m_addr, d_addr, h, qpos, qvel, qfrc, ten_length, ten_velocity, ten_J, ten_J_rowadr, ten_J_rownnz, ten_J_colind,
          jnt_stiffness, dof_damping, tendon_damping, bush, bank, cross, damp, spring):
     """Advance ``n`` steps, row i of ``inputs`` set before step i (none if ``inputs`` has no rows).
 
     A row holds the rig inputs in the order of ``elastokin.vehicle.scenarios.channels.INPUT_CHANNELS`` (17 values):
-    pad heights [m], Fx, Fy [N] at the carriages, Mz [N·m] at the wheels, four corners each, then
+    pad heights [m], Fx, Fy [N] on ``force_body`` (the carriages: at the contact points; or the
+    wheels: at their centres), Mz [N·m] at the wheels, four corners each, then
     the rack [m]; ``active[g]`` says whether group g (pads, Fx, Fy, Mz, rack) is driven (else left
     as is). After each step ``pad_force`` holds the force of each pad's drive row (``pad_row``) in
     that step, the force that moved the car to the new state: a later ``mj_forward`` recomputes the
@@ -131,9 +132,9 @@ def _run(mj_step, n, inputs, active, eq_data, pad_eq, rack_eq, xfrc, carriage, w
                 if active[0]:
                     eq_data[pad_eq[c], 0] = u[c]
                 if active[1]:
-                    xfrc[carriage[c], 0] = u[4 + c]
+                    xfrc[force_body[c], 0] = u[4 + c]
                 if active[2]:
-                    xfrc[carriage[c], 1] = u[8 + c]
+                    xfrc[force_body[c], 1] = u[8 + c]
                 if active[3]:
                     xfrc[wheel[c], 5] = u[12 + c]
             if active[4]:
