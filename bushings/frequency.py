@@ -16,6 +16,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.optimize import brentq
 
 from elastokin.bushings.bank import BushingBank
 from elastokin.bushings.parameters import ChannelParams
@@ -102,6 +103,44 @@ def lossier(channel: ChannelParams, amplitude_m: float, frequency_hz: float, fac
     if k0 < 0.0:
         raise ValueError(f"Kpa × {factor:g} alone makes |K*| above the law's {target:.4g} N/m: no K0 keeps it")
     return stiffened.replace(K0=k0)
+
+
+def with_loss(channel: ChannelParams, tan_delta: float, amplitude_m: float, frequency_hz: float,
+              max_factor: float = 50.0) -> ChannelParams:
+    """``channel`` made lossier (:func:`lossier`) until its tan δ at (``amplitude_m``,
+    ``frequency_hz``) is ``tan_delta``, its |K*| there kept: a part of the same rate in a compound of
+    the stated loss (PSA specifies tan δ at 15 Hz, 1 mm: Bourgeteau 2009, §2.1.1).
+
+    Args:
+        channel: a ladder law (SI) whose elastic part is linear.
+        tan_delta: the loss wanted, at least the law's own.
+        amplitude_m: sine amplitude [m]; frequency_hz: its frequency [Hz].
+        max_factor: the stiffest ladder tried, × the law's own Kpa.
+
+    Returns:
+        The law with Kpa × f and K0 lowered (SI), f found to a relative 1e-6.
+
+    Raises:
+        ValueError: when ``tan_delta`` is below the law's own loss, or beyond what a ladder
+            ``max_factor`` times as stiff gives (or than a K0 ≥ 0 allows).
+    """
+    at = (np.array([amplitude_m]), np.array([frequency_hz]))
+
+    def loss(factor: float) -> float:
+        k = first_harmonic(lossier(channel, amplitude_m, frequency_hz, factor), *at).k_complex_n_per_m[0]
+        return float(k.imag / k.real) - tan_delta
+
+    own = loss(1.0) + tan_delta
+    if tan_delta < own:
+        raise ValueError(f"tan δ {tan_delta:g} is below the law's own {own:.4g}: a lossier law cannot give it")
+    where = f"at {amplitude_m * 1e3:g} mm, {frequency_hz:g} Hz"
+    try:
+        most = loss(max_factor) + tan_delta
+    except ValueError as exc:   # the ladder that stiff leaves no K0 ≥ 0: try a smaller max_factor
+        raise ValueError(f"tan δ {tan_delta:g} {where}: a ladder {max_factor:g} × as stiff is refused ({exc})") from None
+    if tan_delta > most:
+        raise ValueError(f"tan δ {tan_delta:g} is beyond a ladder {max_factor:g} × as stiff (it gives {most:.4g}) {where}")
+    return lossier(channel, amplitude_m, frequency_hz, brentq(loss, 1.0, max_factor, xtol=1e-9, rtol=1e-6))
 
 
 def equivalent_damping(channel: ChannelParams, amplitudes_m: np.ndarray, frequencies_hz: np.ndarray, *,

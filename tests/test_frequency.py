@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from elastokin.bushings import BushingBank, load_parameter_set, to_si
-from elastokin.bushings.frequency import equivalent_damping, first_harmonic, harmonic_ratio, lossier, rate_scaled
+from elastokin.bushings.frequency import (equivalent_damping, first_harmonic, harmonic_ratio, lossier, rate_scaled,
+                                         with_loss)
 from elastokin.core.errors import InputError
 
 MM = 1e-3
@@ -129,3 +130,18 @@ def test_a_lossier_law_is_refused_where_k0_is_no_parallel_spring():
         lossier(load_parameter_set("fig5_9_progressive").channel(), 0.2e-3, 0.1)
     with pytest.raises(ValueError, match="no K0 keeps it"):
         lossier(load_parameter_set("fig5_9").channel(), 1e-6, 0.1, 50.0)   # sliders stuck: K* ≈ K0 + Kpa
+
+
+def test_a_law_made_as_lossy_as_stated_keeps_its_dynamic_stiffness():
+    """frequency.with_loss: the lossier law whose tan δ at the stated point is the one asked, its |K*|
+    there the law's own; a loss below the law's own, or beyond any ladder, is refused."""
+    law = load_parameter_set("fig5_9").channel()
+    at = (np.array([1 * MM]), np.array([15.0]))
+    before = first_harmonic(law, *at)
+    made = first_harmonic(with_loss(law, 0.30, 1 * MM, 15.0), *at)
+    assert made.tan_delta[0] == pytest.approx(0.30, abs=1e-5)
+    assert made.k_dyn_n_per_m[0] == pytest.approx(before.k_dyn_n_per_m[0], rel=1e-9)
+    with pytest.raises(ValueError, match="below the law's own"):
+        with_loss(law, 0.5 * before.tan_delta[0], 1 * MM, 15.0)
+    with pytest.raises(ValueError, match="beyond a ladder"):
+        with_loss(law, 0.9, 1 * MM, 15.0)
