@@ -87,7 +87,7 @@ def bench_rows() -> list[str]:
     ]
 
 
-def _span(low: float, high: float) -> str:
+def span(low: float, high: float) -> str:
     """``low``–``high`` to three decimals, or one number when they print alike."""
     a, b = f"{low:.3f}", f"{high:.3f}"
     return a if a == b else f"{a}–{b}"
@@ -116,7 +116,7 @@ def car_rows(deflection_ratios: tuple[float, float], rt_thicker_pct: tuple[float
              f"{thinning_pct:+.0f} % from 1.5 to 15 mm/s", "agrees; the dampers thin it",
              f"`{held}::test_the_camber_loop_thins_with_the_pumping_speed_through_the_dampers`"),
         _row("the car's bushings: a high loss angle, tan δ ≈ 0.3", "§4.4, §4.4.1",
-             f"the thesis car's 18 STVS laws: {_span(*thesis_car_loss)} (15 Hz, 1 mm); "
+             f"the thesis car's 18 STVS laws: {span(*thesis_car_loss)} (15 Hz, 1 mm); "
              f"the default car's front ladder laws: {loss_range[0]:.3f}–{loss_range[1]:.3f} (0.2 mm, 0.1 Hz)",
              "the thesis car meets it; the default car is not the thesis's",
              "`tests/test_thesis_car.py`, `tests/test_measured_figures.py::test_the_default_cars_ladder_laws_are_less_lossy_than_the_thesis_car`"),

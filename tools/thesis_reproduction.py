@@ -532,7 +532,7 @@ def _thesis_car_section(r: dict) -> list[str]:
         "the three principal directions of E1 and E2 front and E1 rear (18 models), identified on a part of "
         "tan δ 0.3 (§4.4.1). `models/vehicles/c_segment_thesis.yaml` (written by `tools/thesis_car.py`) is the "
         "default car with each of those directions' laws read as STVS (fig. 5.9's shape at the direction's own "
-        f"K0; tan δ {family:.3f} at 15 Hz, 1 mm) made lossier to tan δ {thesis_numbers._span(low, high)} there, PSA's "
+        f"K0; tan δ {family:.3f} at 15 Hz, 1 mm) made lossier to tan δ {thesis_numbers.span(low, high)} there, PSA's "
         "specification point (§2.1.1), with |K*| there kept; the rotations keep the default car's linear laws. "
         "The same experiments on both, the default car with STVS everywhere (`--bushing-model stvs`), the "
         "thesis car with its own laws:",

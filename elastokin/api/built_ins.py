@@ -52,7 +52,7 @@ def built_ins() -> dict[str, list[str]]:
 
     >>> import elastokin
     >>> elastokin.built_ins()["vehicles"]
-    ['c_segment']
+    ['c_segment', 'c_segment_thesis']
     >>> "road/step_steer" in elastokin.built_ins()["scenarios"]
     True
     """
