@@ -300,6 +300,10 @@ def report(r: dict, files: dict[str, str]) -> str:
     bent_rear_free = [r["speeds_stvs_bending_no_dampers"][c]["camber_rr_loop_deg"] for c in (1, 2, 3)]
     rigid_range, bent_range = (r[label][1]["camber_rr_range_deg"] for label in ("speeds_stvs", "speeds_stvs_bending"))
     stvs_fl = [r["speeds_stvs"][c]["camber_fl_loop_deg"] for c in (1, 2, 3)]
+    # RT's camber loop against STVS's at 1.5 mm/s [%], figs. 5.8-5.9 as the captions and as the equations read them
+    rt_thicker = tuple(100 * (r[f"{reading}speeds_rt"][1]["camber_fl_loop_deg"]
+                              / r[f"{reading}speeds_stvs"][1]["camber_fl_loop_deg"] - 1) for reading in ("", "equations_"))
+    thesis_loss = thesis_car_loss()
     file_loss = [loss[d][0][0] for d in FRONT_LADDERS]
     lines = [
         "# The thesis's vehicle-level phenomena, reproduced",
@@ -318,9 +322,8 @@ def report(r: dict, files: dict[str, str]) -> str:
         "",
         *thesis_numbers.HEADER,
         *thesis_numbers.bench_rows(),
-        *thesis_numbers.car_rows((pp[2] / pp[0], pp[2] / pp[1]), tuple(
-            100 * (r[f"{reading}speeds_rt"][1]["camber_fl_loop_deg"] / r[f"{reading}speeds_stvs"][1]["camber_fl_loop_deg"] - 1)
-            for reading in ("", "equations_")), 100 * (stvs_fl[2] / stvs_fl[0] - 1), (min(file_loss), max(file_loss)), thesis_car_loss()),
+        *thesis_numbers.car_rows((pp[2] / pp[0], pp[2] / pp[1]), rt_thicker, 100 * (stvs_fl[2] / stvs_fl[0] - 1),
+                                 (min(file_loss), max(file_loss)), thesis_loss),
         "",
         "## Fig. 4.28 — the E1 rear bushing follows the pumping triangle",
         "",
@@ -357,7 +360,7 @@ def report(r: dict, files: dict[str, str]) -> str:
         "same bench loops), so at quasi-static speeds they dissipate nearly the same energy per cycle; the "
         "thesis's RT was identified separately and gives no number to compare. With the sets as the equations "
         "read figs. 5.8–5.9 (below, \"Figs. 5.8–5.9 read two ways\"), RT's loop is "
-        f"{100 * (r['equations_speeds_rt'][1]['camber_fl_loop_deg'] / r['equations_speeds_stvs'][1]['camber_fl_loop_deg'] - 1):.0f} % "
+        f"{rt_thicker[1]:.0f} % "
         "thicker: the thesis's clear difference.",
         "",
         "## Fig. 4.30 — the camber loop against the pumping speed",
@@ -449,7 +452,7 @@ def report(r: dict, files: dict[str, str]) -> str:
         "",
         *_readings_section(r),
         "",
-        *_thesis_car_section(r),
+        *_thesis_car_section(r, thesis_loss),
     ]
     return "\n".join(lines)
 
@@ -507,11 +510,11 @@ def _change(new: float, old: float) -> str:
     return f"{100.0 * (new / old - 1.0):+.0f} %"
 
 
-def _thesis_car_section(r: dict) -> list[str]:
-    """The report's section on the thesis's car: chapter 4's experiments on it beside the default car."""
+def _thesis_car_section(r: dict, loss: tuple[float, float]) -> list[str]:
+    """The report's section on the thesis's car: chapter 4's experiments on it beside the default car
+    (``loss``: :func:`thesis_car_loss`)."""
     at = (np.array([1e-3]), np.array([15.0]))
     family = float(first_harmonic(load_parameter_set("fig5_9").channel(), *at).tan_delta[0])
-    low, high = thesis_car_loss()
     pp = {car: [r[label][c]["e1_rear_z_pp_mm"] for c in sorted(r[label])]
           for car, label in (("default", "pumping_stvs"), ("thesis", "thesis_car_pumping"))}
     cam = {car: [r[label][c]["camber_fl_loop_deg"] for c in (1, 2, 3)]
@@ -522,8 +525,7 @@ def _thesis_car_section(r: dict) -> list[str]:
     rack = {car: r[label][1] for car, label in (("default", "rack_stvs_slow"), ("thesis", "thesis_car_rack_slow"))}
     double = {(car, way): r[f"{prefix}double_{way}{suffix}_slow"][1] for car, prefix, suffix in
               (("default", "", "_stvs"), ("thesis", "thesis_car_", "")) for way in ("same", "opposite")}
-    forces = [toe["lateral_file"], toe["lateral_part_fig5_6"]]
-    part = [100.0 * (b / a - 1.0) for a, b in zip(*forces)]
+    part = [100.0 * (b / a - 1.0) for a, b in zip(toe["lateral_file"], toe["lateral_part_fig5_6"])]
     thicker = all(t > d for t, d in zip(cam["thesis"], cam["default"]))
     return [
         "## The thesis's car: lossy STVS on its 18 principal directions (§4.4)",
@@ -532,7 +534,7 @@ def _thesis_car_section(r: dict) -> list[str]:
         "the three principal directions of E1 and E2 front and E1 rear (18 models), identified on a part of "
         "tan δ 0.3 (§4.4.1). `models/vehicles/c_segment_thesis.yaml` (written by `tools/thesis_car.py`) is the "
         "default car with each of those directions' laws read as STVS (fig. 5.9's shape at the direction's own "
-        f"K0; tan δ {family:.3f} at 15 Hz, 1 mm) made lossier to tan δ {thesis_numbers.span(low, high)} there, PSA's "
+        f"K0; tan δ {family:.3f} at 15 Hz, 1 mm) made lossier to tan δ {thesis_numbers.span(*loss)} there, PSA's "
         "specification point (§2.1.1), with |K*| there kept; the rotations keep the default car's linear laws. "
         "The same experiments on both, the default car with STVS everywhere (`--bushing-model stvs`), the "
         "thesis car with its own laws:",
