@@ -19,7 +19,7 @@ class BankState:
     arrays: dict[str, np.ndarray]
 
 
-#: Default solver tolerance [m or rad]: ladder nodes placed to 10 nm (fig5_9's sliders stretch 3 µm
+#: Default solver tolerance [m or rad]: ladder nodes placed to 10 nm (fig5_9_caption's sliders stretch 3 µm
 #: before slipping). On the benchmark's load at h = 1 ms (tools/benchmarks/bushing_speed.py) it moves the force
 #: by 0.05 N, a 28th of the time step's own error (1.4 N); 1e-9 m would cost 8 % more time.
 DEFAULT_TOLERANCE = 1e-8

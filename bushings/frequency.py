@@ -70,7 +70,7 @@ def first_harmonic(channel: ChannelParams, amplitudes_m: np.ndarray, frequencies
     common shape. Every pair is one channel of a single bank, stepped in time normalised by its
     own period (see :func:`rate_scaled`), so all pairs share one grid of n samples per cycle with
     n ≥ ``points_per_cycle`` (and a real step ≤ ``max_dt_s`` at the lowest frequency if given).
-    The ladder laws have no time scale of their own, so n alone sets the accuracy: for ``fig5_9``
+    The ladder laws have no time scale of their own, so n alone sets the accuracy: for ``fig5_9_caption``
     n = 400 and n = 2000 agree to 0.05 % in |K*| and 0.5 % in tan δ. Backward Euler's phase
     error makes tan δ of a linear damper low by about (π/n)·tan δ relative.
     """

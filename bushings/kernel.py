@@ -145,7 +145,7 @@ def _pow(x, p):
     loop that calls it: the power law's exp and log calls were most of the solver's cost. The
     series stop at 1e-9 rather than at round-off: each term kept is an operation on every node in
     every pass, and a power-law force of 100 N then errs by 1e-7 N, far below the solver's force
-    tolerance (tolerance·(Kpa + 2·Kr): 0.07 N for fig5_9 at the bank's default tolerance).
+    tolerance (tolerance·(Kpa + 2·Kr): 0.07 N for fig5_9_caption at the bank's default tolerance).
     """
     tiny = x < 2.0 ** -900
     x = x * 2.0 ** 200 if tiny else x

@@ -112,7 +112,7 @@ def test_csv_errors_name_file_line_and_column(tmp_path, text, message):
 
 # --- bench validation -------------------------------------------------------------------------
 
-GOOD = {"model": "stvs", "params": "fig5_9", "dt_s": 0.001,
+GOOD = {"model": "stvs", "params": "fig5_9_caption", "dt_s": 0.001,
         "programme": {"type": "sine", "amplitude_mm": 0.5, "frequency_hz": 10, "cycles": 2}}
 INLINE = {"K0": 508.2, "Kpa": 1076.7, "Kr": 2935, "Ff": 9, "Co": 32, "pw": 0.15}
 

@@ -132,7 +132,7 @@ def _step(rise_s: float, hold_s: float, amp_m: float, dt: float) -> np.ndarray:
     return np.minimum(t / rise_s, 1.0) * amp_m
 
 
-@pytest.mark.parametrize("name", ["fig5_8", "fig5_9"])
+@pytest.mark.parametrize("name", ["fig5_8_caption", "fig5_9_caption"])
 def test_relaxation_after_step_is_monotonic_and_faster_rise_peaks_higher(name):
     ch = channel(name)
     dt = 1e-3
@@ -165,7 +165,7 @@ def test_stvs_limits_are_sts_and_rt():
     np.testing.assert_allclose(stvs_rt, rt, rtol=0, atol=1e-9)
 
 
-@pytest.mark.parametrize("name", ["fig3_14", "fig5_8", "fig5_9"])
+@pytest.mark.parametrize("name", ["fig3_14", "fig5_8_caption", "fig5_9_caption"])
 def test_dissipation_over_a_closed_cycle_equals_element_losses(name):
     ch = channel(name)
     dt = 1e-5
@@ -182,7 +182,7 @@ def test_dissipation_over_a_closed_cycle_equals_element_losses(name):
 
 
 def test_implicit_converges_to_explicit_reference_at_least_linearly():
-    ch = channel("fig5_9")
+    ch = channel("fig5_9_caption")
     h0 = 5e-5
     t = np.arange(0.0, 0.6 + h0 / 2, h0)
     e = 1e-3 * np.sin(2 * np.pi * t) + 0.2e-3 * np.sin(2 * np.pi * 10 * t)
@@ -200,7 +200,7 @@ def test_default_solver_tolerance_errs_far_less_than_the_time_step():
     """At h = 1 ms under the benchmark's load, the default tolerance (nodes placed to 10 nm) moves
     the force by less than a fifteenth of the step's own discretisation error, and the solver's
     error shrinks with its tolerance."""
-    ch = channel("fig5_9")
+    ch = channel("fig5_9_caption")
     h, sub = 1e-3, 20
     t = np.arange(0.0, 1.0 + h / (2 * sub), h / sub)
     e = 1e-3 * np.sin(2 * np.pi * t) + 0.2e-3 * np.sin(2 * np.pi * 10 * t)
@@ -214,7 +214,7 @@ def test_default_solver_tolerance_errs_far_less_than_the_time_step():
     assert solver_error[1e-9] < solver_error[1e-8] / 5, solver_error
 
 
-@pytest.mark.parametrize("name", ["fig3_14", "fig5_8", "fig5_9"])
+@pytest.mark.parametrize("name", ["fig3_14", "fig5_8_caption", "fig5_9_caption"])
 @pytest.mark.parametrize("amp_mm,freq_hz", [(0.1, 100.0), (5.0, 1.0)])
 def test_large_steps_are_stable(name, amp_mm, freq_hz):
     ch = channel(name)
@@ -253,10 +253,10 @@ def test_extreme_power_laws_stay_finite_bounded_and_passive(model, values, amp_m
 
 def test_mixed_bank_equals_separate_banks():
     # The long ladders do not fit beside the others in one block of the ladder array.
-    chans = [channel("fig5_9"), channel("fig3_14"), channel("fig5_8"), channel("table3_2"),
+    chans = [channel("fig5_9_caption"), channel("fig3_14"), channel("fig5_8_caption"), channel("table3_2"),
              channel("fig3_14", "sts_continuous"), inline("linear", K0=300.0, C=0.5),
              TVS,
-             replace(channel("fig5_9"), n_cells=150), replace(channel("fig5_8"), n_cells=MAX_CELLS), channel("fig5_8")]
+             replace(channel("fig5_9_caption"), n_cells=150), replace(channel("fig5_8_caption"), n_cells=MAX_CELLS), channel("fig5_8_caption")]
     t = np.arange(0.0, 1.0, 1e-3)
     e = np.stack([(0.5 + 0.2 * i) * MM * np.sin(2 * np.pi * (1 + i) * t) for i in range(len(chans))], axis=1)
     F, K = BushingBank(chans).run(e, 1e-3)
@@ -280,7 +280,7 @@ def test_ladders_are_placed_side_by_side_without_overlap():
 
 
 def test_a_step_with_the_wrong_number_of_deflections_is_refused():
-    bank = BushingBank([channel("fig5_9")] * 3)
+    bank = BushingBank([channel("fig5_9_caption")] * 3)
     bank.step(np.full(3, 0.5 * MM), 1e-3)
     before = bank.snapshot()
     with pytest.raises(ValueError, match="one entry per channel"):
@@ -293,7 +293,7 @@ def test_reset_returns_the_arrays_compiled_callers_hold_to_the_virgin_state():
     """A compiled caller (the vehicle's step loop) keeps the arrays of kernel_args(); after reset()
     the steps it takes with them are those of a new bank (STVS ladder, continuous STS memory,
     Maxwell branches), whereas the same path run on without reset gives other forces."""
-    channels = [channel("fig5_9"), channel("fig3_14", "sts_continuous"), TVS]
+    channels = [channel("fig5_9_caption"), channel("fig3_14", "sts_continuous"), TVS]
     path = np.outer(np.sin(np.linspace(0.0, 3.0 * np.pi, 200)), [1.0, -0.6, 0.8]) * MM
 
     def forces(args: tuple) -> np.ndarray:
@@ -312,7 +312,7 @@ def test_reset_returns_the_arrays_compiled_callers_hold_to_the_virgin_state():
     assert (np.abs(continued - fresh).max(axis=0) > 0.1).all()  # N: every channel remembers the first run
 
 
-@pytest.mark.parametrize("name,model", [("fig5_9", None), ("fig5_8", None), ("fig3_14", None),
+@pytest.mark.parametrize("name,model", [("fig5_9_caption", None), ("fig5_8_caption", None), ("fig3_14", None),
                                         ("table3_2", None), ("fig3_14", "sts_continuous")])
 def test_tangent_is_the_derivative_of_the_step(name, model):
     ch = channel(name, model)

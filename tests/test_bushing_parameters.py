@@ -12,7 +12,7 @@ from elastokin.core.errors import InputError
 
 def test_shipped_sets_load_with_their_source():
     names = available_parameter_sets()
-    assert {"fig3_14", "fig5_6", "fig5_7_lowloss", "fig5_8", "fig5_9", "table3_2"} <= set(names)
+    assert {"fig3_14", "fig5_6", "fig5_7_lowloss", "fig5_8", "fig5_9", "fig5_8_caption", "fig5_9_caption", "table3_2"} <= set(names)
     for name in names:
         pset = load_parameter_set(name)
         assert "Bourgeteau 2009" in pset.source
@@ -20,7 +20,7 @@ def test_shipped_sets_load_with_their_source():
 
 
 def test_thesis_units_convert_to_si_once():
-    ch = load_parameter_set("fig5_9").channel()
+    ch = load_parameter_set("fig5_9_caption").channel()
     assert ch.K0 == pytest.approx(508.2e3) and ch.Kpa == pytest.approx(1076.7e3) and ch.Kr == pytest.approx(2935e3)
     assert ch.Ff == 9.0 and ch.n_cells == 15 and ch.pw == 0.15
     # D = Co·|v|^pw: 32 N at 1 mm/s is 32 N at 1e-3 m/s.
@@ -37,7 +37,7 @@ def test_rotational_sets_use_newton_metres_and_degrees():
 
 
 def test_reading_a_set_as_another_model():
-    stvs = load_parameter_set("fig5_9")
+    stvs = load_parameter_set("fig5_9_caption")
     assert stvs.channel("sts").Co == 0.0 and stvs.channel("sts").Ff == 9.0
     cont = load_parameter_set("fig3_14").channel("sts_continuous")
     assert cont.Ct == pytest.approx(2 * 30.0 * 990e3)

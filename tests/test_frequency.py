@@ -13,8 +13,8 @@ from elastokin.bushings.frequency import (equivalent_damping, first_harmonic, ha
 from elastokin.core.errors import InputError
 
 MM = 1e-3
-STVS = load_parameter_set("fig5_9").channel()
-RT = load_parameter_set("fig5_8").channel()
+STVS = load_parameter_set("fig5_9_caption").channel()
+RT = load_parameter_set("fig5_8_caption").channel()
 STS = load_parameter_set("fig5_6").channel()
 
 
@@ -81,7 +81,7 @@ def test_loss_factor_at_vanishing_frequency_rt_goes_to_zero_stvs_to_the_sts():
     f = 10.0 ** np.array([0.0, -6.0, -12.0, -20.0, -30.0])
     rt = first_harmonic(RT, 0.5 * MM, f, cycles=3).tan_delta
     stvs = first_harmonic(STVS, 0.5 * MM, f, cycles=3).tan_delta
-    sts = first_harmonic(load_parameter_set("fig5_9").channel("sts"), 0.5 * MM, 1.0, cycles=3).tan_delta
+    sts = first_harmonic(load_parameter_set("fig5_9_caption").channel("sts"), 0.5 * MM, 1.0, cycles=3).tan_delta
     assert np.all(np.diff(rt) < 0) and rt[-1] < 2e-3  # measured 0.164 at 1 Hz, 1.1e-3 at 1e-30 Hz
     assert stvs[-1] == pytest.approx(sts, rel=0.01) and sts > 0.1  # measured 0.1232 vs 0.1231
 
@@ -101,10 +101,10 @@ def test_equivalent_damping_stiffness_close_to_time_domain(channel):
 
 def test_equivalent_damping_refuses_the_continuous_sts():
     with pytest.raises(InputError, match="ladder"):
-        equivalent_damping(load_parameter_set("fig5_9").channel("sts_continuous"), 1 * MM, 1.0)
+        equivalent_damping(load_parameter_set("fig5_9_caption").channel("sts_continuous"), 1 * MM, 1.0)
 
 
-@pytest.mark.parametrize("name", ["fig5_9", "fig5_7_lowloss", "fig5_8"])
+@pytest.mark.parametrize("name", ["fig5_9_caption", "fig5_7_lowloss", "fig5_8_caption"])
 def test_a_lossier_law_keeps_its_dynamic_stiffness_and_dissipates_more(name):
     """frequency.lossier: the ladder stiffened, K0 lowered so that |K*| at the given amplitude and
     frequency is the law's own (K0 adds to K* exactly with the deflection imposed); tan δ grows
@@ -129,13 +129,13 @@ def test_a_lossier_law_is_refused_where_k0_is_no_parallel_spring():
     with pytest.raises(ValueError, match="nonlinear elastic part"):
         lossier(load_parameter_set("fig5_9_progressive").channel(), 0.2e-3, 0.1)
     with pytest.raises(ValueError, match="no K0 keeps it"):
-        lossier(load_parameter_set("fig5_9").channel(), 1e-6, 0.1, 50.0)   # sliders stuck: K* ≈ K0 + Kpa
+        lossier(load_parameter_set("fig5_9_caption").channel(), 1e-6, 0.1, 50.0)   # sliders stuck: K* ≈ K0 + Kpa
 
 
 def test_a_law_made_as_lossy_as_stated_keeps_its_dynamic_stiffness():
     """frequency.with_loss: the lossier law whose tan δ at the stated point is the one asked, its |K*|
     there the law's own; a loss below the law's own, or beyond any ladder, is refused."""
-    law = load_parameter_set("fig5_9").channel()
+    law = load_parameter_set("fig5_9_caption").channel()
     at = (np.array([1 * MM]), np.array([15.0]))
     before = first_harmonic(law, *at)
     made = first_harmonic(with_loss(law, 0.30, 1 * MM, 15.0), *at)

@@ -20,6 +20,7 @@ import pytest
 import yaml
 
 import elastokin
+from elastokin.analysis.compare import compare_runs
 from tests.damage_helpers import damaged, damaged_kc_dataset
 from elastokin.bushings.bench.bench_file import load_bench
 from elastokin.bushings.bench.records import read_bench_csv
@@ -189,7 +190,7 @@ def test_a_triangle_faster_than_the_rig_samples_is_refused(tmp_path: Path) -> No
 ])
 def test_a_bench_asking_for_terabytes_is_refused(tmp_path: Path, change: dict, expected: str) -> None:
     data = {**yaml.safe_load((BENCH_DIR / "bisine.yaml").read_text()), **change}
-    data["params"] = "fig5_9"
+    data["params"] = "fig5_9_caption"
     file = tmp_path / "b.yaml"
     file.write_text(yaml.safe_dump(data, sort_keys=False))
     with pytest.raises(InputError, match=expected):
@@ -385,19 +386,19 @@ def chunked_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return output
 
 
-@pytest.mark.parametrize("kind, words, whole", [
-    ("cut_half", [r"recording cut at \d+\.\d s of its 13\.\d s \((no summary section|the file ends inside a record)\): "
-                  r"read as far as it goes"],
-     False),
-    ("inverted", [r"chunk \d+ of \d+ failed its CRC: \d\.\d s missing \(t = \d+\.\d to \d+\.\d s\)"], False),
-    ("cut_last_byte", [r"its summary section is cut \(the file ends inside a record\); its data is whole"], True),
-])
-def test_a_damaged_recording_is_said_damaged_by_every_reader(chunked_run: Path, tmp_path: Path, capsys, kind, words,
-                                                            whole) -> None:
-    """Cut short, 64 bytes inverted, its summary cut: read as far as it goes, the part missing said on
-    stderr by plot, view, compare, in the run (reason, damage) and the comparison; --strict refuses it."""
+#: Damage kinds: the words the reading says, and whether the data is whole.
+DAMAGE = {"cut_half": ([r"recording cut at \d+\.\d s of its 13\.\d s \((no summary section|the file ends inside a record)\): "
+                       r"read as far as it goes"], False),
+          "inverted": ([r"chunk \d+ of \d+ failed its CRC: \d\.\d s missing \(t = \d+\.\d to \d+\.\d s\)"], False),
+          "cut_last_byte": ([r"its summary section is cut \(the file ends inside a record\); its data is whole"], True)}
+
+
+def _read_damaged(chunked_run: Path, folder: Path, kind: str) -> tuple[Path, str]:
+    """The run damaged as ``kind``, read: what is read is the original's, less what the warning says
+    missing; returns the damaged file and the warning."""
+    words, whole = DAMAGE[kind]
     original = load_run(chunked_run)
-    path = damaged(chunked_run, tmp_path, kind)
+    path = damaged(chunked_run, folder, kind)
     with pytest.warns(UserWarning) as said:
         run = load_run(path)
     message = str(said[0].message)
@@ -405,10 +406,37 @@ def test_a_damaged_recording_is_said_damaged_by_every_reader(chunked_run: Path, 
     assert run.complete == whole and run.damage == (message.removeprefix(f"{path}: "),)
     if whole:
         assert np.array_equal(run.t_s, original.t_s)
-    else:   # what is read is the original's, less what is said missing
+    else:
         assert 0 < len(run.t_s) < len(original.t_s) and np.all(np.isin(run.t_s, original.t_s))
         kept = np.isin(original.t_s, run.t_s)
         assert np.array_equal(run.signals["camber_fl"], original.signals["camber_fl"][kept])
+    with pytest.raises(InputError, match="damaged"):
+        elastokin.load_run(path, strict=True)
+    return path, message
+
+
+@pytest.mark.parametrize("kind", DAMAGE)
+def test_a_damaged_recording_is_read_as_far_as_it_goes_and_said_damaged(chunked_run: Path, tmp_path: Path,
+                                                                        kind) -> None:
+    """Cut short, 64 bytes inverted, its summary cut: read as far as it goes, the reason and the part
+    missing said in a warning and in the run and, for a run whose data is whole, in its comparison
+    with the original; a strict reading refuses it."""
+    path, message = _read_damaged(chunked_run, tmp_path, kind)
+    if DAMAGE[kind][1]:
+        with pytest.warns(UserWarning):
+            damaged_run = load_run(path)
+        assert compare_runs(damaged_run, load_run(chunked_run)).to_json()["damage"] == {
+            str(path): [message.removeprefix(f"{path}: ")]}
+
+
+# plot and compare draw some 50 figures (30 s on a core): every damage in the slow stage
+@pytest.mark.parametrize("kind", ["cut_half", *(pytest.param(k, marks=pytest.mark.slow) for k in DAMAGE
+                                                if k != "cut_half")])
+def test_a_damaged_recording_is_said_damaged_by_every_reader(chunked_run: Path, tmp_path: Path, capsys,
+                                                            kind) -> None:
+    """The damage said on stderr by plot, view, compare and in the comparison; --strict refuses it."""
+    path, message = _read_damaged(chunked_run, tmp_path, kind)
+    compared = True
     for argv in (["plot", str(path), "-o", str(tmp_path / "p")], ["view", str(path), "--save", str(tmp_path / "v.rrd")],
                  ["compare", str(path), str(chunked_run), "-o", str(tmp_path / "c")]):
         code, err = _vsim(capsys, *argv)
@@ -421,8 +449,6 @@ def test_a_damaged_recording_is_said_damaged_by_every_reader(chunked_run: Path, 
     if compared:
         comparison = json.loads((tmp_path / "c" / "comparison.json").read_text())
         assert comparison["damage"] == {str(path): [message.removeprefix(f"{path}: ")]}
-    with pytest.raises(InputError, match="damaged"):
-        elastokin.load_run(path, strict=True)
 
 
 def test_a_recording_cut_before_its_first_sample_is_refused_by_plot_and_view(chunked_run: Path, tmp_path: Path,
@@ -441,7 +467,7 @@ def test_a_kc_dataset_with_a_damaged_recording_is_refused_unless_asked(tmp_path:
     assert code == 2 and re.search(r"rig\.yaml: recordings\[1\]: 02_kc_roll\.mcap is incomplete \(chunk 4 of 6 failed "
                                    r"its CRC: [\d.]+ s missing \(t = [\d.]+ to [\d.]+ s\)\); --use-damaged", err), err
     assert "vsim: warning: " in err and "Traceback" not in err
-    code, err = _vsim(capsys, "diagnose", "bench", "--bushing-set", "fig5_9", "--use-damaged")
+    code, err = _vsim(capsys, "diagnose", "bench", "--bushing-set", "fig5_9_caption", "--use-damaged")
     assert code == 2 and "--use-damaged (use_damaged=True) is for a K&C dataset's recordings" in err
     with pytest.warns(DamagedRecording):
         kept = read_kc_dataset(folder, use_damaged=True)

@@ -93,7 +93,7 @@ def test_a_place_set_by_the_sweep_is_the_vehicle_file_edited_by_hand(serial_tabl
     # the same car written by hand: the front spring rate and the E2 front y law inline
     text = DEFAULT_VEHICLE.read_text()
     text = text.replace("rate: 28000.0 ", f"rate: {rate!r} ", 1)
-    text = text.replace("y:  {set: fig5_9}", "y:  {model: stvs, params: {N: 15, K0: 508.2, Kpa: 1076.7, "
+    text = text.replace("y:  {set: fig5_9_caption}", "y:  {model: stvs, params: {N: 15, K0: 508.2, Kpa: 1076.7, "
                                              f"Kr: {kr!r}, Ff: 9.0, Co: 32.0, pw: 0.15}}}}", 1)
     hand = tmp_vehicle = out.parent / "hand.yaml"
     tmp_vehicle.write_text(text)
@@ -109,7 +109,7 @@ def test_a_place_set_by_the_sweep_is_the_vehicle_file_edited_by_hand(serial_tabl
     files = {Path(f["path"]).name: f["text"] for f in inputs["files"]}
     assert files["sweep.yaml"] == sweep_path.read_text() and inputs["software_version"]
     # every file the runs read: the vehicle, its bushing sets and its tyre
-    assert {"c_segment.yaml", "short_pumping.yaml", "fig5_9.yaml", "195_65R15.tir"} <= set(files)
+    assert {"c_segment.yaml", "short_pumping.yaml", "fig5_9_caption.yaml", "195_65R15.tir"} <= set(files)
 
 
 def test_serial_local_cluster_and_external_scheduler_give_the_same_bits(serial_table, tmp_path):
@@ -356,7 +356,7 @@ def test_grid_points_on_the_bounds_are_the_bounds():
 def test_places_of_the_vehicle_file():
     text = DEFAULT_VEHICLE.read_text()
     data = Document(text, str(DEFAULT_VEHICLE)).data
-    assert file_value(data, "bushings.e2_front.y.Kr") == 2935.0          # from its set, fig5_9
+    assert file_value(data, "bushings.e2_front.y.Kr") == 2935.0          # from its set, fig5_9_caption
     assert file_value(data, "front.hardpoints.tie_rod_inner.z") == 0.19
     assert file_value(data, "rear.beam_torsion_scale") == 1.0
     for bad in ("name", "front.hardpoints.tie_rod_inner.w", "bushings.e2_front.y.Kq", "bushings.e1_rear"):

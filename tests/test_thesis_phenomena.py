@@ -43,11 +43,12 @@ SPEEDS = _front_axle("pumping", "[{amplitude_mm: 20, speed_mm_s: 2}, {amplitude_
 
 def _camber_loops(model: str, values: dict, equations: bool = False) -> list[float]:
     """The front left camber loops [deg] of :data:`SPEEDS`, ``model`` on every direction; with
-    ``equations`` the family sets are figs. 5.8-5.9 as the equations read them (``*_equations``)."""
+    ``equations`` the family sets are figs. 5.8-5.9 as the equations read them (``fig5_8``, ``fig5_9``
+    in place of the file's captions' ``*_caption``)."""
     scenario = replace(SPEEDS, bushing_model=model)
     text = DEFAULT_VEHICLE.read_text()
     if equations:
-        text = re.sub(r"\bfig5_([89])\b", r"fig5_\1_equations", text)
+        text = re.sub(r"\bfig5_([89])_caption\b", r"fig5_\1", text)
     run = simulate(scenario, vehicle_with(text, DEFAULT_VEHICLE, values, "test"))
     return [case_loop(run, c, "pad_height_fl", "camber_fl", "pad_height_fl").width for c in cases(run)]
 
@@ -201,7 +202,7 @@ def test_the_rt_camber_loop_is_thicker_than_the_stvs_one_at_low_speed():
 
 
 def test_with_the_equations_reading_the_rt_camber_loop_is_clearly_thicker():
-    """Figs. 5.8-5.9 as the equations read them (fig5_8_equations, fig5_9_equations: the STVS slider 80 %
+    """Figs. 5.8-5.9 as the equations read them (fig5_8, fig5_9: the STVS slider 80 %
     of the STS threshold, RT all of it at V0): RT's camber loop clearly thicker than STVS's, as fig.
     4.29 has it (×4.5 measured at 20 mm and 2 mm/s; the report: +45 % at 60 mm and 1.5 mm/s, against
     +2 % with the captions' sets)."""
@@ -235,14 +236,14 @@ def _bench_relaxation(set_name: str, ringing_m: float = 0.0) -> float:
 
 def test_the_laws_relax_on_the_bench_rt_more_than_stvs():
     """Fig. 4.32's bushing-level half: held after a 50 ms ramp to 0.3 mm, the force keeps falling
-    from 0.5 s to 6 s, RT (fig5_8) more than STVS (fig5_9)."""
-    assert 0.02 < _bench_relaxation("fig5_9") < _bench_relaxation("fig5_8") < 0.1
+    from 0.5 s to 6 s, RT (fig5_8_caption) more than STVS (fig5_9_caption)."""
+    assert 0.02 < _bench_relaxation("fig5_9_caption") < _bench_relaxation("fig5_8_caption") < 0.1
 
 
 def test_a_ringing_after_the_step_works_the_relaxation_off():
     """Why the car's rack step shows no relaxation (report, figs. 4.32–4.39): the same bench step
     followed by a 20 Hz ringing of ±0.15 mm that decays in 0.1 s relaxes no further afterwards."""
-    assert _bench_relaxation("fig5_9") > 0.03 and abs(_bench_relaxation("fig5_9", 0.15e-3)) < 0.002
+    assert _bench_relaxation("fig5_9_caption") > 0.03 and abs(_bench_relaxation("fig5_9_caption", 0.15e-3)) < 0.002
 
 
 def test_the_thesis_cars_lossy_bushings_thicken_the_camber_and_toe_loops():

@@ -5,7 +5,7 @@ high loss, tan δ = 0.30 (§4.4.1: "une articulation de tangente d'angle de pert
     python tools/thesis_car.py [--check]
 
 Each translation's law is the default car's read as STVS (its own STVS set, or the family set
-fig5_9 scaled to its K0: what ``--bushing-model stvs`` gives), made lossier to tan δ = 0.30 at
+fig5_9_caption scaled to its K0: what ``--bushing-model stvs`` gives), made lossier to tan δ = 0.30 at
 15 Hz, 1 mm (PSA's specification point, §2.1.1) with its |K*| there kept
 (:func:`elastokin.bushings.frequency.with_loss`); the rotations keep the default car's laws. The
 file is the default car's text with those nine directions (left side, mirrored) written inline,
@@ -37,7 +37,7 @@ _HEADER = """\
 # 18 principal directions the thesis names (x, y, z of E1 and E2 front and E1 rear, both sides),
 # at its high loss: tan δ = {tan:.2f} at {freq:g} Hz, {amp:g} mm (§4.4.1's "tangente d'angle de perte
 # valant 0,3", read at PSA's specification point, §2.1.1). Each law is the default car's direction
-# read as STVS (its own set, or the family set fig5_9 scaled to its K0) made lossier with its |K*|
+# read as STVS (its own set, or the family set fig5_9_caption scaled to its K0) made lossier with its |K*|
 # there kept: the ladder stiffened, K0 lowered (elastokin.bushings.frequency.with_loss). Not the
 # thesis's measured parts, which it does not give. Written by `python tools/thesis_car.py`; do not
 # edit by hand (the test suite checks it against the default car).

@@ -90,19 +90,19 @@ With {NOISE:.0%} of white noise on the force (last row) the fit lands at a = {no
 
 
 #: The shipped sets set beside the thesis's figures: the captions' readings of figs. 5.8-5.9 and the equations'.
-COMPARED_SETS = ("fig5_6", "fig5_8", "fig5_8_equations", "fig5_9", "fig5_9_equations")
+COMPARED_SETS = ("fig5_6", "fig5_8_caption", "fig5_8", "fig5_9_caption", "fig5_9")
 _LABELS = {"k_dyn_1hz_1mm_n_per_mm": "K_dyn at 1 Hz, 1 mm [N/mm]", "tan_delta_1hz_1mm": "tan δ at 1 Hz, 1 mm",
            "payne_loss_10hz": "Payne: loss 0.1 → 2 mm at 10 Hz", "frequency_loss_0p5mm": "loss 100 → 1 Hz at 0.5 mm"}
 
 
 def _figures(write_set: bool) -> str:
     """The section on the thesis's measured figures; with ``write_set``, writes the identified set."""
-    found, m = measured_figures.identify(load_parameter_set("fig5_9"))
+    found, m = measured_figures.identify(load_parameter_set("fig5_9_caption"))
     found = dataclasses.replace(found, source=(
         "identified by vsim to the thesis's measured figures (Bourgeteau 2009: 920 N/mm and tan delta 0.12 at 1 Hz, "
         "1 mm, figs. 5.18–5.19 captions; about 50 % lost from 0.1 to 2 mm at 10 Hz and 20 % between 100 and 1 Hz "
         "at 0.5 mm, §3.3.1) together with the slow 20 mm/min loops of fig. 5.6's STS (fig5_6) at 0.5, 1 and 2 mm; "
-        "fitted from fig5_9 by elastokin.bushings.bench.measured_figures.identify (tools/thesis_identification.py)"))
+        "fitted from fig5_9_caption by elastokin.bushings.bench.measured_figures.identify (tools/thesis_identification.py)"))
     if write_set:
         save_parameter_set(found, PARAMETER_SET_DIR / "measured_figures_stvs.yaml")
     sets = {name: measured_figures.measures(load_parameter_set(name).channel()) for name in COMPARED_SETS}
@@ -136,8 +136,8 @@ stands for it), first harmonic of the fifth cycle:
 """ + "\n".join(rows) + f"""
 
 The sets of figs. 5.8 and 5.9 are given in two readings (`models/bushings/README.md`): as their
-captions print them (`fig5_8`, `fig5_9`), and as the thesis's equations and text make them from
-fig. 5.6's STS (`fig5_8_equations`, `fig5_9_equations`: Co = Fs / V0^pw, eq. 3.16, with pw = 0.1 as
+captions print them (`fig5_8_caption`, `fig5_9_caption`), and as the thesis's equations and text make them from
+fig. 5.6's STS (`fig5_8`, `fig5_9`: Co = Fs / V0^pw, eq. 3.16, with pw = 0.1 as
 printed; eq. 5.10's threshold shared 80 / 20 between the slider and the viscous threshold at V0;
 fig. 5.6's Kpa and Kr, which the text says are kept). The figures' own sets are off the stiffness by {gap("k_dyn_1hz_1mm_n_per_mm")} N/mm, the loss factor by
 {gap("tan_delta_1hz_1mm")}, the Payne loss by {gap("payne_loss_10hz")} and the frequency loss by
