@@ -46,16 +46,25 @@ def _check_named(result: dict, cause: str, effects: list[dict]) -> None:
     before, after = excess(result["heldout_error_before"]), excess(result["heldout_error_after"])
     assert result["share_explained"] == pytest.approx(min(1.0, max(0.0, 1.0 - after / before)) if before else 1.0)
     truth = effects[0]
+    factors = {p.name for p in CAUSES[cause].parameters if p.factor}
     for name, fitted in result["parameters"].items():
         # The fitted magnitude is the hidden one, within 4 standard uncertainties or 25 % (the
-        # self-heating rate and time constant trade off against each other over a 30 s endurance run).
+        # self-heating rate and time constant trade off against each other over a 30 s endurance run);
+        # a factor's magnitude is its distance from 1.
         # (a null uncertainty: a parameter the tests do not see, e.g. a slip stiffness with no slip force)
-        tolerance = max(4.0 * (fitted["std"] if fitted["std"] is not None else np.inf), 0.25 * abs(truth[name]))
+        size = abs(truth[name] - 1.0) if name in factors else abs(truth[name])
+        tolerance = max(4.0 * (fitted["std"] if fitted["std"] is not None else np.inf), 0.25 * size)
         assert abs(fitted["value"] - truth[name]) <= tolerance, (name, fitted, truth[name])
 
 
+#: Causes whose drawn diagnosis runs in the slow stage only, for the default suite's time: it names
+#: each all the same, with its magnitude, in a dataset measured apart (Mullins: tests/test_layout.py).
+NAMED_ELSEWHERE = ("mullins",)
+
+
 @pytest.mark.parametrize("seed", SEEDS)
-@pytest.mark.parametrize("cause", BENCH_CAUSES)
+@pytest.mark.parametrize("cause", [pytest.param(c, marks=pytest.mark.slow) if c in NAMED_ELSEWHERE else c
+                                   for c in BENCH_CAUSES])
 def test_hidden_cause_is_named_with_its_magnitude(tmp_path, cause, seed):
     baseline, effects, measured = measure(tmp_path, cause, seed)
     result = diagnose_fresh(measured, baseline, report=tmp_path / "report")
@@ -313,6 +322,30 @@ def test_a_slipping_interface_adds_the_elastoplastic_loop_and_its_tangent():
         assert moved[0] - moved[1] == pytest.approx(sign * ks * delta, rel=1e-9)
 
 
+@pytest.mark.parametrize("name", ["fig5_9_progressive", "fig5_6", "fig5_8", "linear", "curve"])
+def test_a_stiffness_scale_multiplies_every_force_of_the_law(name):
+    """The stiffness family (a harder or softer rubber): along any history (a virgin loading, minor
+    loops, a fast sine, a hold), the scaled law's force is the factor times the baseline's, to the
+    ladder solver's tolerance, for a ladder with a progressive elastic law, an STS, an RT, a linear
+    law with a dashpot and a Maxwell branch and a tabulated curve; its node deflections unchanged."""
+    from elastokin.bushings.parameter_sets import ParameterSet
+    from elastokin.bushings.bench.records import simulate_record
+
+    base = {"linear": ParameterSet("linear", "linear", "translation",
+                                   {"K0": 300.0, "C": 0.5, "maxwell_k": [80.0], "maxwell_c": [8.0]}, "test"),
+            "curve": ParameterSet("curve", "curve", "translation",
+                                  {"curve": [[-2.0, -900.0], [0.0, 0.0], [1.0, 350.0], [2.0, 1100.0]]}, "test")
+            }.get(name) or load_parameter_set(name)
+    scale = 1.0 / 1.17 if name == "fig5_8" else 1.21
+    scaled = CAUSES["stiffness"].apply(base, {"stiffness_scale": scale})
+    t = np.linspace(0.0, 6.0, 6001)
+    e = 1e-3 * (2.5 * np.sin(0.5 * np.pi * t) * (t < 4.0) + 0.3 * np.sin(2 * np.pi * 5.0 * t) * (t > 2.0) * (t < 4.0))
+    e = np.where(t >= 4.0, e[np.searchsorted(t, 4.0) - 1], e)   # held from 4 s
+    forces = simulate_record([base.channel(), scaled.channel()], t, e)
+    assert np.abs(forces[:, 0]).max() > 200.0
+    np.testing.assert_allclose(forces[:, 1], scale * forces[:, 0], rtol=1e-6, atol=1e-3)
+
+
 def test_dahl_friction_closes_its_loop_at_fc_tanh():
     """truth_forms' dahl_parallel, cycled between ±A: the force at the top of the loop is
     F_c·tanh(σA/F_c) and the loop's area 2·(2A·F_c − (F_c + F_top)·F_c/σ·(1 − e^{−2σA/F_c}))
@@ -397,10 +430,13 @@ def _named_as_family(result: dict, form: str) -> str:
 
 
 #: Other forms drawn in the default suite (all of truth_forms.FORMS in the slow one: the two-node
-#: heating's and the box spectrum's diagnoses take a minute each on 2 cores, and so does Dahl's
-#: friction, drawn here in the slow stage only).
-DEFAULT_FORMS = ["asymmetry_smooth_kink", "asymmetry_exponential", "mullins_ogden",
-                 pytest.param("dahl_parallel", marks=pytest.mark.slow), "viscous_parallel"]
+#: heating's and the box spectrum's diagnoses take a minute each on 2 cores, and so do Dahl's
+#: friction and the dashpot alone; the exponential asymmetry and Ogden-Roxburgh's softening half a
+#: minute each, drawn here in the slow stage only, for the default suite's time; the cubic asymmetry
+#: has its own test below).
+DEFAULT_FORMS = ["asymmetry_smooth_kink", *(pytest.param(f, marks=pytest.mark.slow) for f in
+                                            ("asymmetry_exponential", "mullins_ogden", "dahl_parallel",
+                                             "viscous_parallel"))]
 
 
 @pytest.mark.parametrize("form", DEFAULT_FORMS)

@@ -5,6 +5,7 @@ is the real tree; every module, class and public function says what it is for; m
 from __future__ import annotations
 
 import ast
+import json
 import re
 import subprocess
 import sys
@@ -215,6 +216,11 @@ def test_measured_data_is_imported_compared_plotted_and_diagnosed_without_mujoco
     done = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stderr[-3000:]
     assert (tmp_path / "d" / "report.md").is_file() and (tmp_path / "c" / "comparison.json").is_file()
+    # the Mullins softening hidden in the bench dataset named with its magnitude
+    verdict = json.loads((tmp_path / "d" / "diagnosis.json").read_text())
+    assert verdict["cause"] == "mullins", verdict["ranking"][:3]
+    fitted = verdict["parameters"]["mullins"]
+    assert abs(fitted["value"] - 0.15) <= max(4.0 * fitted["std"], 0.25 * 0.15), fitted
 
 
 def _small_bench_dataset(directory: Path) -> None:

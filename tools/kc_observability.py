@@ -103,10 +103,11 @@ def main() -> int:
     if args.json:
         print(json.dumps(out))
     else:
-        print("\nobservable (the first parameter's floor leaves at least the top fifth of its range):")
+        print("\nobservable (the first parameter's floor leaves at least the top fifth of its range, in the "
+              "coordinate its effect grows with: a factor's logarithm):")
         for label, r in out.items():
-            h = next(p for p in places if p.label == label)
-            if r["floor"] <= 0.8 * parameters(h.cause)[0].draw[1]:
+            first = parameters(next(p for p in places if p.label == label).cause)[0]
+            if first.effect(r["floor"]) <= 0.8 * first.effect(first.draw[1]):
                 print(f"  {label:40s} floor {r['floor']:.4g}")
     return 0
 

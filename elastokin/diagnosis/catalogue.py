@@ -35,6 +35,7 @@ class Parameter:
     log: bool = False                  #: fitted on a log scale (positive, spans decades)
     factor: bool = False               #: a factor on a design value (1: no effect), whose effect grows
     #: with its logarithm (a log parameter otherwise has no effect at 0 and an effect growing with it)
+    either_side: bool = False          #: a factor drawn above or below 1 alike (its draw range above 1)
     description: str = ""
     default: float | None = None       #: a family's shape parameter: its value in the family's first
     #: form, taken when a truth file leaves it out
@@ -43,6 +44,8 @@ class Parameter:
         if (self.sided or self.even_part) and not self.signed:
             raise ValueError(f"parameter {self.name}: sided or even_part needs signed (a fit on one sign's run "
                              f"must be free to take the other)")
+        if self.either_side and not (self.factor and self.draw[0] > 1.0):
+            raise ValueError(f"parameter {self.name}: either_side needs a factor drawn above 1")
 
     @property
     def signs(self) -> tuple[float, ...]:
@@ -144,6 +147,20 @@ def _mullins(params: dict, effects: dict, v: Mapping[str, float]) -> tuple[dict,
     return params, {**_add(dict(effects), "mullins", v["mullins"]), "mullins_shape": shape}
 
 
+#: The keys of a law whose values are forces, or forces per deflection, speed or deflection's power:
+#: what a harder or softer rubber scales alike (a curve's forces too; its deflections stay).
+FORCE_KEYS = ("K0", "Kpa", "Kr", "Ff", "Co", "C", "P_sup", "P_inf", "maxwell_k", "maxwell_c")
+
+
+def _stiffness(params: dict, effects: dict, v: Mapping[str, float]) -> tuple[dict, dict]:
+    s = v["stiffness_scale"]
+    out = {k: ([s * x for x in value] if isinstance(value, (list, tuple)) else s * value) if k in FORCE_KEYS else value
+           for k, value in params.items()}
+    if "curve" in params:
+        out["curve"] = [[x, s * f] for x, f in params["curve"]]
+    return out, {**effects, **({"slip_force": s * effects["slip_force"]} if "slip_force" in effects else {})}
+
+
 def _heating(params: dict, effects: dict, v: Mapping[str, float]) -> tuple[dict, dict]:
     return params, {**_add(dict(effects), "heating", v["heating"]), "heating_tau_s": v["heating_tau_s"]}
 
@@ -217,6 +234,21 @@ CAUSES: dict[str, Cause] = {c.id: c for c in (
            Parameter("mullins_shape", "-", (1.0, 5.0), (1.0, 2.0), log=True, default=1.0,
                      description="power p of the recovery: softening mu*(1 - (|x|/x_max)^p)")),
           lambda b: True, _mullins),
+    # the commonest deviation of a real part (issue 53): rubber hardness varies by a few Shore points
+    # from batch to batch, its shear modulus and so every force of the part by ±10-25 %; a modulus
+    # factor scales the whole law alike (a ladder's node speeds are then unchanged: the loop's shape
+    # and its rate dependence stay), unlike an asymmetry (one side) or a Mullins softening (below the
+    # largest deflection)
+    Cause("stiffness",
+          "the part's rubber harder or softer than the law's (a few Shore points from batch to batch): every "
+          "force of the law scaled by one factor at the same deflection history (its stiffnesses, slider "
+          "thresholds, dampers and elastic law alike)",
+          "gradient, loop width and loop area off together by one factor, on both sides; the loops' shape and "
+          "their speed dependence unchanged",
+          (Parameter("stiffness_scale", "-", (0.3, 3.0), (1.1, 1.25), log=True, factor=True, either_side=True,
+                     description="factor on every force of the law (drawn above or below 1)"),),
+          lambda b: b.model not in ("sts_continuous", "stsn") and (b.values.get("K0", 0.0) > 0.0 or "curve" in b.values),
+          _stiffness),
     Cause("self_heating",
           "dissipated energy heats the part; stiffness and viscous parameters fall with temperature",
           "slow drift of loops over many cycles, growing with amplitude x frequency",
@@ -273,12 +305,15 @@ def draw(cause: Cause, rng: np.random.Generator) -> dict[str, float]:
 
 def draw_parameters(parameters: tuple[Parameter, ...], rng: np.random.Generator) -> dict[str, float]:
     """Parameter values drawn uniformly (log-uniformly for log parameters) in the realistic range;
-    either sign for a signed parameter, one side for all the sided parameters of a family."""
+    either sign for a signed parameter, one side for all the sided parameters of a family, above or
+    below 1 for a factor drawn on either side."""
     out: dict[str, float] = {}
     side = None
     for p in parameters:
         lo, hi = p.draw
         value = float(np.exp(rng.uniform(np.log(lo), np.log(hi)))) if p.log else float(rng.uniform(lo, hi))
+        if p.either_side and rng.random() < 0.5:
+            value = 1.0 / value
         sign = 1.0
         if p.signed:
             sign = side if p.sided and side is not None else float(rng.choice([-1.0, 1.0]))

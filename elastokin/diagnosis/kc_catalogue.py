@@ -99,7 +99,8 @@ MIN_EXCESS = 1.0
 #: ``python tools/kc_observability.py --duration-scale 0.25``; a cause screened on both signs by its weaker).
 #: The virtual rig's draws take these places, their magnitudes in the observable part of the
 #: realistic range; elsewhere a cause is still a hypothesis of the diagnosis. Kept: places whose
-#: floor leaves at least the top fifth of the range. Missing: viscoelasticity_excess (the 0.1 Hz
+#: floor leaves at least the top fifth of the range (in the coordinate its effect grows with: a factor's
+#: logarithm). Missing: viscoelasticity_excess (the 0.1 Hz
 #: triangles are too slow for the STVS dampers: floor 14.8 N of 5-15; damper_force likewise: floors
 #: 1.23 front, 1.17 rear of 1.05-1.4), preload (the car has no direction with a nonlinear elastic
 #: law for it to act on), and places such as the asymmetry of the front pivot's y direction (floor
@@ -108,6 +109,10 @@ OBSERVABLE: dict[str, dict[tuple[str, ...], float]] = {
     "viscoelasticity_missing": {("e1_front", "y"): 20.8},
     "asymmetry": {("e1_rear", "x"): 0.043},
     "mullins": {("e1_front", "y"): 0.125, ("e1_rear", "x"): 0.167},
+    # a factor, either way: its floor is its magnitude's above 1 (the front pivot's lateral ladder, the
+    # rear pivot's linear axial direction and its longitudinal ladder; elsewhere 1.75, E2 front y, or
+    # more: beyond the range)
+    "stiffness": {("e1_front", "y"): 1.053, ("e1_rear", "x"): 1.055, ("e1_rear", "y"): 1.092},
     "broad_relaxation": {("e1_front", "y"): 50.0},
     "coupling": {("e1_rear", "x", "y"): 27.6, ("e1_rear", "x", "z"): 57.1},   # x/z: 43.6 on its positive sign
     "strut_friction": {(): 27.2},
@@ -168,7 +173,8 @@ KC_FITTED_PARAMETERS = 2
 def draw(cause: str, rng: np.random.Generator) -> Hypothesis:
     """A random hypothesis of ``cause``: a place where the K&C campaign sees it (:data:`OBSERVABLE`)
     and values in the realistic range, the first parameter's magnitude mapped into the part of it
-    that the campaign resolves at that place (a beam torsion scale above or below 1)."""
+    that the campaign resolves at that place (a factor, such as a beam torsion or a bushing's
+    stiffness scale, above or below 1: its floor is its magnitude's, above 1)."""
     where = list(OBSERVABLE[cause])
     location = where[int(rng.integers(len(where)))]
     values = draw_parameters(parameters(cause), rng)
@@ -177,9 +183,11 @@ def draw(cause: str, rng: np.random.Generator) -> Hypothesis:
     low = max(OBSERVABLE[cause][location], first.draw[0])
     low = math.log(low) if first.log else low
     v = abs(values[first.name])
+    below = first.either_side and v < 1.0   # a factor drawn below 1: mapped by its inverse's magnitude
+    v = 1.0 / v if below else v
     v = low + ((math.log(v) if first.log else v) - lo) / (hi - lo) * (hi - low)
     values[first.name] = math.copysign(math.exp(v) if first.log else v, values[first.name])
-    if cause in VEHICLE_CAUSES and first.factor and rng.random() < 0.5:   # a design value off either way
+    if below or (cause in VEHICLE_CAUSES and first.factor and rng.random() < 0.5):   # off either way
         values[first.name] = 1.0 / values[first.name]
     return Hypothesis(cause, location, values)
 
