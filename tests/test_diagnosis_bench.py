@@ -16,10 +16,10 @@ import numpy as np
 import pytest
 
 from elastokin.bushings.bench.programmes import TimeSeries
-from elastokin.bushings.bench.records import sample_steps
+from elastokin.bushings.bench.records import sample_steps, simulate_record
 from elastokin.bushings.effects import Effects, broad_relaxation_branches, effects_to_si
 from elastokin.bushings.extended_bank import ExtendedBank
-from elastokin.bushings.parameter_sets import load_parameter_set
+from elastokin.bushings.parameter_sets import ParameterSet, load_parameter_set
 from elastokin.core.errors import InputError
 from tests.diagnosis_helpers import (MIN_PAIR_SUCCESS_RATE, MIN_SUCCESS_RATE, OWN_FORM_SUCCESS_RATE, PAIR, SLOW_SEEDS,
                                      assert_success_rate, diagnose_fresh, measure)
@@ -329,9 +329,6 @@ def test_a_stiffness_scale_multiplies_every_force_of_the_law(name):
     loops, a fast sine, a hold), the scaled law's force is the factor times the baseline's, to the
     ladder solver's tolerance, for a ladder with a progressive elastic law, an STS, an RT, a linear
     law with a dashpot and a Maxwell branch and a tabulated curve; its node deflections unchanged."""
-    from elastokin.bushings.parameter_sets import ParameterSet
-    from elastokin.bushings.bench.records import simulate_record
-
     base = {"linear": ParameterSet("linear", "linear", "translation",
                                    {"K0": 300.0, "C": 0.5, "maxwell_k": [80.0], "maxwell_c": [8.0]}, "test"),
             "curve": ParameterSet("curve", "curve", "translation",

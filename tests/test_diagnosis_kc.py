@@ -521,10 +521,9 @@ def _excess(error: float) -> float:
 
 def _within(fitted: float, hidden: float, p: Parameter, share: float = 0.3) -> bool:
     """Whether a fitted value is the hidden one, of the same sign, within ``share`` of its magnitude
-    (a factor's magnitude is its logarithm: ×1.08 fitted ×1.10 is 24 % off, not 2 %)."""
-    if p.factor:
-        return fitted > 0.0 and abs(math.log(fitted / hidden)) <= share * abs(math.log(hidden))
-    return fitted * hidden > 0.0 and abs(fitted - hidden) <= share * abs(hidden)
+    in the coordinate its effect grows with (:meth:`Parameter.effect`: a factor's logarithm, so that
+    ×1.08 fitted ×1.10 is 24 % off, not 2 %)."""
+    return fitted * hidden > 0.0 and abs(p.effect(fitted) - p.effect(hidden)) <= share * abs(p.effect(hidden))
 
 
 def check(result: dict, h: Hypothesis | None) -> str:
