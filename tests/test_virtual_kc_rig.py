@@ -241,6 +241,13 @@ def test_cli_measures_a_kc_truth_and_refuses_to_overwrite(where, tmp_path, capsy
     ({"measurement": {"force_noise_N": 1.0}}, "measurement.force_noise_N", "unknown key"),
     ({"measurement": {"angle_noise_deg": -1.0}}, "measurement.angle_noise_deg", ">= 0"),
     ({"seed": 1.5}, "seed", "whole number"),
+    ({"chain": [1]}, "chain", "mapping of channel"),
+    ({"chain": {"toe_xx": {"gain": 0.01}}}, "chain.toe_xx", "no measured channel"),
+    ({"chain": {"pad_fy": {"gain": 0.01}}}, "chain.pad_fy", "rig input"),
+    ({"chain": {"toe": {"lag_ms": 1.0}}}, "chain.toe.lag_ms", "unknown chain element"),
+    ({"chain": {"toe": {"delay_ms": -1.0}}}, "chain.toe.delay_ms", ">= 0"),
+    ({"chain": {"camber_fl": {"gain": -1.5}}}, "chain.camber_fl.gain", "> -1"),
+    ({"chain": {"toe": {"ar1_sigma": 0.01}, "toe_fl": {"ar1_sigma": 0.0}}}, "chain", "toe_fr: ar1_sigma and"),
 ])
 def test_truth_errors_name_the_file_and_key(where, change, key, says):
     with pytest.raises(InputError) as err:

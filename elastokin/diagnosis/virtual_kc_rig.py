@@ -17,18 +17,21 @@ TRUTH.yaml (K&C level; paths relative to this file)::
       - {cause: spring_rate, location: front, spring_rate_scale: 0.9}  # also anti_roll_bar (front), damper_force
       - {cause: backlash, location: e1_front.y, backlash: 0.2}          # mm, outside the catalogue
     measurement: {angle_noise_deg: 0.003, ...}       # MEASUREMENT_DEFAULTS keys
+    chain: {toe: {delay_ms: 15, low_pass_hz: 9}, ...}  # optional: elastokin/diagnosis/rig_chain.py
     seed: 0
 
 The rig measures what :func:`elastokin.recordings.rig_recordings.measured_channels` lists. Every measured channel gets
 a zero error drawn once per dataset (uniform in ± its offset), Gaussian noise and the quantisation
-of its sensor, by unit: deg (angle), mm (length), N (force), N·m (torque). The rig inputs (pad
+of its sensor, by unit: deg (angle), mm (length), N (force), N·m (torque), after the truth's
+measurement ``chain`` if it has one (gains, filters, lags, drifts, coloured noise: drawn from a
+stream of their own, so that a truth without a chain measures as before). The rig inputs (pad
 displacements, forces and torques, rack) are the commanded values and are written as commanded.
 """
 
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
@@ -45,6 +48,7 @@ from elastokin.core.shipped import DEFAULT_VEHICLE, KC_SCENARIO_DIR
 from elastokin.diagnosis.kc_catalogue import (BUSHING_CAUSES, DIRECTIONS, VEHICLE_CAUSES, Hypothesis, extended_vehicle,
                                          locations, parameters)
 from elastokin.diagnosis.measurement import parse_measurement, quantise, required, truth_number, truth_values
+from elastokin.diagnosis.rig_chain import ChannelChain, parse_chain
 from elastokin.recordings.kc_dataset import write_kc_rig_yaml
 from elastokin.recordings.recorder import simulate
 from elastokin.recordings.rig_recordings import measured_channels, write_rig_recording
@@ -70,7 +74,9 @@ MEASUREMENT_DEFAULTS = {
 #: Run unit of a channel -> (sensor kind, key suffix) in MEASUREMENT_DEFAULTS.
 SENSORS = {"deg": ("angle", "deg"), "mm": ("length", "mm"), "N": ("force", "n"), "N·m": ("torque", "nm")}
 RIG_NAME = "virtual K&C rig"
-_KEYS = ("level", "vehicle", "scenarios", "duration_scale", "effects", "measurement", "seed")
+_KEYS = ("level", "vehicle", "scenarios", "duration_scale", "effects", "measurement", "chain", "seed")
+#: The chain's random stream: apart from the noise's, which stays as it was without a chain.
+_CHAIN_STREAM = 53
 #: Causes the K&C virtual rig can hide: the catalogue's, and backlash (outside it).
 CAUSES = (*BUSHING_CAUSES, *VEHICLE_CAUSES, "backlash")
 
@@ -86,6 +92,7 @@ class KCTruth:
     measurement: Mapping[str, float]
     seed: int
     duration_scale: float = 1.0
+    chain: Mapping[str, ChannelChain] = field(default_factory=dict)   #: measured channel -> its chain
 
     @property
     def vehicle(self) -> VehicleDefinition:
@@ -224,7 +231,8 @@ def parse_kc_truth(data: Any, source: str, base_dir: Path | None = None) -> KCTr
     seed = data.get("seed", 0)
     if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
         raise InputError(f"expected a whole number >= 0, got {seed!r}", source=source, key="seed")
-    truth = KCTruth(source, baseline, scenarios, effects, measurement, seed, duration_scale)
+    chain = parse_chain(data.get("chain"), measured_channels(), INPUT_CHANNELS, source)
+    truth = KCTruth(source, baseline, scenarios, effects, measurement, seed, duration_scale, chain)
     try:
         truth.vehicle  # every effect together (e.g. two couplings of one bushing)
     except InputError as exc:
@@ -239,12 +247,14 @@ def sensor(unit: str, measurement: Mapping[str, float]) -> tuple[float, float, f
     return tuple(measurement[f"{kind}_{what}_{suffix}"] for what in ("noise", "offset", "resolution"))
 
 
-def rig_description(measurement: Mapping[str, float]) -> dict[str, Any]:
-    """What ``rig.yaml`` and every recording say about the rig: its name, notes and sensor accuracy."""
+def rig_description(measurement: Mapping[str, float], chain: bool = False) -> dict[str, Any]:
+    """What ``rig.yaml`` and every recording say about the rig: its name, notes and sensor accuracy
+    (a ``chain`` is said to be there, not what it is: a rig does not know its own errors)."""
     return {"name": RIG_NAME,
             "notes": "simulated K&C rig (vsim): body clamped, pads driven; every measured channel carries a "
-                     "zero error drawn once per dataset, Gaussian noise and the sensor's quantisation; the "
-                     "rig inputs are written as commanded",
+                     "zero error drawn once per dataset, Gaussian noise and the sensor's quantisation"
+                     + ("; some pass a chain of calibration errors, filters, lags, drifts and coloured noise, "
+                        "not stated" if chain else "") + "; the rig inputs are written as commanded",
             "accuracy": {k: float(v) for k, v in measurement.items()}}
 
 
@@ -264,10 +274,11 @@ def measure_kc(truth: KCTruth, output: str | os.PathLike[str], *, overwrite: boo
     channels = measured_channels()
     m = truth.measurement
     rng = np.random.default_rng(truth.seed)
+    chain_rng = np.random.default_rng([truth.seed, _CHAIN_STREAM])
     offsets = {name: rng.uniform(-1.0, 1.0) * sensor(unit, m)[1] for name, unit in channels.items()
                if name not in INPUT_CHANNELS}
     vehicle = truth.vehicle
-    rig = rig_description(m)
+    rig = rig_description(m, chain=bool(truth.chain))
     with atomic_directory(root, overwrite=overwrite) as tmp:
         files = []
         for i, scenario in enumerate(truth.scenarios):
@@ -279,6 +290,8 @@ def measure_kc(truth: KCTruth, output: str | os.PathLike[str], *, overwrite: boo
                 if name not in run.signals:
                     continue
                 x = run.signals[name]
+                if name in truth.chain:
+                    x = truth.chain[name].apply(run.t_s, x, chain_rng)
                 if name not in INPUT_CHANNELS:
                     noise, _, resolution = sensor(unit, m)
                     x = quantise(x + offsets[name] + rng.normal(0.0, noise, x.shape), resolution)
