@@ -4,7 +4,7 @@ acquisition do to a signal besides the white noise, zero error and resolution of
 apart from any model the diagnosis makes of it.
 
 A truth's ``chain`` key (K&C level), by channel (``toe_fl``) or by a channel's name without its
-wheel (``toe``: every wheel; a channel's own entry wins)::
+wheel (``toe``: every wheel; a channel's own elements go over its stem's)::
 
     chain:
       toe:    {delay_ms: 15, low_pass_hz: 9, gain: 0.01, ar1_sigma: 0.002, ar1_time_constant_s: 2,
