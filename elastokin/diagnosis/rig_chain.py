@@ -30,7 +30,7 @@ The rig inputs (pad travel and forces, rack) are written as commanded, so no cha
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from typing import Any, Mapping
 
 import numpy as np
@@ -62,16 +62,13 @@ GRADES = {
 }
 #: What :func:`draw_chain` can draw, alone or together.
 DRAWN = ("delay", "low_pass", "gain", "ar1", "drift")
-#: A channel's chain elements: key -> the value meaning "absent".
-ELEMENTS = {"gain": 0.0, "low_pass_hz": 0.0, "delay_ms": 0.0, "drift_per_min": 0.0, "ar1_sigma": 0.0,
-            "ar1_time_constant_s": 0.0}
 _SIGNED = ("gain",)
 _FILTER_ORDER = 2
 
 
 @dataclass(frozen=True)
 class ChannelChain:
-    """What the rig's chain does to one channel (keys of :data:`ELEMENTS`)."""
+    """What the rig's chain does to one channel (a truth's chain elements, each 0 when absent)."""
 
     gain: float = 0.0
     low_pass_hz: float = 0.0
@@ -96,6 +93,10 @@ class ChannelChain:
         if self.ar1_sigma > 0.0:
             y = y + ar1(white, self.ar1_sigma, math.exp(-dt / self.ar1_time_constant_s))
         return y
+
+
+#: A channel's chain elements, the keys of a truth's chain entry.
+ELEMENTS = tuple(f.name for f in fields(ChannelChain))
 
 
 def ar1(white: np.ndarray, sigma: float, phi: float) -> np.ndarray:
