@@ -11,12 +11,12 @@ import numpy as np
 import pytest
 
 from elastokin.core.shipped import DEFAULT_VEHICLE
-from elastokin.diagnosis.rig_chain import DRAWN, GRADES, GROUPS, ChannelChain, draw_chain, parse_chain
+from elastokin.diagnosis.rig_chain import CROSSTALK, DRAWN, GRADES, GROUPS, ChannelChain, draw_chain, parse_chain, servoed
 from elastokin.diagnosis.virtual_kc_rig import MEASUREMENT_DEFAULTS, measure_kc, parse_kc_truth, sensor
 from elastokin.recordings.kc_dataset import read_kc_dataset
 from elastokin.recordings.recorder import simulate
 from elastokin.recordings.rig_recordings import measured_channels
-from elastokin.vehicle.scenarios.channels import INPUT_CHANNELS
+from elastokin.vehicle.scenarios.channels import INPUT_CHANNELS, channel_quantity
 from tests.test_virtual_kc_rig import PUMPING
 
 RATE_HZ = 50.0
@@ -98,11 +98,16 @@ def test_a_truths_chain_acts_on_its_channels_alone(tmp_path):
     assert "not stated" in read_kc_dataset(tmp_path / "chained").rig["notes"]
 
 
-WHITE = {n.rsplit("_", 1)[0]: sensor(u, MEASUREMENT_DEFAULTS)[0] for n, u in measured_channels().items()}
+WHITE = {channel_quantity(n): sensor(u, MEASUREMENT_DEFAULTS)[0] for n, u in measured_channels().items()}
+
+
+def _within(value: float, bounds: tuple[float, float], scale: float = 1.0, slack: float = 1e-5) -> bool:
+    return bounds[0] * scale - slack <= value <= bounds[1] * scale + slack
 
 
 @pytest.mark.parametrize("grade", GRADES)
-@pytest.mark.parametrize("elements", [DRAWN, ("delay",), ("gain",), ("ar1", "drift")])
+@pytest.mark.parametrize("elements", [DRAWN, ("delay",), ("gain",), ("ar1", "drift"), ("crosstalk", "pink"),
+                                      ("input_gain",)])
 def test_drawn_chains_sit_in_their_grades_ranges_and_parse_as_a_truths(grade, elements):
     ranges = GRADES[grade]
     draw = draw_chain(np.random.default_rng(8), grade, WHITE, elements)
@@ -110,22 +115,76 @@ def test_drawn_chains_sit_in_their_grades_ranges_and_parse_as_a_truths(grade, el
     assert draw != draw_chain(np.random.default_rng(9), grade, WHITE, elements)
     chains = parse_chain(draw, measured_channels(), INPUT_CHANNELS, "drawn")
     measured = [n for n in measured_channels() if n not in INPUT_CHANNELS]
-    assert set(chains) == set(measured)                  # every measured channel, no input
+    inputs = [n for n in measured_channels() if n in INPUT_CHANNELS]
+    only_inputs = elements == ("input_gain",)
+    assert set(chains) == (set() if only_inputs else set(measured)) | (set(inputs) if "input_gain" in elements
+                                                                     else set())
+    for name in inputs:   # a servoed input: a gain alone, each transducer its own
+        assert (_within(abs(chains[name].gain), ranges["gain"]) and chains[name] == ChannelChain(gain=chains[name].gain)
+                if "input_gain" in elements else name not in chains)
+    if only_inputs:
+        return
     for group, stems in GROUPS.items():
-        for name in (n for n in measured if n.rsplit("_", 1)[0] in stems):
-            c, white = chains[name], WHITE[name.rsplit("_", 1)[0]]
-            low, high = ranges["delay_ms"][group]
-            assert (low - 0.01 <= c.delay_ms <= high + 0.01) if "delay" in elements else c.delay_ms == 0.0
-            low, high = ranges["low_pass_hz"][group]
-            assert (low - 0.01 <= c.low_pass_hz <= high + 0.01) if "low_pass" in elements else c.low_pass_hz == 0.0
-            low, high = ranges["gain"]
-            assert (low - 1e-5 <= abs(c.gain) <= high + 1e-5) if "gain" in elements else c.gain == 0.0
-            low, high = ranges["ar1"]
-            assert (low * white <= c.ar1_sigma <= high * white) if "ar1" in elements else c.ar1_sigma == 0.0
-            low, high = ranges["drift"]
-            assert (low * white <= c.drift_per_min <= high * white) if "drift" in elements else c.drift_per_min == 0.0
-        lags = {chains[n].delay_ms for n in measured if n.rsplit("_", 1)[0] in stems}
+        for name in (n for n in measured if channel_quantity(n) in stems):
+            c, white = chains[name], WHITE[channel_quantity(name)]
+            checks = {"delay": (c.delay_ms, ranges["delay_ms"][group], 1.0),
+                      "low_pass": (c.low_pass_hz, ranges["low_pass_hz"][group], 1.0),
+                      "gain": (abs(c.gain), ranges["gain"], 1.0), "ar1": (c.ar1_sigma, ranges["ar1"], white),
+                      "pink": (c.pink_sigma, ranges["pink"], white), "drift": (c.drift_per_min, ranges["drift"], white)}
+            for element, (value, bounds, scale) in checks.items():
+                assert _within(value, bounds, scale, 0.01) if element in elements else value == 0.0, (name, element)
+            source = CROSSTALK.get(channel_quantity(name))
+            if "crosstalk" in elements and source:
+                (seen_q, coefficient), = c.crosstalk
+                assert seen_q == source and _within(abs(coefficient), ranges["crosstalk"])
+            else:
+                assert c.crosstalk == ()
+        lags = {chains[n].delay_ms for n in measured if channel_quantity(n) in stems}
         assert len(lags) == 1                            # one acquisition path per group
     if "gain" in elements:
         gains = [chains[n].gain for n in measured]
         assert min(gains) < 0.0 < max(gains) and len(set(gains)) > len(gains) // 2   # each transducer its own
+
+
+def test_crosstalk_adds_the_other_quantitys_true_signal_times_its_coefficient():
+    x, camber = np.sin(0.3 * T), 0.7 * np.cos(0.11 * T)
+    chain = ChannelChain(gain=0.01, crosstalk=(("camber", -0.02),))
+    y = chain.apply(T, x, np.random.default_rng(0), {"camber": camber})
+    np.testing.assert_allclose(y, 1.01 * x - 0.02 * camber, rtol=0, atol=1e-15)
+
+
+def test_pink_noise_has_its_expected_variance_and_a_one_over_f_spectrum():
+    """Averaged over records, the mean square is the stated σ² and the periodogram falls as 1/f (a
+    log-log slope of −1 over three decades); one record's mean is zero (no DC)."""
+    sigma, n, records = 0.003, 4096, 300
+    t = np.arange(n) / RATE_HZ
+    rng = np.random.default_rng(11)
+    draws = np.array([ChannelChain(pink_sigma=sigma).apply(t, np.zeros(n), rng) for _ in range(records)])
+    assert np.abs(draws.mean(axis=1)).max() < 1e-15
+    assert np.mean(draws ** 2) == pytest.approx(sigma ** 2, rel=0.05)
+    power = np.mean(np.abs(np.fft.rfft(draws, axis=1)[:, 1:]) ** 2, axis=0)
+    k = np.arange(1, n // 2 + 1)
+    slope = np.polyfit(np.log(k[:-1]), np.log(power[:-1]), 1)[0]
+    assert slope == pytest.approx(-1.0, abs=0.02)
+
+
+def test_a_servoed_inputs_gain_gives_the_car_the_command_over_one_plus_it(tmp_path):
+    """A pad-travel transducer reading 2 % high at the front left: the recording holds the command
+    (the servo makes the reading follow it), the car is the simulation of that pad moved by the
+    command / 1.02, and every other input is as commanded."""
+    (tmp_path / "pumping.yaml").write_text(PUMPING)
+    shutil.copy(DEFAULT_VEHICLE, tmp_path / "car.yaml")
+    exact = {k: 0.0 for k in MEASUREMENT_DEFAULTS}
+    base = {"level": "kc", "scenarios": ["pumping.yaml"], "duration_scale": 0.2, "measurement": exact, "seed": 4}
+    truth = parse_kc_truth({**base, "chain": {"pad_z_fl": {"gain": 0.02}}}, "t.yaml", tmp_path)
+    run = read_kc_dataset(measure_kc(truth, tmp_path / "servoed")).tests[0].run
+    commanded = simulate(replace(truth.scenarios[0], bushing_model=None), truth.vehicle, duration_scale=0.2)
+    played = simulate(replace(servoed(truth.scenarios[0], truth.chain), bushing_model=None), truth.vehicle,
+                      duration_scale=0.2)
+    np.testing.assert_allclose(played.signals["pad_z_fl"], commanded.signals["pad_z_fl"] / 1.02, atol=1e-12)
+    for name in measured_channels():
+        expected = commanded if name in INPUT_CHANNELS else played
+        np.testing.assert_allclose(run.signals[name], expected.signals[name], rtol=1e-12, atol=1e-12, err_msg=name)
+    travel = commanded.signals["wheel_travel_fl"]
+    # the car saw the pad's travel / 1.02: so, nearly, does its wheel (the tyre's and the rest's share alike)
+    assert np.abs(run.signals["wheel_travel_fl"]).max() == pytest.approx(np.abs(travel).max() / 1.02, rel=3e-3)

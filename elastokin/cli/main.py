@@ -14,8 +14,8 @@ import warnings
 from types import ModuleType
 
 from elastokin.cli import (built_ins, bushing_export, bushing_fit, bushing_import, bushing_run, bushings_on_road,
-                           compare, compile, diagnose, kc, model_export, plot, rig_import, rig_measure, road_import,
-                           run, sweep, view)
+                           compare, compile, diagnose, kc, model_export, plot, rig_dataset, rig_export, rig_import,
+                           rig_measure, road_import, run, sweep, view)
 from elastokin.core.provenance import software_version
 from elastokin.cli.interrupts import handle_sigterm, status
 from elastokin.core.errors import ElastokinWarning, InputError
@@ -27,8 +27,8 @@ GROUPS: dict[str, tuple[str, str, tuple[ModuleType, ...]]] = {
                 "in and out.",
                 (bushing_run, bushing_fit, bushing_import, bushing_export)),
     "model": ("vehicle models", "Vehicle models.", (model_export,)),
-    "rig": ("measured data: import a K&C rig's CSV export, or measure on the virtual rig",
-            "Measured K&C rig data (data/README.md).", (rig_import, rig_measure)),
+    "rig": ("measured data: import a K&C rig's CSV exports as a dataset, or measure on the virtual rig",
+            "Measured K&C rig data (data/README.md).", (rig_import, rig_dataset, rig_export, rig_measure)),
     "road": ("measured data: a test car's logged road runs", "Measured road runs (scenarios/README.md, "
              "\"Measured manoeuvres\").", (road_import,)),
 }

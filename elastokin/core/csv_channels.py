@@ -40,6 +40,10 @@ class Column:
         """The column's values in the channel's unit and sign."""
         return (values + self.offset) * self.factor
 
+    def invert(self, values: np.ndarray) -> np.ndarray:
+        """The column's values that :meth:`convert` gives ``values`` (in the channel's unit and sign) from."""
+        return values / self.factor - self.offset
+
 
 def unit_factor(f: Fields, channel: str, unit: str) -> float:
     """``unit`` per the unit declared at ``f``'s ``unit`` key, for ``channel`` kept in ``unit``;

@@ -14,6 +14,7 @@ import numpy as np
 from elastokin.diagnosis.catalogue import Parameter
 from elastokin.diagnosis.kc_catalogue import Hypothesis, parameters
 from elastokin.diagnosis.kc_layout import Layout
+from elastokin.vehicle.scenarios.channels import channel_quantity
 
 #: Relative increase of the held-out score per fitted parameter.
 PARAMETER_PENALTY = 0.02
@@ -69,7 +70,7 @@ class Scorer:
         damaged recording's gap is not one)."""
         d = np.vstack([np.diff(residual[t.rows], axis=0)[np.diff(t.samples) == 1] for t in self.layout.tests])
         per = 1.4826 * np.median(np.abs(d - np.median(d, axis=0)), axis=0) / math.sqrt(2.0)
-        family = [c.rsplit("_", 1)[0] for c in self.layout.channels]
+        family = [channel_quantity(c) for c in self.layout.channels]
         out = np.array([np.median([p for p, g in zip(per, family) if g == f]) for f in family])
         return np.maximum(out, 1e-9)
 

@@ -48,7 +48,7 @@ from elastokin.core.shipped import DEFAULT_VEHICLE, KC_SCENARIO_DIR
 from elastokin.diagnosis.kc_catalogue import (BUSHING_CAUSES, DIRECTIONS, VEHICLE_CAUSES, Hypothesis, extended_vehicle,
                                          locations, parameters)
 from elastokin.diagnosis.measurement import parse_measurement, quantise, required, truth_number, truth_values
-from elastokin.diagnosis.rig_chain import ChannelChain, parse_chain
+from elastokin.diagnosis.rig_chain import ChannelChain, parse_chain, seen, servoed
 from elastokin.recordings.kc_dataset import write_kc_rig_yaml
 from elastokin.recordings.recorder import simulate
 from elastokin.recordings.rig_recordings import measured_channels, write_rig_recording
@@ -265,7 +265,9 @@ def measure_kc(truth: KCTruth, output: str | os.PathLike[str], *, overwrite: boo
     Each scenario is simulated with the vehicle's own bushing laws (a scenario's ``bushings`` key is
     ignored: a rig cannot choose them); the rig keeps the channels of
     :func:`elastokin.recordings.rig_recordings.measured_channels`, adds to each measured one its zero error (drawn once
-    per dataset), noise and quantisation, and writes the inputs as commanded. Recordings are
+    per dataset), noise and quantisation, and writes the inputs as commanded (a truth's ``chain``
+    goes before those on the channels it names; a servoed input's transducer gain g gives the car
+    the command / (1 + g)). Recordings are
     ``NN_<scenario name>.mcap`` in the order played, plus ``rig.yaml``. The dataset is written as a
     whole (a temporary folder renamed at the end); an existing ``output`` is refused unless
     ``overwrite``. ``progress(i, n, scenario name)`` is called before each scenario.
@@ -284,14 +286,16 @@ def measure_kc(truth: KCTruth, output: str | os.PathLike[str], *, overwrite: boo
         for i, scenario in enumerate(truth.scenarios):
             if progress is not None:
                 progress(i, len(truth.scenarios), scenario.name)
-            run = simulate(replace(scenario, bushing_model=None), vehicle, duration_scale=truth.duration_scale)
+            played = servoed(scenario, truth.chain)   # the command the servoed inputs' transducers read
+            run = simulate(replace(played, bushing_model=None), vehicle, duration_scale=truth.duration_scale)
             signals = {}
             for name, unit in channels.items():
                 if name not in run.signals:
                     continue
                 x = run.signals[name]
                 if name in truth.chain:
-                    x = truth.chain[name].apply(run.t_s, x, chain_rng)
+                    chain = truth.chain[name]
+                    x = chain.apply(run.t_s, x, chain_rng, seen(chain, name, run.signals))
                 if name not in INPUT_CHANNELS:
                     noise, _, resolution = sensor(unit, m)
                     x = quantise(x + offsets[name] + rng.normal(0.0, noise, x.shape), resolution)

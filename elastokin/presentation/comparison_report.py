@@ -8,7 +8,7 @@ from pathlib import Path
 
 from matplotlib.figure import Figure
 
-from elastokin.vehicle.scenarios.channels import CORNER_TAGS
+from elastokin.vehicle.scenarios.channels import CORNER_TAGS, channel_quantity
 from elastokin.analysis.compare import ChannelComparison, Comparison
 from elastokin.analysis.run_metrics import case_mask, cases, loop_axes
 from elastokin.core.files import atomic_output
@@ -37,7 +37,7 @@ def format_table(c: Comparison) -> str:
             lines.append("  n/a: " + "; ".join(f"{', '.join(metrics)} ({reason})" for reason, metrics in why.items()))
         by_quantity: dict[str, list[ChannelComparison]] = {}
         for ch in case.channels:
-            by_quantity.setdefault(ch.channel.rsplit("_", 1)[0], []).append(ch)
+            by_quantity.setdefault(channel_quantity(ch.channel), []).append(ch)
         for quantity, rows in by_quantity.items():
             shown = [m for m in METRIC_NAMES if any(m in r.metrics for r in rows)]
             units = {m: next(r.metrics[m].unit for r in rows if m in r.metrics) for m in shown}
@@ -78,13 +78,13 @@ def _plot_loops(sim: Run, rig: Run, case: int, tags: list[str], path: Path) -> P
 
 def _plot_time(sim: Run, rig: Run, case: int, names: list[str], path: Path) -> Path:
     """Each compared quantity against the input time, simulation and rig overlaid, a line per wheel."""
-    quantities = list(dict.fromkeys(n.rsplit("_", 1)[0] for n in names))
+    quantities = list(dict.fromkeys(channel_quantity(n) for n in names))
     fig = Figure(figsize=(10, 2.4 * len(quantities)), layout="constrained")
     axes = fig.subplots(len(quantities), 1, sharex=True, squeeze=False)[:, 0]
     for ax, quantity in zip(axes, quantities):
         # wheel-centre coordinates differ by a track or a wheelbase: show them from the simulation's start
         relative = quantity.startswith("wheel_centre")
-        for k, name in enumerate(n for n in names if n.rsplit("_", 1)[0] == quantity):
+        for k, name in enumerate(n for n in names if channel_quantity(n) == quantity):
             origin = sim.signals[name][case_mask(sim, cases(sim)[case - 1])][0] if relative else 0.0
             for run, style in ((sim, "-"), (rig, "--")):
                 m = case_mask(run, cases(run)[case - 1])

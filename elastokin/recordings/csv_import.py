@@ -9,14 +9,13 @@ written by :func:`elastokin.recordings.rig_recordings.write_rig_recording`.
 from __future__ import annotations
 
 import os
-import re
 from pathlib import Path
 from typing import Mapping
 
-from elastokin.vehicle.scenarios.channels import CORNER_TAGS
+from elastokin.vehicle.scenarios.channels import CORNER_TAGS, channel_quantity, channel_wheel
 from elastokin.vehicle.scenarios.scenario import Scenario
 from elastokin.vehicle.scenarios.scenario_file import load_scenario, parse_scenario
-from elastokin.core.csv_channels import TIME_KEYS, declared_columns, time_column
+from elastokin.core.csv_channels import TIME_KEYS, Column, declared_columns, time_column
 from elastokin.core.documents import Document, Fields, dump_yaml
 from elastokin.core.errors import InputError
 from elastokin.core.files import is_file, read_text
@@ -27,8 +26,7 @@ _META_KEYS = ("scenario", "duration_scale", "rig", "notes", "time", "columns")
 
 
 def _channel_patterns(names: list[str]) -> str:
-    corners = "|".join(CORNER_TAGS.values())
-    patterns = dict.fromkeys(re.sub(f"_({corners})$", "_<c>", n) for n in names)
+    patterns = dict.fromkeys(f"{channel_quantity(n)}_<c>" if channel_wheel(n) else n for n in names)
     return f"{', '.join(patterns)} (<c>: {', '.join(CORNER_TAGS.values())})"
 
 
@@ -49,6 +47,19 @@ def _scenario(top: Fields, meta: Path) -> Scenario:
         raise top.fail("scenario", f"inline scenario{f', {exc.key}' if exc.key else ''}: {exc.bare}") from None
 
 
+def read_meta(meta: Path) -> tuple[Document, Fields, Column, list[Column]]:
+    """The META file ``meta``: its document, its top-level fields, and its time and signal columns
+    (InputError naming the key for an unknown key, channel or unit, a unit that does not convert, a
+    bad sign, a channel given twice)."""
+    doc = Document(read_text(meta), str(meta))
+    top = doc.top(_META_KEYS)
+    time = time_column(Fields.of(doc, ("time",), top.raw("time"), TIME_KEYS))
+    known = measured_channels()
+    columns = declared_columns(doc, ("columns",), top.raw("columns"), time, known,
+                               f"a channel a K&C rig measures: {_channel_patterns(list(known))}")
+    return doc, top, time, columns
+
+
 def import_csv(data: str | os.PathLike[str], meta: str | os.PathLike[str], output: str | os.PathLike[str], *,
                overwrite: bool = False) -> Path:
     """Convert the rig CSV ``data`` as the META file ``meta`` declares into the rig recording ``output``.
@@ -61,16 +72,12 @@ def import_csv(data: str | os.PathLike[str], meta: str | os.PathLike[str], outpu
     written on error.
     """
     meta = Path(meta)
-    doc = Document(read_text(meta), str(meta))
-    top = doc.top(_META_KEYS)
+    doc, top, time, columns = read_meta(meta)
     scenario = _scenario(top, meta)
     duration_scale = top.number("duration_scale", 1.0, positive=True)
     rig = {"name": top.text("rig"), "notes": top.text("notes", ""),
            "imported_from": {"csv": Path(data).name, "meta_yaml": doc.text}}
-    time = time_column(Fields.of(doc, ("time",), top.raw("time"), TIME_KEYS))
     known = measured_channels()
-    columns = declared_columns(doc, ("columns",), top.raw("columns"), time, known,
-                               f"a channel a K&C rig measures: {_channel_patterns(list(known))}")
     header = {TIME_NAME: time.name, **{c.channel: c.name for c in columns}}   # the time first: read_csv_columns checks it increases
     limits = {c.name: c.limit for c in (time, *columns)}
     values = read_csv_columns(data, list(header.values()), min_rows=2, limits=limits)

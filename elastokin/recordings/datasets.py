@@ -10,6 +10,7 @@ from typing import Any, Mapping
 
 from elastokin.core.documents import Document, dump_yaml
 from elastokin.core.errors import InputError
+from elastokin.core.files import atomic_output
 
 RIG_FILE = "rig.yaml"
 LEVELS = ("bench", "kc")
@@ -48,9 +49,10 @@ def read_manifest(directory: str | os.PathLike[str], level: str, keys: tuple[str
 
 
 def write_manifest(directory: str | os.PathLike[str], manifest: Mapping[str, Any]) -> Path:
-    """Write a dataset's rig.yaml (the caller writes the tests and the folder atomically)."""
+    """Write a dataset's rig.yaml, whole or not at all (the caller writes the tests)."""
     path = Path(directory) / RIG_FILE
-    path.write_text(dump_yaml(dict(manifest), sort_keys=False, allow_unicode=True))
+    with atomic_output(path) as tmp:
+        tmp.write_text(dump_yaml(dict(manifest), sort_keys=False, allow_unicode=True))
     return path
 
 

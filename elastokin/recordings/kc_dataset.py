@@ -27,7 +27,7 @@ from elastokin.core.documents import Document, dump_yaml
 from elastokin.core.errors import InputError
 from elastokin.core.files import is_file
 from elastokin.core.shipped import DEFAULT_VEHICLE
-from elastokin.recordings.datasets import read_manifest, write_manifest
+from elastokin.recordings.datasets import RIG_FILE, read_manifest, write_manifest
 from elastokin.recordings.run_format import Run
 from elastokin.recordings.run_reader import load_run
 
@@ -83,7 +83,15 @@ def read_kc_dataset(directory: str | os.PathLike[str], *, use_damaged: bool = Fa
     if not isinstance(entries, list) or not entries:
         raise InputError(f"expected a non-empty list of recording files (.mcap, relative to this file), got "
                          f"{entries!r}", source=source, key="recordings")
-    tests, seen, damage = [], set(), []
+    tests = _tests(root, entries, source, use_damaged)
+    damage = tuple(f"{t.file.name}: {t.run.reason}" for t in tests if not t.run.complete)
+    return KCDataset(root, vehicle_text, dict(rig), tests, damage)
+
+
+def _tests(root: Path, entries: list[Any], source: str, use_damaged: bool) -> list[KCTest]:
+    """The tests of the recording files ``entries`` (relative to ``root``), in that order; errors
+    name ``source`` and ``recordings[i]``."""
+    tests, seen = [], set()
     for i, entry in enumerate(entries):
         key = f"recordings[{i}]"
         if not isinstance(entry, str) or not entry:
@@ -95,10 +103,43 @@ def read_kc_dataset(directory: str | os.PathLike[str], *, use_damaged: bool = Fa
         if not is_file(file):
             raise InputError(f"no such recording file {entry!r}", source=source, key=key)
         run = _load(file, source, key, use_damaged)
-        if not run.complete:
-            damage.append(f"{file.name}: {run.reason}")
         tests.append(KCTest(file.stem, file, run, recorded_scenario(run, source=source, key=key)))
-    return KCDataset(root, vehicle_text, dict(rig), tests, tuple(damage))
+    return tests
+
+
+def assemble_kc_dataset(directory: str | os.PathLike[str], recordings: Sequence[str] | None = None, *,
+                        vehicle_text: str = "", overwrite: bool = False) -> KCDataset:
+    """Make a folder of rig recordings (`vsim rig import`'s) a K&C dataset: write its ``rig.yaml``.
+
+    Args:
+        directory: the folder that holds the recordings.
+        recordings: their file names in the order played (default: every ``*.mcap`` there, by name).
+        vehicle_text: free text, the car measured.
+        overwrite: replace an existing ``rig.yaml``.
+
+    Returns:
+        The dataset, read back as :func:`read_kc_dataset` reads it.
+
+    Raises:
+        InputError: naming ``rig.yaml`` and ``recordings[i]`` for a recording that is missing,
+        unreadable, damaged, not a rig recording or whose scenario cannot be rebuilt; an existing
+        ``rig.yaml`` without ``overwrite``; no recording at all. Nothing is written then. The rig's
+        description is the first recording's (its name and notes; what it was imported from and its
+        sampling rate are each recording's own).
+    """
+    root = Path(directory)
+    path = root / RIG_FILE
+    if path.exists() and not overwrite:
+        raise InputError("the output exists; pass --overwrite (overwrite=True) to replace it", source=str(path))
+    entries = list(recordings) if recordings is not None else sorted(p.name for p in root.glob("*.mcap"))
+    if not entries:
+        raise InputError(f"no recording (.mcap) in {root}; expected the tests of one car, as `vsim rig import` "
+                         f"writes them", source=str(path), key="recordings")
+    tests = _tests(root, entries, str(path), use_damaged=False)
+    rig = {k: v for k, v in (tests[0].run.metadata.extra.get("rig") or {}).items()
+           if k not in ("imported_from", "sample_rate_hz")}   # each recording's own
+    write_kc_rig_yaml(root, vehicle_text, rig, entries)
+    return read_kc_dataset(root)
 
 
 def _load(file: Path, source: str, key: str, use_damaged: bool) -> Run:
@@ -128,6 +169,20 @@ def recorded_scenario(run: Run, *, source: str | None = None, key: str | None = 
     scenario file where it was found (else as recorded).
     Errors are :class:`InputError` naming ``source`` and ``key``.
     """
+    data, where = recorded_mapping(run, source=source, key=key)
+    try:
+        scenario = parse_scenario(dump_yaml(data, sort_keys=False, allow_unicode=True), where)
+    except InputError as exc:
+        sub = f", {exc.key}" if exc.key else ""
+        raise InputError(f"{run.path.name}: its scenario{sub}: {exc.bare}", source=source, key=key) from None
+    return replace(scenario, name=data["name"] or scenario.name, path=where, text=run.metadata.scenario_yaml)
+
+
+def recorded_mapping(run: Run, *, source: str | None = None, key: str | None = None) -> tuple[dict[str, Any], Path]:
+    """The scenario mapping a recording stored, its paths made absolute as :func:`recorded_scenario`
+    says (the vehicle's, the default vehicle where it does not resolve) and its ``name`` the one it
+    played under; and the scenario file where it was found (else as recorded). Errors name
+    ``source`` and ``key``."""
     text = run.metadata.scenario_yaml
     try:
         data = Document(text, run.path.name).data
@@ -147,14 +202,8 @@ def recorded_scenario(run: Run, *, source: str | None = None, key: str | None = 
     for part in (data.get("defaults"), *(data.get("cases") or [])):
         if isinstance(part, dict) and isinstance(part.get("path"), str):
             part["path"] = _resolve(part["path"], base)
-    where = file or Path(recorded or run.path)
-    try:
-        scenario = parse_scenario(dump_yaml(data, sort_keys=False, allow_unicode=True), where)
-    except InputError as exc:
-        sub = f", {exc.key}" if exc.key else ""
-        raise InputError(f"{run.path.name}: its scenario{sub}: {exc.bare}", source=source, key=key) from None
-    name = data["name"] if isinstance(data.get("name"), str) else str(run.metadata.extra.get("scenario", ""))
-    return replace(scenario, name=name or scenario.name, path=where, text=text)
+    data["name"] = data["name"] if isinstance(data.get("name"), str) else str(run.metadata.extra.get("scenario", ""))
+    return data, file or Path(recorded or run.path)
 
 
 def _scenario_file(run: Run, recorded: str) -> Path | None:

@@ -20,7 +20,7 @@ import numpy as np
 
 from elastokin.vehicle.model.definition import CORNERS, is_rotation
 from elastokin.vehicle.model.elements import Channel
-from elastokin.vehicle.scenarios.channels import CORNER_TAGS, INPUT_CHANNELS, input_quantity
+from elastokin.vehicle.scenarios.channels import CORNER_TAGS, INPUT_CHANNELS, channel_quantity
 from elastokin.vehicle.scenarios.road_scenario import RoadScenario
 from elastokin.vehicle.scenarios.scenario import Scenario
 from elastokin.vehicle.scenarios.schedule import CaseSchedule
@@ -64,8 +64,8 @@ class SignalLayout:
                                           columns.wheel("pad_height"), columns.wheel("pad_fz")])
         self._scale = np.concatenate([np.full(4, f) for _, f in read] + [np.full(12, MM_PER_M), np.full(4, MM_PER_M),
                                                                          np.ones(4)])
-        self.input_scale = np.array([units.per_si(INPUT_UNITS[input_quantity(ch)]) for ch in INPUT_CHANNELS])
-        specs += [SignalSpec(ch, INPUT_UNITS[input_quantity(ch)], "inputs") for ch in INPUT_CHANNELS]
+        self.input_scale = np.array([units.per_si(INPUT_UNITS[channel_quantity(ch)]) for ch in INPUT_CHANNELS])
+        specs += [SignalSpec(ch, INPUT_UNITS[channel_quantity(ch)], "inputs") for ch in INPUT_CHANNELS]
         self.suspension = SuspensionSignals(columns, bushings, springs, dampers)
         self.specs = specs + self.suspension.specs
 

@@ -20,14 +20,22 @@ INPUT_CHANNELS = tuple(f"{q}_{tag}" for q in INPUT_QUANTITIES for tag in CORNER_
 FILE_UNITS = {"pad_z": "mm", "pad_fx": "daN", "pad_fy": "daN", "pad_mz": "Nm", "rack": "mm"}
 
 
-def input_quantity(channel: str) -> str:
-    """The quantity of an input channel: ``pad_z_fl`` → ``pad_z``; ``rack`` → ``rack``."""
-    return channel if channel == "rack" else channel.rsplit("_", 1)[0]
+def channel_wheel(channel: str) -> str:
+    """The wheel tag a channel's name ends with (``toe_fl`` → ``fl``), "" for a channel of no wheel
+    (``rack``)."""
+    head, _, tag = channel.rpartition("_")
+    return tag if head and tag in CORNER_TAGS.values() else ""
+
+
+def channel_quantity(channel: str) -> str:
+    """A channel's name without its wheel: ``pad_z_fl`` → ``pad_z``; ``rack`` → ``rack``."""
+    wheel = channel_wheel(channel)
+    return channel[:-len(wheel) - 1] if wheel else channel
 
 
 def csv_columns() -> tuple[str, ...]:
     """Input columns a scenario CSV may have besides ``t_s``: channel name and file unit."""
-    return tuple(f"{ch}_{FILE_UNITS[input_quantity(ch)]}" for ch in INPUT_CHANNELS)
+    return tuple(f"{ch}_{FILE_UNITS[channel_quantity(ch)]}" for ch in INPUT_CHANNELS)
 
 
 def file_si(quantity: str) -> float:

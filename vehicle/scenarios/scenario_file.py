@@ -15,7 +15,7 @@ import numpy as np
 
 from elastokin.vehicle.model.definition import BUSHING_MODELS
 from elastokin.vehicle.scenarios.channels import (AXLES, CORNER_TAGS, FILE_UNITS, INPUT_CHANNELS, csv_columns, file_si,
-                                        input_quantity)
+                                        channel_quantity)
 from elastokin.vehicle.scenarios.road_scenario import ROAD_TOP_KEYS, ROAD_TYPES, RoadScenario, parse_road_scenario
 from elastokin.vehicle.scenarios.scenario import (BISINE_INPUTS, MAX_FREQUENCY_HZ, MAX_INPUT_S, MAX_SETTLE_S, SHAPES,
                                         SIGNAL_TYPES, TYPES, Case, InputTable, Limits, Scenario, Settle, Waveform)
@@ -175,7 +175,7 @@ def read_input_csv(path: Path) -> InputTable:
     if not present:
         raise InputError(f"expected t_s and at least one input column, got {','.join(header) or 'an empty file'}",
                          source=str(path), key="line 1")
-    unit_of = {c: FILE_UNITS[input_quantity(ch)] for c, ch in zip(columns, INPUT_CHANNELS)}
+    unit_of = {c: FILE_UNITS[channel_quantity(ch)] for c, ch in zip(columns, INPUT_CHANNELS)}
     limits = {"t_s": units.plausible("s")} | {c: units.plausible(unit_of[c]) for c in present}
     data = read_csv_columns(path, ("t_s", *present), min_rows=2, limits=limits)
     if data["t_s"][0] != 0.0:
@@ -184,7 +184,7 @@ def read_input_csv(path: Path) -> InputTable:
     values = np.zeros((len(data["t_s"]), len(INPUT_CHANNELS)))
     for name in present:
         k = columns.index(name)
-        values[:, k] = data[name] * file_si(input_quantity(INPUT_CHANNELS[k]))
+        values[:, k] = data[name] * file_si(channel_quantity(INPUT_CHANNELS[k]))
     return InputTable(data["t_s"], values)
 
 
