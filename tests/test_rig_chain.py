@@ -31,18 +31,21 @@ def test_a_gain_scales_the_reading_and_nothing_else():
 
 @pytest.mark.parametrize("cutoff_hz, delay_ms", [(9.0, 0.0), (9.0, 15.0), (20.0, 3.0), (0.0, 12.0)])
 def test_filter_and_delay_lag_a_ramp_by_their_closed_forms(cutoff_hz, delay_ms):
-    """A ramp through a digital 2nd-order Butterworth lags by sqrt(2)/(2π f_a), the group delay at low
-    frequency of its analogue prototype at the pre-warped cut-off f_a = (f_s/π) tan(π f_c/f_s) (the
-    bilinear transform keeps it at DC), plus the pure delay; the slope is kept (unit DC gain)."""
+    """A ramp through the analogue 2nd-order Butterworth lags by sqrt(2)/(2π f_c), its group delay at
+    low frequency (which its bilinear transform, pre-warped to f_c at 8 × the rate, keeps), plus the
+    pure delay; the slope is kept (unit DC gain). The same at another sampling rate: the filter is
+    the rig's, before the sampling, not the recording's."""
     x = 2.0 * T
     y = ChannelChain(low_pass_hz=cutoff_hz, delay_ms=delay_ms).apply(T, x, np.random.default_rng(0))
-    prewarped = RATE_HZ / math.pi * math.tan(math.pi * cutoff_hz / RATE_HZ)
-    filter_lag = math.sqrt(2.0) / (2.0 * math.pi * prewarped) if cutoff_hz else 0.0
+    filter_lag = math.sqrt(2.0) / (2.0 * math.pi * cutoff_hz) if cutoff_hz else 0.0
     settled = T > 5.0
     lag = (x - y)[settled] / 2.0
     assert lag.mean() == pytest.approx(filter_lag + 1e-3 * delay_ms, rel=1e-3)
     assert np.ptp(lag) < 1e-9 + 0.002 * lag.mean()
     assert y[0] == x[0]                                  # started at rest on the first sample
+    fast = np.arange(0.0, 20.0, 1.0 / 200.0)
+    z = ChannelChain(low_pass_hz=cutoff_hz, delay_ms=delay_ms).apply(fast, 2.0 * fast, np.random.default_rng(0))
+    assert ((2.0 * fast - z)[fast > 5.0] / 2.0).mean() == pytest.approx(filter_lag + 1e-3 * delay_ms, rel=1e-3)
 
 
 def test_ar1_noise_has_its_variance_and_correlation_time():
@@ -98,6 +101,7 @@ def test_a_truths_chain_acts_on_its_channels_alone(tmp_path):
     assert "not stated" in read_kc_dataset(tmp_path / "chained").rig["notes"]
 
 
+#: The white noise of each measured quantity on the virtual rig, the scale of a drawn chain's noises.
 WHITE = {channel_quantity(n): sensor(u, MEASUREMENT_DEFAULTS)[0] for n, u in measured_channels().items()}
 
 

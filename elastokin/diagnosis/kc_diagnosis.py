@@ -5,7 +5,9 @@
    vehicle's own laws are the model under test). Every measured channel but the rig inputs is
    compared in units of its measurement noise, estimated from the data (sample-to-sample
    differences of the residual, which a smooth model error hardly affects); each channel's zero
-   error in each recording is a nuisance, removed.
+   error in each recording is a nuisance, removed, and so is each acquisition path's response
+   (a low-pass filter and a delay behind the rig inputs, :mod:`elastokin.diagnosis.kc_lags`):
+   estimated on the baseline, what is left of it fitted with every hypothesis.
 2. Screening: every catalogue cause at every place it can sit (:mod:`elastokin.diagnosis.kc_catalogue`)
    is run once on the training tests (every other one) at mid-range magnitude (a sided cause, whose
    sign picks another effect, or one whose effect is not odd in its magnitude, such as a cross
@@ -56,6 +58,7 @@ from elastokin.diagnosis.kc_catalogue import (BUSHING_CAUSES, VEHICLE_CAUSES, Hy
                                          parameters)
 from elastokin.diagnosis.kc_fits import (Candidate, Scorer, fit, fit_pair, halfway, kept, nominal, nudged, significant,
                                     verify)
+from elastokin.diagnosis.kc_lags import PathResponse
 from elastokin.diagnosis.kc_layout import Layout, run_job
 from elastokin.diagnosis.verdict import (Outcome, Separation, decide, explained, misfit, misfit_stretch, pair_named,
                                     pair_shares, second_cause_wanted, single_verdict, split)
@@ -108,6 +111,9 @@ class KCDiagnosis(Outcome):
     #: (None: none ran for both)
     separations: list[Separation | None] = field(default_factory=list)
     extra_tests: int = 0                  #: shipped rig tests the dataset lacks (read when there are rivals)
+    #: each acquisition path's filter and delay behind the rig inputs, fitted beside the final model
+    #: (:mod:`elastokin.diagnosis.kc_lags`) and taken out of every comparison
+    responses: list[PathResponse] = field(default_factory=list)
 
     @property
     def final(self) -> Candidate:
@@ -268,6 +274,11 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, executor: Execut
         named = [c.hypothesis for c in out.causes]
         out.verdict = PAIR_SEPARATOR.join(h.cause for h in named)
         out.extended = extended_vehicle(vehicle, named)
+    out.responses = scorer.responses(out.final.simulated if out.named else base)
+    for r in out.responses:
+        say(f"the {r.path}' channels lag the rig inputs by {1e3 * r.lag_s:.2f} ms at low frequency: "
+            f"{f'a {r.cutoff_hz:.3g} Hz low-pass, then ' if r.cutoff_hz else ''}{1e3 * r.delay_s:.2f} ± "
+            f"{1e3 * r.std_s:.2g} ms (taken out)")
     return out
 
 

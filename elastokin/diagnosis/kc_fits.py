@@ -13,6 +13,7 @@ import numpy as np
 
 from elastokin.diagnosis.catalogue import Parameter
 from elastokin.diagnosis.kc_catalogue import Hypothesis, parameters
+from elastokin.diagnosis.kc_lags import PathResponse, Response, fit_response, paths
 from elastokin.diagnosis.kc_layout import Layout
 from elastokin.vehicle.scenarios.channels import channel_quantity
 
@@ -56,12 +57,29 @@ class Candidate:
 
 
 class Scorer:
-    """Residuals in noise units, each channel's zero error in each recording removed; errors per test."""
+    """Residuals in noise units: the prediction through each acquisition path's filter and delay
+    (:mod:`elastokin.diagnosis.kc_lags`, estimated on the baseline; what is left of the delay to first
+    order fitted with every prediction), each channel's zero error in each recording removed;
+    errors per test."""
 
     def __init__(self, layout: Layout, baseline: np.ndarray, heldout: np.ndarray):
         self.layout, self.heldout = layout, heldout
         self.held_rows = heldout[layout.test]
+        self.paths = paths(layout.channels)
+        self.response = Response(layout, self.paths)
+        every = np.ones(len(baseline), dtype=bool)
         self.noise = self._noise(layout.measured - baseline)
+        self.cutoffs_hz, self.delays_s = fit_response(self.response, layout.measured, baseline,
+                                                      lambda r: self._zeroed(r, every, np.mean))
+        delivered = self._delivered(baseline)
+        self.noise = self._noise(layout.measured - delivered)
+        self._rates, self._taps = self.response.rates(delivered), self.response.taps(delivered)
+        self._columns: dict[bytes, list[tuple[np.ndarray, list[np.ndarray], np.ndarray]]] = {}
+        #: the last residual: (the prediction, its rows and zero, the residual), read-only
+        self._last: tuple[np.ndarray, tuple, np.ndarray] | None = None
+
+    def _delivered(self, rows: np.ndarray) -> np.ndarray:
+        return self.response.apply(rows, self.cutoffs_hz, self.delays_s)
 
     def _noise(self, residual: np.ndarray) -> np.ndarray:
         """Per channel: the white noise of the residual from its sample-to-sample differences within
@@ -74,17 +92,66 @@ class Scorer:
         out = np.array([np.median([p for p, g in zip(per, family) if g == f]) for f in family])
         return np.maximum(out, 1e-9)
 
-    def residual(self, predicted: np.ndarray, rows: np.ndarray, zero: Callable[..., np.ndarray] = np.mean
-                 ) -> np.ndarray:
-        """(measured − predicted) / noise on the selected rows (a boolean mask), each channel's
-        ``zero`` over the selected rows of each recording removed (its zero error): the mean, in
-        which the residual stays affine in the prediction (the fits), or the median, which a misfit
-        confined to a stretch does not move for the rest of its recording (the misfits' search)."""
-        r = self.layout.measured[rows] - predicted[rows]
+    def _zeroed(self, r: np.ndarray, rows: np.ndarray, zero: Callable[..., np.ndarray]) -> np.ndarray:
+        """``r`` (the selected rows) with each channel's ``zero`` in each recording removed, in noise units."""
         rec = self.layout.recording[rows]
         for k in np.unique(rec):
             r[rec == k] -= zero(r[rec == k], axis=0)
         return r / self.noise
+
+    def _lag_columns(self, rows: np.ndarray) -> list[tuple[np.ndarray, list[np.ndarray], np.ndarray]]:
+        """Per acquisition path, on the selected rows, zeroed as the residual is: its delay's
+        correction column (its channels' rates through the response), the taps' columns
+        (:meth:`elastokin.diagnosis.kc_lags.Response.taps`) and the pseudo-inverse of their Gram
+        matrix, cached per selection."""
+        key = rows.tobytes()
+        if key not in self._columns:
+            blocks = [self._zeroed(c[rows], rows, np.mean) for c in (self._rates, *self._taps)]
+            self._columns[key] = []
+            for idx in self.paths.values():
+                rate, *taps = [b[:, idx] for b in blocks]
+                self._columns[key].append((rate, taps, np.linalg.pinv(_gram([c.ravel() for c in taps]))))
+        return self._columns[key]
+
+    def _raw(self, predicted: np.ndarray, rows: np.ndarray, zero: Callable[..., np.ndarray]) -> np.ndarray:
+        return self._zeroed(self.layout.measured[rows] - self._delivered(predicted)[rows], rows, zero)
+
+    def responses(self, predicted: np.ndarray) -> list[PathResponse]:
+        """Each acquisition path's response as fitted beside ``predicted`` (all rows): its filter,
+        and its delay with what ``predicted``'s residual still shows of it to first order, with the
+        standard uncertainty (the residual's own correlation along time counted)."""
+        every = np.ones(len(predicted), dtype=bool)
+        r = self._raw(predicted, every, np.mean)
+        out = []
+        for (name, idx), (d, _, _), cutoff, delay in zip(self.paths.items(), self._lag_columns(every),
+                                                       self.cutoffs_hz, self.delays_s):
+            dd = float(np.sum(d * d))
+            a = float(np.sum(d * r[:, idx])) / dd if dd > 0.0 else 0.0
+            std = math.sqrt(_variances((r[:, idx] - a * d).T.ravel(), np.array([[dd]]))[0])
+            out.append(PathResponse(name, tuple(self.layout.channels[i] for i in idx), float(cutoff),
+                                    float(delay - a), std))
+        return out
+
+    def residual(self, predicted: np.ndarray, rows: np.ndarray, zero: Callable[..., np.ndarray] = np.mean
+                 ) -> np.ndarray:
+        """(measured − predicted) / noise on the selected rows (a boolean mask): the prediction late
+        by each path's lag, each channel's ``zero`` over the selected rows of each recording removed
+        (its zero error: the mean, in which the residual stays affine in the prediction (the fits),
+        or the median, which a misfit confined to a stretch does not move for the rest of its
+        recording (the misfits' search)), and what is left of each path's response to first order
+        (its rate, and its taps) projected out: fitted with whatever the prediction is."""
+        key = (rows.tobytes(), zero)
+        last = self._last
+        if last is not None and last[0] is predicted and last[1] == key:   # the fits' mismatch: the same base
+            return last[2]
+        r = self._raw(predicted, rows, zero)
+        for idx, (_, taps, inverse) in zip(self.paths.values(), self._lag_columns(rows)):
+            part = r[:, idx]
+            coef = inverse @ np.array([np.vdot(c, part) for c in taps])
+            r[:, idx] = part - sum(k * c for k, c in zip(coef, taps))
+        r.flags.writeable = False   # handed out again for the same prediction
+        self._last = (predicted, key, r)
+        return r
 
     def test_errors(self, predicted: np.ndarray) -> np.ndarray:
         """Per test, the RMS residual (1 = the noise)."""

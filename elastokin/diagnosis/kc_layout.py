@@ -30,10 +30,20 @@ class Job:
     channels: tuple[str, ...]     #: the compared channels it gives back (what a remote worker sends)
 
 
+def compared(phase: np.ndarray, case: np.ndarray) -> np.ndarray:
+    """The samples of a case compared (``case``: a mask of its samples): its input phase, from the
+    instant the input starts (the last sample of the settle, the car at rest: a filter or a delay
+    of the rig's acquisition starts from there)."""
+    on = (phase == 2) & case
+    start = np.flatnonzero(on[1:] & ~on[:-1] & (phase[:-1] == 1) & case[:-1])
+    on[start] = True
+    return on
+
+
 def run_job(job: Job) -> dict[str, np.ndarray]:
     """The compared channels of ``job``'s run over its input phase (a task of the executor)."""
     run = simulate(replace(job.scenario, bushing_model=None), job.vehicle, duration_scale=job.duration_scale)
-    on = run.signals["phase"] == 2
+    on = compared(run.signals["phase"], np.ones(len(run.t_s), dtype=bool))
     return {name: run.signals[name][on] for name in job.channels}
 
 
@@ -44,7 +54,8 @@ class Test:
     name: str
     job: Job                  #: the baseline's run of it
     rows: np.ndarray          #: its rows in the layout
-    samples: np.ndarray       #: each row's sample of the input phase (0-based; a damaged recording lacks some)
+    samples: np.ndarray       #: each row's sample of the input phase (0: its start instant; a damaged
+    #: recording lacks some)
     whole: bool               #: from a recording read whole: it holds every sample of the input phase
 
 
@@ -71,7 +82,7 @@ class Layout:
             run, scale = t.run, float(t.run.metadata.extra.get("duration_scale", 1.0))
             phase, number = run.signals["phase"], run.signals["case"].astype(int)
             for c, case in enumerate(t.scenario.cases, start=1):
-                on = (phase == 2) & (number == c)
+                on = compared(phase, number == c)
                 n = int(on.sum())
                 if n == 0:   # only a damaged recording lacks a case's whole input
                     unrecorded.append(f"{t.file.name}: case {c} ({case.label}) has no sample of its input: left out")
@@ -108,16 +119,16 @@ class Layout:
 
 
 def _samples(input_time_s: np.ndarray, scenario: Scenario, where: str) -> np.ndarray:
-    """The samples (0-based) of a case's input phase that a damaged recording holds, from their
-    times since the input started [s]: the k-th comes k output intervals after the start, as the
+    """The samples of a case's input phase that a damaged recording holds, from their times since
+    the input started [s]: the k-th comes k output intervals after the start (the 0-th), as the
     simulation records them. InputError for samples off the scenario's output rate (a rig recording
     at another rate cannot be matched sample by sample once some are missing)."""
     interval = 1.0 / scenario.output_rate_hz
     k = np.rint(input_time_s / interval).astype(np.int64)
-    off = (k < 1) | (np.abs(k * interval - input_time_s) > 1e-6) | np.r_[False, np.diff(k) < 1]
+    off = (k < 0) | (np.abs(k * interval - input_time_s) > 1e-6) | np.r_[False, np.diff(k) < 1]
     if off.any():
         i = int(np.argmax(off))
         raise InputError(f"{where}: a sample {input_time_s[i]:.9g} s after the input started is not on the "
                          f"scenario's output rate ({scenario.output_rate_hz:g} Hz), which the diagnosis compares at; "
                          f"expected a recording at that rate")
-    return k - 1
+    return k

@@ -18,9 +18,10 @@ Per channel, in this order (a transducer, then its amplifier and acquisition):
 - ``crosstalk``: other quantities of the same wheel the transducer sees, quantity -> coefficient
   [this channel's unit per that quantity's unit], added to the reading (a toe head seeing camber,
   a pad's Fz cell seeing Fy);
-- ``low_pass_hz``: a causal digital 2nd-order Butterworth anti-alias filter at this cut-off f_c [Hz]
-  (bilinear, at the recording's rate f_s), started at rest on the first sample; its own lag at low
-  frequency, sqrt(2) / (2π f_a) with f_a = (f_s/π) tan(π f_c/f_s), comes on top of ``delay_ms``;
+- ``low_pass_hz``: a 2nd-order Butterworth anti-alias filter of this cut-off f_c [Hz], an analogue
+  filter before the sampling, whatever the recording's rate (:func:`analogue_low_pass`), started at
+  rest on the first sample; its own lag at low frequency, sqrt(2) / (2π f_c), comes on top of
+  ``delay_ms``;
 - ``delay_ms``: a pure lag of the channel behind the time base [ms] (acquisition buffering,
   sensor-head processing), the first sample held before the record starts;
 - ``drift_per_min``: a zero that drifts linearly through each recording, its rate drawn per
@@ -80,6 +81,8 @@ CROSSTALK = {"toe": "camber", "pad_fz": "pad_fy"}
 DRAWN = ("delay", "low_pass", "gain", "crosstalk", "ar1", "pink", "drift", "input_gain")
 _SIGNED = ("gain",)
 _FILTER_ORDER = 2
+#: The rate, in multiples of the recording's, at which the analogue filter is computed.
+_OVERSAMPLE = 8
 
 
 @dataclass(frozen=True)
@@ -103,8 +106,7 @@ class ChannelChain:
         dt = float(t_s[1] - t_s[0])
         y = (1.0 + self.gain) * x + sum(c * (seen or {})[q] for q, c in self.crosstalk)
         if self.low_pass_hz > 0.0:
-            sos = sps.butter(_FILTER_ORDER, self.low_pass_hz, fs=1.0 / dt, output="sos")
-            y, _ = sps.sosfilt(sos, y, zi=sps.sosfilt_zi(sos) * y[0])
+            y = analogue_low_pass(y, dt, self.low_pass_hz)
         if self.delay_ms > 0.0:
             y = np.interp(t_s - 1e-3 * self.delay_ms, t_s, y)
         rate = rng.uniform(-1.0, 1.0) * self.drift_per_min / 60.0
@@ -119,6 +121,20 @@ class ChannelChain:
 
 #: A channel's chain elements, the keys of a truth's chain entry.
 ELEMENTS = tuple(f.name for f in fields(ChannelChain))
+
+
+def analogue_low_pass(x: np.ndarray, dt: float, cutoff_hz: float) -> np.ndarray:
+    """``x`` (samples ``dt`` [s] apart) through an analogue 2nd-order Butterworth low-pass of
+    ``cutoff_hz``, started at rest on the first sample: the signal taken linear between samples at
+    :data:`_OVERSAMPLE` × the rate, there the filter's bilinear transform pre-warped to the analogue
+    cut-off, read back at the samples."""
+    fine = dt / _OVERSAMPLE
+    k = np.arange((len(x) - 1) * _OVERSAMPLE + 1)
+    between = np.interp(k / _OVERSAMPLE, np.arange(len(x)), x)
+    digital = math.atan(math.pi * cutoff_hz * fine) / (math.pi * fine)   # its pre-warped analogue one: cutoff_hz
+    sos = sps.butter(_FILTER_ORDER, digital, fs=1.0 / fine, output="sos")
+    y, _ = sps.sosfilt(sos, between, zi=sps.sosfilt_zi(sos) * x[0])
+    return y[::_OVERSAMPLE]
 
 
 def ar1(white: np.ndarray, sigma: float, phi: float) -> np.ndarray:

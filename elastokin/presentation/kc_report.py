@@ -86,6 +86,9 @@ def summary(d: KCDiagnosis) -> dict[str, Any]:
         "misfits": [_misfit(m) for m in d.misfits],
         "misfits_after": [_misfit(m) for m in d.misfits_after],
         "noise": {c: float(s) for c, s in zip(d.layout.channels, d.noise)},
+        "acquisition": [{"path": r.path, "channels": list(r.channels), "lag_ms": 1e3 * r.lag_s,
+                         "cutoff_hz": r.cutoff_hz or None, "delay_ms": 1e3 * r.delay_s, "delay_std_ms": 1e3 * r.std_s}
+                        for r in d.responses],
         "damage": list(d.layout.damage),
         "wall_s": d.wall_s,
     }
@@ -131,8 +134,26 @@ def _where(c: Candidate) -> str:
     return ", ".join(f"{k} {'/'.join(v) if isinstance(v, list) else v}" for k, v in loc.items())
 
 
+#: A path's lag is said in the verdict beyond this many standard uncertainties and this [s] (a
+#: rig's own lag well under a sample is not worth a word).
+LAG_SAID, LAG_SAID_S = 3.0, 1e-3
+
+
+def _acquisition_sentence(d: KCDiagnosis) -> str:
+    """What the diagnosis took out of the data as the rig's acquisition (each path's lag), if anything."""
+    said = [r for r in d.responses if abs(r.lag_s) > max(LAG_SAID * r.std_s, LAG_SAID_S)]
+    return "".join(f" The {r.path}' channels lag the rig inputs by {1e3 * r.lag_s:.1f} ms ("
+                   + (f"a {r.cutoff_hz:.3g} Hz low-pass filter, then " if r.cutoff_hz else "")
+                   + f"{1e3 * r.delay_s:.1f} ± {1e3 * r.std_s:.2g} ms): the rig's acquisition, estimated and taken "
+                     f"out." for r in said)
+
+
 def verdict_sentence(d: KCDiagnosis) -> str:
-    """One sentence for people."""
+    """One sentence for people: the cause, and what was taken out as the rig's acquisition."""
+    return _cause_sentence(d) + _acquisition_sentence(d)
+
+
+def _cause_sentence(d: KCDiagnosis) -> str:
     before, after = d.heldout_error_before, d.heldout_error_after
     if d.verdict == "none":
         return (f"Nothing significant is missing: the baseline's held-out error ({before:.2f} × the measurement "
@@ -224,7 +245,8 @@ def write_report(d: KCDiagnosis, baseline: VehicleDefinition, out_dir: Path, dat
                     f"Baseline: `{baseline.path}`; {len(d.test_names)} tests (recorded cases), {int(d.heldout.sum())} "
                     f"held out from every fit (every other one). Errors are RMS of measured − simulated over every "
                     f"measured channel but the rig inputs, each in units of its own measurement noise (estimated from "
-                    f"the data), each channel's zero in each recording removed: 1 is a perfect model.")
+                    f"the data), each channel's zero in each recording removed and each acquisition path's filter and "
+                    f"delay behind the rig inputs taken out: 1 is a perfect model.")
     if d.layout.damage:
         report.paragraph("**Diagnosed on a damaged dataset** (`--use-damaged`), with the samples its recordings hold: "
                          + "; ".join(d.layout.damage) + ".")
@@ -238,6 +260,13 @@ def write_report(d: KCDiagnosis, baseline: VehicleDefinition, out_dir: Path, dat
         written.append(model)
         report.paragraph(f"Extended model: [`{model.name}`]({model.name}) (a vehicle file: `vsim run` uses it "
                          f"through a scenario's `vehicle:` key).")
+    report.section("The rig's acquisition, taken out")
+    report.paragraph("Each acquisition path (channels sharing a filter and a delay behind the rig inputs, which the "
+                     "simulation is driven by) as fitted on the data beside the final model "
+                     "(`elastokin/diagnosis/kc_lags.py`; the cut-off's own uncertainty is not estimated):")
+    report.table(("path", "channels", "lag at low frequency [ms]", "low-pass [Hz]", "delay [ms]"),
+                 [(r.path, f"{len(r.channels)}", f"{1e3 * r.lag_s:.2f}", f"{r.cutoff_hz:.3g}" if r.cutoff_hz else "none",
+                   f"{1e3 * r.delay_s:.2f} ± {1e3 * r.std_s:.2g}") for r in d.responses])
     report.section("Ranking")
     report.paragraph("Every cause at every place it can sit was run once on the training tests and its magnitude "
                      "fitted; the best were run on every test and scored on the held-out ones.")

@@ -1,0 +1,104 @@
+"""The K&C diagnosis's model of a rig's acquisition (issue 53 item 2): each path's filter against
+its closed form, and on synthetic tests measured through the virtual rig's chain (written apart,
+elastokin/diagnosis/rig_chain.py) the paths' lags recovered, the residual at the noise, and a car's
+own effect left for the causes."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from elastokin.diagnosis.kc_fits import Scorer
+from elastokin.diagnosis.kc_lags import Response, paths
+from elastokin.diagnosis import kc_layout
+
+from elastokin.diagnosis.rig_chain import ChannelChain
+
+RATE_HZ = 50.0
+CHANNELS = ["wheel_travel_fl", "camber_fl", "toe_fl", "pad_fz_fl", "pad_height_fl"]
+#: Each channel's gain on the test's input, and its noise (channel units).
+GAINS = np.array([0.9, -0.02, 0.01, 120.0, 1.0])
+NOISE = np.array([0.02, 0.003, 0.003, 5.0, 0.02])
+
+
+def _triangle(t: np.ndarray, amplitude: float, period_s: float) -> np.ndarray:
+    return amplitude * (2.0 / math.pi) * np.arcsin(np.sin(2.0 * math.pi * t / period_s))
+
+
+def _layout(chains: dict[int, ChannelChain], seed: int, effect: np.ndarray | None = None) -> tuple[kc_layout.Layout, np.ndarray]:
+    """Four tests (triangles of 30 and 60 mm, two speeds), each its own recording, measured through
+    ``chains`` (channel index -> chain) with white noise; the simulated rows are the true ones
+    (plus ``effect`` (C,) × the input in the measurement: a car's own error)."""
+    rng = np.random.default_rng(seed)
+    true, measured, times, tests, start = [], [], [], [], 0
+    for k, (amplitude, period) in enumerate([(30.0, 10.0), (60.0, 10.0), (30.0, 4.0), (60.0, 4.0)]):
+        t = np.arange(0.0, 2.0 * period + 1e-9, 1.0 / RATE_HZ)
+        x = _triangle(t, amplitude, period)
+        rows = x[:, None] * GAINS[None, :]
+        seen = rows * (1.0 + (effect if effect is not None else 0.0))
+        cols = [chains[c].apply(t, seen[:, c], rng) if c in chains else seen[:, c] for c in range(len(CHANNELS))]
+        measured.append(np.column_stack(cols) + rng.normal(0.0, NOISE, rows.shape))
+        true.append(rows)
+        times.append(t)
+        tests.append(kc_layout.Test(f"test {k}", None, np.arange(start, start + len(t)), np.arange(len(t)), True))
+        start += len(t)
+    recording = np.concatenate([np.full(len(t.rows), k) for k, t in enumerate(tests)])
+    layout = kc_layout.Layout(CHANNELS, np.vstack(measured), np.concatenate(times), recording, recording.copy(), tests)
+    return layout, np.vstack(true)
+
+
+def test_the_paths_filter_lags_a_ramp_by_its_closed_form():
+    """The continuous 2nd-order Butterworth at f_c, discretised for a signal linear between samples,
+    delays a ramp by √2/(2π f_c) exactly, plus the path's delay."""
+    layout, _ = _layout({}, 0)
+    response = Response(layout, paths(CHANNELS))
+    ramp = np.tile(layout.input_time[:, None], (1, len(CHANNELS)))
+    out = response.apply(ramp, np.array([9.0, 20.0]), np.array([0.013, 0.002]))
+    rows = layout.tests[0].rows[100:400]
+    lag = (ramp - out)[rows]
+    assert lag[:, 0] == pytest.approx(math.sqrt(2.0) / (2.0 * math.pi * 9.0) + 0.013, abs=1e-9)
+    assert lag[:, 3] == pytest.approx(math.sqrt(2.0) / (2.0 * math.pi * 20.0) + 0.002, abs=1e-9)
+
+
+@pytest.mark.parametrize("seed", [1])
+def test_the_rigs_lags_are_recovered_and_the_residual_is_the_noise(seed):
+    """Wheel sensors 13 ms late behind a 9 Hz filter, pads 2 ms behind 20 Hz (the virtual rig's
+    digital filters): each path's lag at low frequency within 0.5 ms, the perfect model's error at
+    the noise; without a chain, no lag."""
+    rng = np.random.default_rng(seed)
+    wheel = ChannelChain(low_pass_hz=9.0, delay_ms=float(rng.uniform(10.0, 16.0)))
+    pad = ChannelChain(low_pass_hz=20.0, delay_ms=2.0)
+    layout, true = _layout({0: wheel, 1: wheel, 2: wheel, 3: pad, 4: pad}, seed)
+    heldout = np.array([False, True, False, True])
+    scorer = Scorer(layout, true, heldout)
+    lags = {r.path: r.lag_s for r in scorer.responses(true)}
+    truth = lambda c: math.sqrt(2.0) / (2.0 * math.pi * c.low_pass_hz) + 1e-3 * c.delay_ms
+    assert lags["wheel sensors"] == pytest.approx(truth(wheel), abs=5e-4)
+    assert lags["pad sensors"] == pytest.approx(truth(pad), abs=5e-4)
+    assert scorer.heldout_error(true) == pytest.approx(1.0, abs=0.05)
+    plain, true = _layout({}, seed)
+    scorer = Scorer(plain, true, heldout)
+    assert all(abs(r.lag_s) < max(4.0 * r.std_s, 1e-4) for r in scorer.responses(true))
+    assert scorer.heldout_error(true) == pytest.approx(1.0, abs=0.05)
+
+
+def test_a_cars_own_error_is_left_for_the_causes():
+    """The toe 3 % and the pad load 2 % off their model (a car's error, not the rig's), measured
+    through the same chain: the comparison still shows them, tens of times the noise."""
+    wheel, pad = ChannelChain(low_pass_hz=9.0, delay_ms=13.0), ChannelChain(low_pass_hz=20.0, delay_ms=2.0)
+    chains = {0: wheel, 1: wheel, 2: wheel, 3: pad, 4: pad}
+    layout, true = _layout(chains, 3, effect=np.array([0.0, 0.0, 0.03, 0.02, 0.0]))
+    scorer = Scorer(layout, true, np.array([False, True, False, True]))
+    every = np.ones(len(true), dtype=bool)
+    errors = np.sqrt(np.mean(scorer.residual(true, every) ** 2, axis=0))
+    # the effect's own size in noise units, each recording's mean out (as the zero errors are)
+    effect = true * np.array([0.0, 0.0, 0.03, 0.02, 0.0])
+    for k in range(4):
+        effect[layout.recording == k] -= effect[layout.recording == k].mean(axis=0)
+    size = np.sqrt(np.mean((effect / NOISE) ** 2, axis=0))
+    assert size[2] > 2.0 and size[3] > 2.0
+    for c in (2, 3):   # all of it still there: the chain's model took none of it
+        assert math.sqrt(errors[c] ** 2 - 1.0) == pytest.approx(size[c], rel=0.1)
+    assert errors[0] == pytest.approx(1.0, abs=0.1) and errors[1] == pytest.approx(1.0, abs=0.1)
