@@ -39,9 +39,12 @@ from elastokin.diagnosis.kc_fits import (Candidate, Scorer, fit, fit_pair, halfw
                                     verify)
 from elastokin.diagnosis.kc_layout import Layout, Test
 from elastokin.diagnosis.verdict import Separation, pair_named, split, told_apart
-from elastokin.diagnosis.rig_chain import DRAWN, draw_chain
+from elastokin.diagnosis.rig_chain import DRAWN, GROUPS, draw_chain
 from elastokin.diagnosis.virtual_kc_rig import DEFAULT_SCENARIOS, measure_kc, parse_kc_truth
 from tests.test_rig_chain import WHITE   # the white noise of each measured quantity: a drawn chain's scale
+from tests.test_rig_export import _import_all
+from elastokin.cli import main as cli
+from elastokin.vehicle.scenarios.channels import CORNER_TAGS
 from elastokin.presentation.kc_report import _candidate, _parameters, summary, write_report
 from elastokin.recordings.recorder import run_scenario, simulate
 from elastokin.recordings.kc_dataset import read_kc_dataset
@@ -589,23 +592,67 @@ def test_a_drawn_cause_is_named_at_its_place(tmp_path):
     check(diagnose_fresh(measured), h)
 
 
+#: The end-to-end tests' rig: the wheel-position heads (toe, camber, wheel travel and centre: one
+#: acquisition path) 15 ms late, the pads' lateral-force transducers reading 1.5 % high (the car gets
+#: the command / 1.015).
+E2E_CHAIN = {**{stem: {"delay_ms": 15.0} for stem in GROUPS["wheel_sensors"]}, "pad_fy": {"gain": 0.015}}
+
+
+def through_a_rigs_csv(tmp: Path, hs: list[Hypothesis], seed: int) -> Path:
+    """The default car with ``hs`` hidden measured on the lateral-force test at 10 times its speed
+    through :data:`E2E_CHAIN`, exported as a rig's CSV + META in SAE signs (`vsim rig export`) and
+    brought in as a user's would be (`vsim rig import`, `vsim rig dataset`): the dataset's folder."""
+    root = Path(__file__).resolve().parents[1]
+    measured = measure_truth(tmp, hs, seed, duration_scale=0.1, chain=E2E_CHAIN,
+                             scenarios=[str(root / "scenarios" / "kc" / "lateral_force.yaml")])
+    assert cli.main(["rig", "export", str(measured), "-o", str(tmp / "csv"), "--convention", "sae"]) == 0
+    _import_all(tmp / "csv", tmp / "dataset")
+    return tmp / "dataset"
+
+
+def assert_the_chain_recovered(result: dict) -> None:
+    """The wheel sensors' 15 ms and the pads' none within 3 standard uncertainties and
+    LAG_TOLERANCE_S; every pad's lateral-force gain within 3 of its uncertainties (and 0.1 %) of
+    1.5 % (on one test, its response's channels' own gains act alike: the uncertainty is wide), every
+    measured channel's gain and cross-talk of none."""
+    lags = {a["path"]: a for a in result["acquisition"]}
+    for path, truth_ms in (("wheel sensors", 15.0), ("pad sensors", 0.0)):
+        lag = lags[path]
+        assert abs(lag["lag_ms"] - truth_ms) <= 3.0 * lag["delay_std_ms"] + 1e3 * LAG_TOLERANCE_S, lag
+    gains = {g["channel"]: g for g in result["transducers"] if g["kind"] == "input gain"}
+    assert set(gains) == {f"pad_fy_{w}" for w in CORNER_TAGS.values()}
+    for g in gains.values():
+        assert abs(g["value"] - 0.015) <= 3.0 * g["std"] + 1e-3, g
+    for g in result["transducers"]:   # the measured channels' transducers read true
+        if g["kind"] != "input gain":
+            assert abs(g["value"]) <= 3.0 * g["std"] + 2e-3, g
+
+
+def test_a_clean_car_through_a_rigs_lag_and_force_gain_is_given_no_car_cause(tmp_path):
+    """A clean car measured through :data:`E2E_CHAIN` and brought in as a rig's SAE CSV exports:
+    "none", the lag and the gains recovered (without the gains' fit: a coupling and a stiffness)."""
+    result = diagnose_fresh(through_a_rigs_csv(tmp_path, [], 2))
+    check(result, None)
+    assert_the_chain_recovered(result)
+
+
 def test_report_of_a_one_scenario_dataset_and_a_bushing_stiffer_than_its_law(tmp_path):
     """The rear pivot's axial direction 250 N/mm where the car's file says 200 (a harder rubber,
-    ×1.25), measured on the lateral-force test alone at 10 times its speed: a stiffness factor named
-    at its place, its factor within 3 standard uncertainties and 3 %, not an asymmetry; the same
-    verdict, every number of it, on a local Dask cluster and serially; ``-o`` writes the report, its
-    pictures, diagnosis.json and an extended vehicle file that carries the fitted factor where it
-    was found."""
-    root = Path(__file__).resolve().parents[1]
+    ×1.25), measured on the lateral-force test alone at 10 times its speed through a rig's lag and
+    force gain, brought in as the rig's SAE CSV exports (:func:`through_a_rigs_csv`): a stiffness
+    factor named at its place, its factor within 3 standard uncertainties and 3 %, not an asymmetry;
+    the chain recovered; the same verdict, every number of it, on a local Dask cluster and serially;
+    ``-o`` writes the report, its pictures, diagnosis.json and an extended vehicle file that carries
+    the fitted factor where it was found."""
     h = Hypothesis("stiffness", ("e1_rear", "x"), {"stiffness_scale": 1.25})
-    measured = measure_truth(tmp_path, [h], 2, duration_scale=0.1,
-                             scenarios=[str(root / "scenarios" / "kc" / "lateral_force.yaml")])
+    measured = through_a_rigs_csv(tmp_path, [h], 2)
     report = tmp_path / "report"
     result = diagnose_fresh(measured, "-o", str(report))   # on a local Dask cluster of 2 workers
     check(result, h)
     fitted = result["parameters"]["stiffness_scale"]
     assert abs(fitted["value"] - 1.25) <= min(3.0 * fitted["std"], 0.03 * 1.25), fitted
     assert all(c["cause"] != "asymmetry" for c in result["causes"])
+    assert_the_chain_recovered(result)
     # the same verdict, every number of it, serially in this process
     serial = diagnose_kc(read_kc_dataset(measured), load_vehicle(DEFAULT_VEHICLE), executor=SerialExecutor())
     assert ({k: v for k, v in json.loads(json.dumps(summary(serial))).items() if k != "wall_s"}
@@ -614,6 +661,7 @@ def test_report_of_a_one_scenario_dataset_and_a_bushing_stiffer_than_its_law(tmp
     text = (report / "report.md").read_text()
     assert text.count("![") == 3 and all((report / name).stat().st_size > 0 for name in
                                          ("overlays.png", "residuals.png", "ranking.png"))
+    assert "pad_fy_fl" in text and "transducer" in text   # the gains said and tabled
     extended = {b.name: b for b in load_vehicle(report / "extended_vehicle.yaml").bushings}
     baseline = {b.name: b for b in load_vehicle(DEFAULT_VEHICLE).bushings}
     assert extended["e1_rear"].directions["x"].params["K0"] == pytest.approx(
@@ -680,13 +728,23 @@ def _chain_lags(chain: dict) -> dict[str, float]:
     return out
 
 
+def _chain_reading(chain: dict, reading: dict) -> float:
+    """A drawn chain's value of a transducer error the diagnosis reports (a gain; a cross-talk's
+    coefficient), from the channel's own entry over its quantity's."""
+    entry = {**chain.get(reading["channel"].rsplit("_", 1)[0], {}), **chain.get(reading["channel"], {})}
+    if reading["kind"] == "cross-talk":
+        return entry.get("crosstalk", {}).get(reading["source"], 0.0)
+    return entry.get("gain", 0.0)
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("cause, elements", [("none", (e,)) for e in DRAWN] + [("none", DRAWN)]
-                         + [(c, ("delay", "low_pass")) for c in KC_CAUSES])
+                         + [(c, DRAWN) for c in KC_CAUSES])
 def test_success_rate_through_a_rigs_acquisition(tmp_path, record_property, cause, elements):
     """Measured through a typical rig's chain drawn from the seed (each element alone on clean cars,
-    all of them; the acquisition's lag with each cause): a clean car never given a car cause, a
-    cause named as without the chain (check), each path's lag recovered (issue 53)."""
+    all of them; all of them with each cause): a clean car never given a car cause, a cause named as
+    without the chain (check), each path's lag and each moved input's transducer gain recovered
+    within 3 of its standard uncertainties (and LAG_TOLERANCE_S, 0.1 %) (issue 53)."""
     def attempt(case: Path, seed: int) -> str:
         rng = np.random.default_rng([seed, 53])
         chain = draw_chain(rng, "typical", WHITE, elements)
@@ -695,6 +753,9 @@ def test_success_rate_through_a_rigs_acquisition(tmp_path, record_property, caus
         for a in result["acquisition"]:
             truth = _chain_lags(chain)[a["path"]]
             assert abs(1e-3 * a["lag_ms"] - truth) <= 3e-3 * a["delay_std_ms"] + LAG_TOLERANCE_S, (a, truth)
+        for g in result["transducers"]:
+            truth = _chain_reading(chain, g)
+            assert abs(g["value"] - truth) <= 3.0 * g["std"] + 1e-3, (g, truth)
         return check(result, h)
 
     assert_success_rate(f"{cause} through {'+'.join(elements)}", SLOW_SEEDS, tmp_path, attempt, record_property,

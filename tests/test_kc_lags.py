@@ -14,7 +14,7 @@ from elastokin.diagnosis.kc_fits import Scorer
 from elastokin.diagnosis.kc_lags import Response, paths
 from elastokin.diagnosis import kc_layout
 
-from elastokin.diagnosis.rig_chain import ChannelChain
+from elastokin.diagnosis.rig_chain import ChannelChain, ar1
 
 RATE_HZ = 50.0
 CHANNELS = ["wheel_travel_fl", "camber_fl", "toe_fl", "pad_fz_fl", "pad_height_fl"]
@@ -42,7 +42,8 @@ def _layout(chains: dict[int, ChannelChain], seed: int, effect: np.ndarray | Non
         measured.append(np.column_stack(cols) + rng.normal(0.0, NOISE, rows.shape))
         true.append(rows)
         times.append(t)
-        tests.append(kc_layout.Test(f"test {k}", None, np.arange(start, start + len(t)), np.arange(len(t)), True))
+        tests.append(kc_layout.Test(f"test {k}", None, np.arange(start, start + len(t)), np.arange(len(t)), True,
+                                    int(round(period * RATE_HZ))))
         start += len(t)
     recording = np.concatenate([np.full(len(t.rows), k) for k, t in enumerate(tests)])
     layout = kc_layout.Layout(CHANNELS, np.vstack(measured), np.concatenate(times), recording, recording.copy(), tests)
@@ -93,12 +94,51 @@ def test_a_cars_own_error_is_left_for_the_causes():
     scorer = Scorer(layout, true, np.array([False, True, False, True]))
     every = np.ones(len(true), dtype=bool)
     errors = np.sqrt(np.mean(scorer.residual(true, every) ** 2, axis=0))
-    # the effect's own size in noise units, each recording's mean out (as the zero errors are)
+    # the effect's own size in the noise's units as estimated, each recording's mean out (as the zero errors are)
     effect = true * np.array([0.0, 0.0, 0.03, 0.02, 0.0])
     for k in range(4):
         effect[layout.recording == k] -= effect[layout.recording == k].mean(axis=0)
-    size = np.sqrt(np.mean((effect / NOISE) ** 2, axis=0))
+    size = np.sqrt(np.mean((effect / scorer.noise) ** 2, axis=0))
     assert size[2] > 2.0 and size[3] > 2.0
     for c in (2, 3):   # all of it still there: the chain's model took none of it
         assert math.sqrt(errors[c] ** 2 - 1.0) == pytest.approx(size[c], rel=0.1)
     assert errors[0] == pytest.approx(1.0, abs=0.1) and errors[1] == pytest.approx(1.0, abs=0.1)
+
+
+@pytest.mark.parametrize("seed", [2, 3])
+def test_coloured_noise_and_a_drifting_zero_are_noise_not_a_model_error(seed):
+    """Each channel through AR(1) noise of twice its white noise (correlation time 0.5 s) and a zero
+    drifting by up to twice it per minute (the virtual rig's chain): the noise estimated from the
+    residual is the white and the coloured noise together (the channels' median within 15 %; each
+    channel is its own quantity here, estimated alone), so the perfect model's error is the noise
+    (within 0.1), where the white noise alone would make it 2."""
+    chains = {c: ChannelChain(ar1_sigma=2.0 * NOISE[c], ar1_time_constant_s=0.5, drift_per_min=2.0 * NOISE[c])
+              for c in range(len(CHANNELS))}
+    layout, true = _layout(chains, seed)
+    scorer = Scorer(layout, true, np.array([False, True, False, True]))
+    assert np.median(scorer.noise / NOISE) == pytest.approx(math.sqrt(5.0), rel=0.15)
+    assert scorer.heldout_error(true) == pytest.approx(1.0, abs=0.1)
+
+
+def test_a_fits_uncertainty_holds_for_coloured_noise():
+    """A smooth effect's coefficient fitted on residuals of AR(1) noise (correlation time 0.5 s at
+    50 Hz: φ = 0.96, n samples worth n(1 − φ)/(1 + φ)): the standard uncertainty the scorer gives
+    is the scatter of the coefficient over 200 draws (within 25 %), where white noise's formula
+    claims seven times less."""
+    layout, true = _layout({}, 0)
+    scorer = Scorer(layout, true, np.array([False, True, False, True]))
+    every = np.ones(len(true), dtype=bool)
+    column = true / NOISE                      # an effect proportional to the input, in noise units
+    rng = np.random.default_rng(4)
+    phi = math.exp(-1.0 / (RATE_HZ * 0.5))
+    fitted, claimed = [], []
+    for _ in range(200):
+        white = rng.standard_normal(true.shape)
+        noise = np.vstack([np.column_stack([ar1(white[t.rows, c], 1.0, phi) for c in range(len(CHANNELS))])
+                           for t in layout.tests])
+        coef = float(np.sum(column * noise) / np.sum(column * column))
+        fitted.append(coef)
+        claimed.append(math.sqrt(scorer.variances(noise - coef * column, [column], every)[0]))
+    scatter = float(np.std(fitted))
+    assert np.median(claimed) == pytest.approx(scatter, rel=0.25)
+    assert 1.0 / math.sqrt(float(np.sum(column * column))) < scatter / 5.0

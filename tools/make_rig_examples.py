@@ -1,8 +1,11 @@
 """Regenerate the shipped measured examples in data/rig/ with the virtual rig.
 
-    python tools/make_rig_examples.py              # writes data/rig/bench and data/rig/kc (overwrites)
+    python tools/make_rig_examples.py              # writes data/rig/bench, kc and kc_csv (overwrites)
     python tools/make_rig_examples.py kc           # only data/rig/kc (seven K&C cases: about half a minute)
     python tools/make_rig_examples.py kc --output-dir /tmp/rig    # elsewhere
+
+``kc_csv`` is shipped as a rig delivers it: each test's CSV export and META in SAE signs (`vsim rig
+export`), the recordings measured by the virtual rig left out.
 
 The truths live in tools/truths/, not beside the data, so that the datasets do not reveal them.
 """
@@ -11,12 +14,16 @@ from __future__ import annotations
 
 import argparse
 import sys
+import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 TRUTHS = ROOT / "tools" / "truths"
 #: Dataset name (its folder in data/rig/) -> the truth it is measured on.
-EXAMPLES = {"bench": TRUTHS / "bench_example.yaml", "kc": TRUTHS / "kc_example.yaml"}
+EXAMPLES = {"bench": TRUTHS / "bench_example.yaml", "kc": TRUTHS / "kc_example.yaml",
+            "kc_csv": TRUTHS / "kc_csv_example.yaml"}
+#: Datasets shipped as a rig's CSV exports, in this sign convention.
+EXPORTED = {"kc_csv": "sae"}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -32,7 +39,13 @@ def main(argv: list[str] | None = None) -> int:
     if unknown:
         parser.error(f"unknown dataset {unknown[0]!r}; expected one of {', '.join(EXAMPLES)}")
     for name in args.names or list(EXAMPLES):
-        status = vsim(["rig", "measure", str(EXAMPLES[name]), "-o", str(args.output_dir / name), "--overwrite"])
+        if name in EXPORTED:
+            with tempfile.TemporaryDirectory() as tmp:
+                status = (vsim(["rig", "measure", str(EXAMPLES[name]), "-o", tmp, "--overwrite"])
+                          or vsim(["rig", "export", tmp, "-o", str(args.output_dir / name), "--convention",
+                                   EXPORTED[name], "--overwrite"]))
+        else:
+            status = vsim(["rig", "measure", str(EXAMPLES[name]), "-o", str(args.output_dir / name), "--overwrite"])
         if status:
             return status
     return 0

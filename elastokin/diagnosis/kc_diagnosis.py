@@ -58,8 +58,10 @@ from elastokin.diagnosis.kc_catalogue import (BUSHING_CAUSES, VEHICLE_CAUSES, Hy
                                          parameters)
 from elastokin.diagnosis.kc_fits import (Candidate, Scorer, fit, fit_pair, halfway, kept, nominal, nudged, significant,
                                     verify)
+from elastokin.diagnosis.kc_transducers import INPUT_GAIN, STEP, Reading, input_column, moved, reading_columns, stepped
 from elastokin.diagnosis.kc_lags import PathResponse
-from elastokin.diagnosis.kc_layout import Layout, run_job
+from elastokin.diagnosis.kc_noise import NoiseModel, coloured_noise
+from elastokin.diagnosis.kc_layout import Job, Layout, run_job
 from elastokin.diagnosis.verdict import (Outcome, Separation, decide, explained, misfit, misfit_stretch, pair_named,
                                     pair_shares, second_cause_wanted, single_verdict, split)
 from elastokin.recordings.kc_dataset import KCDataset
@@ -114,6 +116,12 @@ class KCDiagnosis(Outcome):
     #: each acquisition path's filter and delay behind the rig inputs, fitted beside the final model
     #: (:mod:`elastokin.diagnosis.kc_lags`) and taken out of every comparison
     responses: list[PathResponse] = field(default_factory=list)
+    #: the measurement noise, white and coloured, estimated from the baseline's residual (:mod:`elastokin.diagnosis.kc_noise`)
+    noise_model: NoiseModel | None = None
+    #: the transducers' errors (the moved rig inputs' gains, the measured channels' gains and
+    #: cross-talk), fitted beside the final model and taken out of every comparison
+    #: (:mod:`elastokin.diagnosis.kc_transducers`)
+    transducers: list[Reading] = field(default_factory=list)
 
     @property
     def final(self) -> Candidate:
@@ -177,25 +185,40 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, executor: Execut
     training = [i for i in every if not heldout[i]]
     candidates = hypotheses(vehicle)
     with nullcontext(executor) if executor is not None else open_executor() as pool:
-        def rows(vehicles: list[VehicleDefinition], tests: Sequence[int]) -> list[np.ndarray]:
-            """The compared rows of each vehicle on ``tests`` (NaN elsewhere), the runs in parallel."""
-            n = len(tests)
-            flat: list[dict[str, np.ndarray]] = [{}] * (n * len(vehicles))
-            jobs = [j for v in vehicles for j in layout.jobs(v, tests)]
-            with closing(pool.each(run_job, jobs)) as outcomes:   # a failure cancels the others at once
+        def runs(sets: list[tuple[str, list[Job], Sequence[int]]]) -> list[np.ndarray]:
+            """The compared rows of each set of runs (what it is, its jobs, the tests they run: NaN
+            elsewhere), all in parallel."""
+            jobs = [(label, t, j) for label, js, tests in sets for t, j in zip(tests, js)]
+            flat: list[dict[str, np.ndarray]] = [{}] * len(jobs)
+            each = max(1, len(jobs) // len(sets))
+            with closing(pool.each(run_job, [j for _, _, j in jobs])) as outcomes:   # a failure cancels the others at once
                 for done, o in enumerate(outcomes, 1):
                     if o.error:
-                        raise TaskFailed(f"vehicle {o.index // n + 1} of {len(vehicles)} on "
-                                         f"{layout.tests[tests[o.index % n]].name}: {o.error}")
+                        label, test, _ = jobs[o.index]
+                        raise TaskFailed(f"{label} on {layout.tests[test].name}: {o.error}")
                     flat[o.index] = o.result
-                    if len(vehicles) > 1 and done % n == 0:
+                    if len(sets) > 1 and done % each == 0:
                         say(f"  {done}/{len(flat)} runs done on {pool.description}")
-            return [layout.stack(flat[i * n:(i + 1) * n], tests) for i in range(len(vehicles))]
+            out, start = [], 0
+            for _, js, tests in sets:
+                out.append(layout.stack(flat[start:start + len(js)], tests))
+                start += len(js)
+            return out
+
+        def rows(vehicles: list[VehicleDefinition], tests: Sequence[int]) -> list[np.ndarray]:
+            """The compared rows of each vehicle on ``tests`` (NaN elsewhere), the runs in parallel."""
+            return runs([(f"vehicle {k + 1} of {len(vehicles)}", layout.jobs(v, tests), tests)
+                         for k, v in enumerate(vehicles)])
 
         say(f"baseline {vehicle.name} on {len(data.tests)} recordings, {len(layout.tests)} tests "
             f"({int(heldout.sum())} held out)")
         (base,) = rows([vehicle], every)
-        scorer = Scorer(layout, base, heldout)
+        movers = moved(layout)
+        say(f"the baseline with each of the {len(movers)} rig inputs moved × {1 + STEP:g} (its transducer's gain)")
+        stepped_rows = runs([(f"{ch} × {1 + STEP:g}", stepped(layout, ch, tests), tests) for ch, tests in movers.items()])
+        scorer = Scorer(layout, base, heldout, {**{(INPUT_GAIN, ch, None): input_column(r, base)
+                                                   for ch, r in zip(movers, stepped_rows)},
+                                                **reading_columns(layout, base)})
         before = scorer.heldout_error(base)
         say(f"held-out error of the baseline: {before:.3f} (1 = the measurement noise); one run of each of "
             f"{len(candidates)} hypotheses at mid-range magnitude on the {len(training)} training tests")
@@ -275,6 +298,14 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, executor: Execut
         out.verdict = PAIR_SEPARATOR.join(h.cause for h in named)
         out.extended = extended_vehicle(vehicle, named)
     out.responses = scorer.responses(out.final.simulated if out.named else base)
+    out.noise_model = scorer.noise_model
+    out.transducers = scorer.transducers(out.final.simulated if out.named else base)
+    for g in out.transducers:
+        if g.said:
+            say(f"{g.label}: {g.value:+.4f} ± {g.std:.2g} (taken out)")
+    for q, (white, coloured, tau) in coloured_noise(layout.channels, scorer.noise_model).items():
+        say(f"the {q} channels' noise is coloured: {coloured / white:.2g} × their white noise, correlated over "
+            f"{tau:.2g} s (counted in the noise, its uncertainties and thresholds)")
     for r in out.responses:
         say(f"the {r.path}' channels lag the rig inputs by {1e3 * r.lag_s:.2f} ms at low frequency: "
             f"{f'a {r.cutoff_hz:.3g} Hz low-pass, then ' if r.cutoff_hz else ''}{1e3 * r.delay_s:.2f} ± "
@@ -347,14 +378,17 @@ def _best_per_place(candidates: Iterable[Candidate]) -> list[Candidate]:
 
 def located_misfits(layout: Layout, scorer: Scorer, predicted: np.ndarray) -> list[Misfit]:
     """The tests ``predicted`` does not fit (:func:`elastokin.diagnosis.verdict.misfit`: the RMS error
-    over a test or a stretch of it beyond the noise; every test, training or held out), each with
+    over a test or a stretch of it beyond the noise, its correlation counted; every test, training
+    or held out), each with
     where; each recording's zeros taken as its medians, so that one misfit does not shift the tests
     beside it."""
     residual = scorer.residual(predicted, np.ones(len(predicted), dtype=bool), np.median)
     out = []
     for i, t in enumerate(layout.tests):
         error = float(np.sqrt(np.mean(residual[t.rows] ** 2)))
-        chance, first, last, channel = misfit_stretch(residual[t.rows])
+        dt = float(np.median(np.diff(layout.input_time[t.rows]))) if len(t.rows) > 1 else 0.0
+        chance, first, last, channel = misfit_stretch(residual[t.rows],
+                                                      lambda width: scorer.noise_model.window_dof(width, dt))
         if misfit(error, chance):
             out.append(Misfit(t.name, bool(scorer.heldout[i]), error, chance, float(layout.input_time[t.rows[first]]),
                               float(layout.input_time[t.rows[last]]), layout.channels[channel]))

@@ -7,20 +7,26 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
-from typing import Callable
+from typing import Callable, Mapping
 
 import numpy as np
 
 from elastokin.diagnosis.catalogue import Parameter
+from elastokin.diagnosis.fit_uncertainty import standard_errors
 from elastokin.diagnosis.kc_catalogue import Hypothesis, parameters
 from elastokin.diagnosis.kc_lags import PathResponse, Response, fit_response, paths
+from elastokin.diagnosis.kc_transducers import INPUT_GAIN, Key, Reading, reading
 from elastokin.diagnosis.kc_layout import Layout
+from elastokin.diagnosis.kc_noise import estimate_noise, white_noise
 from elastokin.vehicle.scenarios.channels import channel_quantity
 
 #: Relative increase of the held-out score per fitted parameter.
 PARAMETER_PENALTY = 0.02
 #: Standard uncertainties by which a fitted magnitude must stand off no effect to be a cause found.
 SIGNIFICANT = 2.0
+#: The largest rig input's gain fitted (its command's scale): a rig's calibration is good to ±0.5–2 %
+#: (issue 53); what a larger one would take (a test's whole response scaled) is left to the car's causes.
+INPUT_GAIN_BOUND = 0.025
 
 
 @dataclass
@@ -57,40 +63,39 @@ class Candidate:
 
 
 class Scorer:
-    """Residuals in noise units: the prediction through each acquisition path's filter and delay
-    (:mod:`elastokin.diagnosis.kc_lags`, estimated on the baseline; what is left of the delay to first
-    order fitted with every prediction), each channel's zero error in each recording removed;
-    errors per test."""
+    """Residuals in units of the measurement noise (white and coloured, :mod:`elastokin.diagnosis.kc_noise`):
+    the prediction through each acquisition path's filter and delay (:mod:`elastokin.diagnosis.kc_lags`,
+    estimated on the baseline; what is left of them to first order fitted with every prediction),
+    each transducer's error fitted with every prediction (:mod:`elastokin.diagnosis.kc_transducers`),
+    each channel's zero error in each recording removed; errors per test."""
 
-    def __init__(self, layout: Layout, baseline: np.ndarray, heldout: np.ndarray):
+    def __init__(self, layout: Layout, baseline: np.ndarray, heldout: np.ndarray,
+                 transducers: Mapping[Key, np.ndarray] | None = None):
+        """``transducers``: the rows' derivative (N, C) with respect to each transducer error fitted
+        with every prediction (:mod:`elastokin.diagnosis.kc_transducers`), as the rig's acquisition
+        delivers it (here)."""
         self.layout, self.heldout = layout, heldout
         self.held_rows = heldout[layout.test]
         self.paths = paths(layout.channels)
         self.response = Response(layout, self.paths)
         every = np.ones(len(baseline), dtype=bool)
-        self.noise = self._noise(layout.measured - baseline)
+        self.noise = white_noise(layout, layout.measured - baseline)   # the fit's weights, until the noise's model
         self.cutoffs_hz, self.delays_s = fit_response(self.response, layout.measured, baseline,
                                                       lambda r: self._zeroed(r, every, np.mean))
         delivered = self._delivered(baseline)
-        self.noise = self._noise(layout.measured - delivered)
+        #: the measurement noise, white and coloured (:mod:`elastokin.diagnosis.kc_noise`)
+        self.noise_model = estimate_noise(layout, layout.measured - delivered)
+        self.noise = self.noise_model.sigma
         self._rates, self._taps = self.response.rates(delivered), self.response.taps(delivered)
-        self._columns: dict[bytes, list[tuple[np.ndarray, list[np.ndarray], np.ndarray]]] = {}
+        self._transducers = {k: self._delivered(c) for k, c in (transducers or {}).items()}   # linear in the rows
+        self._columns: dict[bytes, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+        #: which of the transducers' columns are rig inputs' gains (held within a bound)
+        self._inputs = np.array([key[0] == INPUT_GAIN for key in self._transducers], dtype=bool)
         #: the last residual: (the prediction, its rows and zero, the residual), read-only
         self._last: tuple[np.ndarray, tuple, np.ndarray] | None = None
 
     def _delivered(self, rows: np.ndarray) -> np.ndarray:
         return self.response.apply(rows, self.cutoffs_hz, self.delays_s)
-
-    def _noise(self, residual: np.ndarray) -> np.ndarray:
-        """Per channel: the white noise of the residual from its sample-to-sample differences within
-        each test (robust: median absolute deviation), which a smooth model error hardly affects;
-        channels of one quantity share their median. Only successive samples are differenced (a
-        damaged recording's gap is not one)."""
-        d = np.vstack([np.diff(residual[t.rows], axis=0)[np.diff(t.samples) == 1] for t in self.layout.tests])
-        per = 1.4826 * np.median(np.abs(d - np.median(d, axis=0)), axis=0) / math.sqrt(2.0)
-        family = [channel_quantity(c) for c in self.layout.channels]
-        out = np.array([np.median([p for p, g in zip(per, family) if g == f]) for f in family])
-        return np.maximum(out, 1e-9)
 
     def _zeroed(self, r: np.ndarray, rows: np.ndarray, zero: Callable[..., np.ndarray]) -> np.ndarray:
         """``r`` (the selected rows) with each channel's ``zero`` in each recording removed, in noise units."""
@@ -99,19 +104,49 @@ class Scorer:
             r[rec == k] -= zero(r[rec == k], axis=0)
         return r / self.noise
 
-    def _lag_columns(self, rows: np.ndarray) -> list[tuple[np.ndarray, list[np.ndarray], np.ndarray]]:
-        """Per acquisition path, on the selected rows, zeroed as the residual is: its delay's
-        correction column (its channels' rates through the response), the taps' columns
-        (:meth:`elastokin.diagnosis.kc_lags.Response.taps`) and the pseudo-inverse of their Gram
-        matrix, cached per selection."""
+    def _nuisance(self, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """On the selected rows, zeroed as the residual is: the columns fitted with every prediction
+        (K, n, C) (each path's taps (:meth:`elastokin.diagnosis.kc_lags.Response.taps`) on its
+        channels in the tests of each sampling rate, then each transducer's), their Gram matrix and
+        its pseudo-inverse; cached per selection."""
         key = rows.tobytes()
         if key not in self._columns:
-            blocks = [self._zeroed(c[rows], rows, np.mean) for c in (self._rates, *self._taps)]
-            self._columns[key] = []
+            taps = [c[rows] for c in self._taps]
+            # a sample's shift is a time at each sampling rate: the taps of the tests at each rate apart
+            steps = np.round(np.array(self.response.steps), 9)[self.layout.test[rows]]
+            columns = []
             for idx in self.paths.values():
-                rate, *taps = [b[:, idx] for b in blocks]
-                self._columns[key].append((rate, taps, np.linalg.pinv(_gram([c.ravel() for c in taps]))))
+                for step in np.unique(steps):
+                    for tap in taps:
+                        own = np.zeros_like(tap)
+                        own[np.ix_(steps == step, idx)] = tap[np.ix_(steps == step, idx)]
+                        columns.append(self._zeroed(own, rows, np.mean))
+            columns += [self._zeroed(c[rows], rows, np.mean) for c in self._transducers.values()]
+            stack = np.array(columns).reshape(len(columns), int(rows.sum()), len(self.layout.channels))
+            flat = stack.reshape(len(columns), stack[0].size if columns else 0)
+            gram = flat @ flat.T
+            self._columns[key] = (stack, gram, np.linalg.pinv(gram))
         return self._columns[key]
+
+    def _fitted(self, r: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The residual ``r`` on the selected rows with the nuisance columns fitted out, the columns
+        and their coefficients. A rig input's gain is held within ± :data:`INPUT_GAIN_BOUND` (a
+        calibrated rig's): beyond, it is held at the bound and the other columns refitted, what is
+        left being the car's."""
+        stack, gram, inverse = self._nuisance(rows)
+        if not len(stack):
+            return r, stack, np.zeros(0)
+        flat = stack.reshape(len(stack), r.size)
+        seen = flat @ r.ravel()
+        coef = inverse @ seen
+        over = np.zeros(len(coef), dtype=bool)
+        over[len(coef) - len(self._inputs):] = self._inputs
+        over &= np.abs(coef) > INPUT_GAIN_BOUND
+        if over.any():
+            coef[over] = np.clip(coef[over], -INPUT_GAIN_BOUND, INPUT_GAIN_BOUND)
+            free = ~over
+            coef[free] = np.linalg.pinv(gram[np.ix_(free, free)]) @ (seen[free] - gram[np.ix_(free, over)] @ coef[over])
+        return r - (coef @ flat).reshape(r.shape), stack, coef
 
     def _raw(self, predicted: np.ndarray, rows: np.ndarray, zero: Callable[..., np.ndarray]) -> np.ndarray:
         return self._zeroed(self.layout.measured[rows] - self._delivered(predicted)[rows], rows, zero)
@@ -122,15 +157,39 @@ class Scorer:
         standard uncertainty (the residual's own correlation along time counted)."""
         every = np.ones(len(predicted), dtype=bool)
         r = self._raw(predicted, every, np.mean)
+        rates = self._zeroed(self._rates.copy(), every, np.mean)
         out = []
-        for (name, idx), (d, _, _), cutoff, delay in zip(self.paths.items(), self._lag_columns(every),
-                                                       self.cutoffs_hz, self.delays_s):
+        for (name, idx), cutoff, delay in zip(self.paths.items(), self.cutoffs_hz, self.delays_s):
+            d = rates[:, idx]
             dd = float(np.sum(d * d))
             a = float(np.sum(d * r[:, idx])) / dd if dd > 0.0 else 0.0
-            std = math.sqrt(_variances((r[:, idx] - a * d).T.ravel(), np.array([[dd]]))[0])
+            std = math.sqrt(self.variances(r[:, idx] - a * d, [d], every)[0])
             out.append(PathResponse(name, tuple(self.layout.channels[i] for i in idx), float(cutoff),
                                     float(delay - a), std))
         return out
+
+    def transducers(self, predicted: np.ndarray) -> list[Reading]:
+        """Each transducer error fitted beside ``predicted`` (all rows), with its standard
+        uncertainty (fitted with the acquisition's taps; the residual's correlation counted)."""
+        if not self._transducers:
+            return []
+        every = np.ones(len(predicted), dtype=bool)
+        left, stack, coef = self._fitted(self._raw(predicted, every, np.mean), every)
+        first = len(stack) - len(self._transducers)
+        std = np.sqrt(self.variances(left, list(stack), every))[first:]
+        return [reading(key, float(coef[first + k]), float(s)) for k, (key, s) in enumerate(zip(self._transducers, std))]
+
+    def variances(self, residual: np.ndarray, columns: list[np.ndarray], rows: np.ndarray) -> np.ndarray:
+        """The variances of the coefficients of ``columns`` fitted to leave ``residual`` on the selected
+        ``rows`` (each (rows, channels), or raveled from them row by row, every compared channel):
+        :func:`elastokin.diagnosis.fit_uncertainty.standard_errors` with the tests as the independent
+        units, the samples' correlation taken along time, channel by channel (coloured noise, a smooth
+        model error)."""
+        tests = self.layout.test[rows]
+        along = lambda x: x.reshape(len(tests), -1).T.ravel()   # channel after channel, time running
+        jacobian = np.column_stack([along(c) for c in columns])
+        width = residual.size // len(tests)
+        return standard_errors(jacobian, along(residual), np.tile(tests, width), residual.size - len(columns)) ** 2
 
     def residual(self, predicted: np.ndarray, rows: np.ndarray, zero: Callable[..., np.ndarray] = np.mean
                  ) -> np.ndarray:
@@ -139,16 +198,12 @@ class Scorer:
         (its zero error: the mean, in which the residual stays affine in the prediction (the fits),
         or the median, which a misfit confined to a stretch does not move for the rest of its
         recording (the misfits' search)), and what is left of each path's response to first order
-        (its rate, and its taps) projected out: fitted with whatever the prediction is."""
+        (its taps) and each transducer's error projected out: fitted with whatever the prediction is."""
         key = (rows.tobytes(), zero)
         last = self._last
         if last is not None and last[0] is predicted and last[1] == key:   # the fits' mismatch: the same base
             return last[2]
-        r = self._raw(predicted, rows, zero)
-        for idx, (_, taps, inverse) in zip(self.paths.values(), self._lag_columns(rows)):
-            part = r[:, idx]
-            coef = inverse @ np.array([np.vdot(c, part) for c in taps])
-            r[:, idx] = part - sum(k * c for k, c in zip(coef, taps))
+        r, _, _ = self._fitted(self._raw(predicted, rows, zero), rows)
         r.flags.writeable = False   # handed out again for the same prediction
         self._last = (predicted, key, r)
         return r
@@ -199,7 +254,7 @@ def fit(h: Hypothesis, signature: np.ndarray, base: np.ndarray, scorer: Scorer,
         coef[1] = moved - at[second.name]
         coef[0] = float(np.dot(columns[0], mismatch - coef[1] * columns[1])) / gram[0, 0]
         at[second.name] = moved
-    var = _variances(mismatch - sum(c * x for c, x in zip(coef, columns)), gram)
+    var = scorer.variances(mismatch - sum(c * x for c, x in zip(coef, columns)), columns, train)
     if len(columns) == 2:
         std[params[1].name] = math.sqrt(var[1])
     value, std[first.name], scale = _magnitude(first, at[first.name], coef[0], math.sqrt(var[0]))
@@ -233,10 +288,11 @@ def fit_pair(first: Candidate, second: Candidate, base: np.ndarray, scorer: Scor
             magnitude, shape_p = parameters(second.hypothesis.cause)[:2]
             moved = float(np.clip(at[shape_p.name] + coef[2], *_side_bounds(shape_p, at[magnitude.name])))
             mismatch = mismatch - (moved - at[shape_p.name]) * shape   # the magnitudes refitted given it
-            extra = {shape_p.name: math.sqrt(_variances(mismatch - coef[:2] @ np.array(columns), wide)[2])}
+            extra = {shape_p.name: math.sqrt(scorer.variances(mismatch - coef[:2] @ np.array(columns),
+                                                               [*columns, shape], train)[2])}
             at[shape_p.name] = moved
     coef = np.linalg.solve(gram, [float(np.dot(c, mismatch)) for c in columns])
-    sd = np.sqrt(_variances(mismatch - coef @ np.array(columns), gram))
+    sd = np.sqrt(scorer.variances(mismatch - coef @ np.array(columns), columns, train))
     out, scales = [], []
     for c, k, s in zip((first, second), coef, sd):
         p = parameters(c.hypothesis.cause)[0]
@@ -283,16 +339,6 @@ def _alike(gram: np.ndarray) -> bool:
     """Whether columns (their ``gram`` matrix) are dependent to within round-off: the last changes
     nothing the others do not, and they cannot be fitted apart."""
     return bool(np.linalg.det(gram) <= 1e-9 * np.prod(np.diag(gram)))
-
-
-def _variances(residual: np.ndarray, gram: np.ndarray) -> np.ndarray:
-    """The fitted coefficients' variances from the ``residual`` left and the columns' ``gram`` matrix,
-    the residual variance inflated for sample-to-sample correlation (a smooth model error is not
-    white noise: n samples are worth n(1 − ρ)/(1 + ρ))."""
-    r = residual
-    rho = float(np.clip(np.dot(r[1:], r[:-1]) / max(np.dot(r, r), 1e-300), 0.0, 0.999))
-    s2 = float(np.dot(r, r)) / max(len(r) - len(gram), 1) * (1.0 + rho) / (1.0 - rho)
-    return np.diag(np.linalg.inv(gram)) * s2 if gram[0, 0] > 0.0 else np.full(len(gram), math.inf)
 
 
 def _side_bounds(second: Parameter, first_value: float) -> tuple[float, float]:

@@ -37,7 +37,7 @@ PATHS = {"wheel sensors": ("wheel_travel", "camber", "toe", "half_track", "steer
                            "wheel_centre_y", "wheel_centre_z"),
          "pad sensors": ("pad_height", "pad_fz")}
 #: Cut-offs [Hz] tried for a path's filter (0: none), each then refined between its neighbours;
-#: those at or above 0.45 × the sampling rate are not tried (the filter would be its own aliasing).
+#: those at or above 0.45 × the highest sampling rate are not tried (the filter would be its own aliasing).
 CUTOFFS_HZ = (0.0, 40.0, 25.0, 18.0, 13.0, 10.0, 8.0, 6.0, 4.5, 3.0)
 #: Golden-section steps refining a cut-off (on its logarithm), and Gauss-Newton steps of a delay.
 REFINE_STEPS, DELAY_STEPS = 10, 4
@@ -99,13 +99,15 @@ class Response:
         self.layout, self.groups = layout, groups
         self._spans = [slice(int(t.rows[0]), int(t.rows[-1]) + 1) for t in layout.tests]   # a test's rows follow
         self._times = [layout.input_time[span] for span in self._spans]
-        self._steps = [float(np.median(np.diff(t))) if t.size > 1 else 0.0 for t in self._times]
+        #: each test's sampling interval [s] (0: a test of one sample)
+        self.steps = [float(np.median(np.diff(t))) if t.size > 1 else 0.0 for t in self._times]
         self._reads: dict[tuple[int, float], tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
 
     def cutoffs(self) -> list[float]:
-        """The cut-offs tried, for this layout's sampling rate (its tests' median)."""
-        steps = [d for d in self._steps if d > 0.0]
-        rate_hz = 1.0 / float(np.median(steps)) if steps else 0.0
+        """The cut-offs tried, for this layout's highest sampling rate (one analogue filter serves
+        every test: a test sampled faster shows its shape)."""
+        steps = [d for d in self.steps if d > 0.0]
+        rate_hz = 1.0 / float(np.min(steps)) if steps else 0.0
         return [f for f in CUTOFFS_HZ if f < 0.45 * rate_hz] or [0.0]
 
     def _read(self, test: int, delay: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -121,7 +123,7 @@ class Response:
     def apply(self, rows: np.ndarray, cutoffs_hz: np.ndarray, delays_s: np.ndarray) -> np.ndarray:
         """``rows`` through each path's filter (cut-off 0: none) and delay [s]."""
         out = rows.copy()
-        for k, (span, dt) in enumerate(zip(self._spans, self._steps)):
+        for k, (span, dt) in enumerate(zip(self._spans, self.steps)):
             for idx, cutoff, delay in zip(self.groups.values(), cutoffs_hz, delays_s):
                 block = rows[span, idx]
                 if cutoff > 0.0 and dt > 0.0:
@@ -148,7 +150,7 @@ class Response:
     def rates(self, rows: np.ndarray) -> np.ndarray:
         """d(rows)/dt within each test [channel unit / s] (one-sided at a test's ends)."""
         out = np.zeros_like(rows)
-        for span, dt, time in zip(self._spans, self._steps, self._times):
+        for span, dt, time in zip(self._spans, self.steps, self._times):
             if dt > 0.0:
                 out[span] = np.gradient(rows[span], time, axis=0)
         return out

@@ -11,7 +11,8 @@ import numpy as np
 
 from elastokin.core.errors import InputError
 from elastokin.vehicle.model.definition import VehicleDefinition
-from elastokin.vehicle.scenarios.scenario import Scenario
+from elastokin.vehicle.scenarios.channels import INPUT_CHANNELS
+from elastokin.vehicle.scenarios.scenario import Case, Scenario
 from elastokin.recordings.kc_dataset import KCDataset
 from elastokin.recordings.recorder import simulate
 
@@ -57,6 +58,7 @@ class Test:
     samples: np.ndarray       #: each row's sample of the input phase (0: its start instant; a damaged
     #: recording lacks some)
     whole: bool               #: from a recording read whole: it holds every sample of the input phase
+    period: int = 0           #: samples in a period of its input, repeated (0: not repeated)
 
 
 @dataclass
@@ -71,13 +73,14 @@ class Layout:
     test: np.ndarray              #: (N,) index of the test of each row
     tests: list[Test]
     damage: tuple[str, ...] = ()  #: what the dataset's damaged recordings lack (their cases unrecorded too)
+    inputs: np.ndarray | None = None   #: (N, len(INPUT_CHANNELS)) the rig's recorded commands (SI)
 
     @classmethod
     def of(cls, data: KCDataset, vehicle: VehicleDefinition) -> "Layout":
         """The compared channels of a dataset, case by case, and the baseline ``vehicle``'s run of each case."""
         first = data.tests[0].run
         channels = [n for n in first.signals if n.rsplit("_", 1)[0] in COMPARED or n.rsplit("_", 2)[0] in COMPARED]
-        measured, times, recording, tests, start, unrecorded = [], [], [], [], 0, []
+        measured, commands, times, recording, tests, start, unrecorded = [], [], [], [], [], 0, []
         for k, t in enumerate(data.tests):
             run, scale = t.run, float(t.run.metadata.extra.get("duration_scale", 1.0))
             phase, number = run.signals["phase"], run.signals["case"].astype(int)
@@ -88,19 +91,21 @@ class Layout:
                     unrecorded.append(f"{t.file.name}: case {c} ({case.label}) has no sample of its input: left out")
                     continue
                 measured.append(np.column_stack([run.signals[ch][on] for ch in channels]))
+                commands.append(np.column_stack([run.signals[ch][on] if ch in run.signals else np.zeros(n)
+                                                 for ch in INPUT_CHANNELS]))
                 times.append(run.signals["input_time"][on])
                 recording.append(np.full(n, k))
                 job = Job(replace(t.scenario, cases=[case]), vehicle, scale, tuple(channels))
                 samples = np.arange(n) if run.complete else _samples(times[-1], t.scenario, f"{t.file.name}, case {c}")
                 tests.append(Test(f"{t.name} case {c} ({case.label})", job, np.arange(start, start + n), samples,
-                                  run.complete))
+                                  run.complete, _period(case, scale, t.scenario.output_rate_hz)))
                 start += n
         if not tests:
             raise InputError("no recording holds a sample of a case's input: nothing to diagnose",
                              source=str(data.path))
         test = np.concatenate([np.full(len(t.rows), i) for i, t in enumerate(tests)])
         return cls(channels, np.vstack(measured), np.concatenate(times), np.concatenate(recording), test, tests,
-                   (*data.damage, *unrecorded))
+                   (*data.damage, *unrecorded), np.vstack(commands))
 
     def jobs(self, vehicle: VehicleDefinition, tests: Sequence[int]) -> list[Job]:
         """The runs of ``tests`` (indices) on ``vehicle``."""
@@ -116,6 +121,12 @@ class Layout:
                                    f"{len(t.rows)}{'' if t.whole else f' up to sample {t.samples[-1] + 1}'}")
             out[t.rows] = np.column_stack([result[ch][t.samples] for ch in self.channels])
         return out
+
+
+def _period(case: Case, duration_scale: float, rate_hz: float) -> int:
+    """The samples in a period of ``case``'s input played at ``duration_scale`` and recorded at
+    ``rate_hz``, when it repeats (else 0)."""
+    return int(round(case.duration_s * duration_scale * rate_hz / case.cycles)) if case.cycles > 1 else 0
 
 
 def _samples(input_time_s: np.ndarray, scenario: Scenario, where: str) -> np.ndarray:

@@ -40,7 +40,7 @@ gets the command / (1 + ``gain``). That gain is the only element an input takes.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, fields
 from typing import Any, Mapping
 
 import numpy as np
@@ -233,12 +233,8 @@ def seen(chain: ChannelChain, channel: str, signals: Mapping[str, np.ndarray]) -
 def servoed(scenario: Scenario, chains: Mapping[str, ChannelChain]) -> Scenario:
     """``scenario`` as the car plays it when its inputs' transducers read ``chains``' gains: each
     input channel's command divided by (1 + gain) (the servo makes the reading follow the command)."""
-    scale = np.array([1.0 / (1.0 + chains[ch].gain) if ch in chains else 1.0 for ch in INPUT_CHANNELS])
-    if np.all(scale == 1.0):
-        return scenario
-    cases = tuple(replace(c, table=replace(c.table, values=c.table.values * scale[None, :])) if c.table is not None
-                  else replace(c, pattern=tuple(np.asarray(c.pattern) * scale)) for c in scenario.cases)
-    return replace(scenario, cases=cases)
+    return scenario.with_inputs_scaled(
+        np.array([1.0 / (1.0 + chains[ch].gain) if ch in chains else 1.0 for ch in INPUT_CHANNELS]))
 
 
 def draw_chain(rng: np.random.Generator, grade: str, white_noise: Mapping[str, float],

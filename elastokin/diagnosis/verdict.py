@@ -8,7 +8,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Sequence
+from typing import Callable, Sequence
 
 import numpy as np
 from scipy.special import gammaincc
@@ -48,15 +48,19 @@ class Outcome:
 
 #: A stretch of a test is misfit when, in one channel, its mean squared residual is at least
 #: NOISE_FACTOR² (in units of the noise) and the chance that the noise alone shows such a stretch
-#: somewhere in the test is below this (χ² with as many degrees as samples in the window, times the
-#: windows scanned in every channel). White noise is assumed, as the noise estimate does.
+#: somewhere in the test is below this (χ² with as many degrees as independent samples in the window,
+#: times the windows scanned in every channel).
 MISFIT_CHANCE = 1e-6
 
 
-def misfit_stretch(residual: np.ndarray) -> tuple[float, int, int, int]:
+def misfit_stretch(residual: np.ndarray, dof: Callable[[int], np.ndarray] | None = None
+                   ) -> tuple[float, int, int, int]:
     """The least likely stretch of a test's ``residual`` under its noise (rows: samples in order;
     columns: channels; in units of their noise; NaN counted as no excess): (a bound on the chance
     that noise alone shows one as unlikely somewhere in the test, first row, last row, channel).
+    ``dof``: for a window's width [samples], each channel's degrees of freedom of its mean square
+    (default: the width, white noise; fewer for a correlated noise,
+    :meth:`elastokin.diagnosis.kc_noise.NoiseModel.window_dof`).
     Windows of a twentieth of the test (at least 10 samples) are scanned in every channel; the
     chance of the least likely is multiplied by the number of windows scanned (overlapping windows
     are alike: a bound, not an estimate); the stretch is where its channel stays above half its
@@ -68,7 +72,8 @@ def misfit_stretch(residual: np.ndarray) -> tuple[float, int, int, int]:
     squares = np.vstack([np.zeros((1, channels)), np.cumsum(np.nan_to_num(residual) ** 2, axis=0)])
     mean = (squares[width:] - squares[:-width]) / width                     # (windows, channels)
     # the chance of a mean of `width` unit-variance squares at least this large (χ²), where it matters
-    tail = np.where(mean >= NOISE_FACTOR ** 2, gammaincc(0.5 * width, 0.5 * width * mean), 1.0)
+    k = np.full(channels, float(width)) if dof is None else np.asarray(dof(width), dtype=float)
+    tail = np.where(mean >= NOISE_FACTOR ** 2, gammaincc(0.5 * k, 0.5 * k * mean), 1.0)
     # beyond the floating-point range the tail is 0 for several windows: the largest mean among them
     least = np.where(tail == tail.min(), mean, -np.inf)
     k, channel = np.unravel_index(int(np.argmax(least)), tail.shape)

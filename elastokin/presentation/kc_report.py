@@ -17,9 +17,12 @@ from elastokin.diagnosis.catalogue import PAIR_SEPARATOR
 from elastokin.diagnosis.kc_catalogue import Hypothesis, extended_vehicle_yaml, parameters
 from elastokin.diagnosis.kc_diagnosis import KCDiagnosis, Misfit
 from elastokin.diagnosis.kc_fits import Candidate
+from elastokin.diagnosis.kc_noise import coloured_noise
+from elastokin.diagnosis.kc_transducers import INPUT_GAIN
 from elastokin.diagnosis.verdict import MISFIT_CHANCE, NOISE_FACTOR, Separation
 from elastokin.presentation.diagnosis_report import Report, partly_explained, ranking_chart, separation_clause
 from elastokin.presentation.figures import save_figure
+from elastokin.vehicle.scenarios.channels import channel_quantity
 
 #: Channels overlaid in the report (the largest baseline mismatch on held-out tests first).
 OVERLAYS = 4
@@ -86,12 +89,25 @@ def summary(d: KCDiagnosis) -> dict[str, Any]:
         "misfits": [_misfit(m) for m in d.misfits],
         "misfits_after": [_misfit(m) for m in d.misfits_after],
         "noise": {c: float(s) for c, s in zip(d.layout.channels, d.noise)},
+        "noise_model": _noise_model(d),
         "acquisition": [{"path": r.path, "channels": list(r.channels), "lag_ms": 1e3 * r.lag_s,
                          "cutoff_hz": r.cutoff_hz or None, "delay_ms": 1e3 * r.delay_s, "delay_std_ms": 1e3 * r.std_s}
                         for r in d.responses],
+        "transducers": [{"kind": g.kind, "channel": g.channel, "source": g.source, "value": g.value, "std": g.std}
+                        for g in d.transducers],
         "damage": list(d.layout.damage),
         "wall_s": d.wall_s,
     }
+
+
+def _noise_model(d: KCDiagnosis) -> dict[str, dict[str, float]]:
+    """Per quantity (its channels share them): the white and coloured noise [its unit], the coloured
+    noise's correlation time [s] (:mod:`elastokin.diagnosis.kc_noise`)."""
+    m, out = d.noise_model, {}
+    for i, c in enumerate(d.layout.channels if m is not None else ()):
+        out.setdefault(channel_quantity(c), {"white": float(m.white[i]), "coloured": float(m.coloured[i]),
+                                             "correlation_time_s": float(m.correlation_time_s[i])})
+    return out
 
 
 def _alike(c: Candidate, sep: Separation | None) -> dict[str, Any]:
@@ -148,9 +164,31 @@ def _acquisition_sentence(d: KCDiagnosis) -> str:
                      f"out." for r in said)
 
 
+def _transducers_sentence(d: KCDiagnosis) -> str:
+    """Which transducers the data show misreading, if any."""
+    said = [g for g in d.transducers if g.said]
+    if not said:
+        return ""
+    return (" The rig's transducers misread: " + ", ".join(
+        f"{g.label} {100 * g.value:+.2f} ± {100 * g.std:.2g} %" for g in said)
+            + " (fitted with every hypothesis and taken out; a cause acting on the campaign as such an error does "
+              "is not told from it: a static calibration of the transducer separates them).")
+
+
+def _noise_sentence(d: KCDiagnosis) -> str:
+    """Which channels' noise is coloured, if any: the noise the verdict was judged against."""
+    said = coloured_noise(d.layout.channels, d.noise_model) if d.noise_model is not None else {}
+    if not said:
+        return ""
+    return " The measurement noise is coloured (counted in the noise the verdict is judged against): " + "; ".join(
+        f"{q} {coloured / white:.2g} × its white noise, correlated over {tau:.2g} s"
+        for q, (white, coloured, tau) in said.items()) + "."
+
+
 def verdict_sentence(d: KCDiagnosis) -> str:
-    """One sentence for people: the cause, and what was taken out as the rig's acquisition."""
-    return _cause_sentence(d) + _acquisition_sentence(d)
+    """One sentence for people: the cause, what was taken out as the rig's acquisition and its
+    transducers' errors, and the noise's colour."""
+    return _cause_sentence(d) + _acquisition_sentence(d) + _transducers_sentence(d) + _noise_sentence(d)
 
 
 def _cause_sentence(d: KCDiagnosis) -> str:
@@ -245,7 +283,7 @@ def write_report(d: KCDiagnosis, baseline: VehicleDefinition, out_dir: Path, dat
                     f"Baseline: `{baseline.path}`; {len(d.test_names)} tests (recorded cases), {int(d.heldout.sum())} "
                     f"held out from every fit (every other one). Errors are RMS of measured − simulated over every "
                     f"measured channel but the rig inputs, each in units of its own measurement noise (estimated from "
-                    f"the data), each channel's zero in each recording removed and each acquisition path's filter and "
+                    f"the data, white and coloured), each channel's zero in each recording removed and each acquisition path's filter and "
                     f"delay behind the rig inputs taken out: 1 is a perfect model.")
     if d.layout.damage:
         report.paragraph("**Diagnosed on a damaged dataset** (`--use-damaged`), with the samples its recordings hold: "
@@ -267,6 +305,18 @@ def write_report(d: KCDiagnosis, baseline: VehicleDefinition, out_dir: Path, dat
     report.table(("path", "channels", "lag at low frequency [ms]", "low-pass [Hz]", "delay [ms]"),
                  [(r.path, f"{len(r.channels)}", f"{1e3 * r.lag_s:.2f}", f"{r.cutoff_hz:.3g}" if r.cutoff_hz else "none",
                    f"{1e3 * r.delay_s:.2f} ± {1e3 * r.std_s:.2g}") for r in d.responses])
+    shown = [g for g in d.transducers if g.kind == INPUT_GAIN or g.said]
+    if shown:
+        report.paragraph("The transducers' errors fitted with every hypothesis (`elastokin/diagnosis/kc_transducers.py`): "
+                         "each moved rig input's gain g (it reads (1 + g) × the truth; the car got the command / (1 + g)), "
+                         "and each measured channel's gain or cross-talk the data show:")
+        report.table(("transducer", "value [%]"), [(g.label, f"{100 * g.value:+.3f} ± {100 * g.std:.2g}") for g in shown])
+    report.paragraph("The measurement noise per quantity, from the residual's differences between successive "
+                     "samples (white) and, in the tests whose input repeats, between the samples a period apart "
+                     "(coloured: what each recording's zero leaves of it; `elastokin/diagnosis/kc_noise.py`):")
+    report.table(("quantity", "white noise", "coloured noise", "correlation time [s]"),
+                 [(q, f"{v['white']:.3g}", f"{v['coloured']:.3g}", f"{v['correlation_time_s']:.2g}" if v["coloured"]
+                   else "") for q, v in result["noise_model"].items()])
     report.section("Ranking")
     report.paragraph("Every cause at every place it can sit was run once on the training tests and its magnitude "
                      "fitted; the best were run on every test and scored on the held-out ones.")

@@ -167,6 +167,17 @@ class Scenario:
         driven = SIGNAL_TYPES.get(kind)
         return None if driven is None else ("wheel_travel" if driven == "pad_z" else driven)
 
+    def with_inputs_scaled(self, scale: np.ndarray) -> "Scenario":
+        """This scenario with each rig input channel's command (INPUT_CHANNELS order) multiplied by
+        ``scale`` (len(INPUT_CHANNELS),): what the car gets from a servo whose own transducer
+        misreads (a calibration gain)."""
+        scale = np.asarray(scale, dtype=float)
+        if np.all(scale == 1.0):
+            return self
+        return replace(self, cases=tuple(
+            replace(c, table=replace(c.table, values=c.table.values * scale[None, :])) if c.table is not None
+            else replace(c, pattern=tuple(np.asarray(c.pattern) * scale)) for c in self.cases))
+
     def without_last_steps(self) -> "Scenario":
         """The control of a step experiment: every case without its last step
         (:meth:`Case.without_last_step`)."""
