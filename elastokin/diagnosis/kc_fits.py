@@ -18,7 +18,6 @@ from elastokin.diagnosis.kc_lags import PathResponse, Response, fit_response, pa
 from elastokin.diagnosis.kc_transducers import INPUT_GAIN, Key, Reading, reading
 from elastokin.diagnosis.kc_layout import Layout
 from elastokin.diagnosis.kc_noise import estimate_noise, white_noise
-from elastokin.vehicle.scenarios.channels import channel_quantity
 
 #: Relative increase of the held-out score per fitted parameter.
 PARAMETER_PENALTY = 0.02
@@ -181,7 +180,7 @@ class Scorer:
 
     def variances(self, residual: np.ndarray, columns: list[np.ndarray], rows: np.ndarray) -> np.ndarray:
         """The variances of the coefficients of ``columns`` fitted to leave ``residual`` on the selected
-        ``rows`` (each (rows, channels), or raveled from them row by row, every compared channel):
+        ``rows`` (each (rows, channels) over the same channels, or raveled from them row by row):
         :func:`elastokin.diagnosis.fit_uncertainty.standard_errors` with the tests as the independent
         units, the samples' correlation taken along time, channel by channel (coloured noise, a smooth
         model error)."""

@@ -12,7 +12,8 @@ A residual is noise plus the model's error. Differences cancel a model error and
   stiffness or geometry), while the noise stays, with its correlation: the autocovariance of
   d(t) = e(t + P) − e(t) is, for noise e of autocovariance γ, 2γ(k) − γ(P + k) − γ(P − k). The
   noise is taken as white plus a first-order autoregressive process, γ(k) = w δ(k) + a φ^|k|
-  (φ = exp(−Δt / τ)), fitted to it (non-negative least squares for w and a, τ on a grid).
+  (φ = exp(−Δt / τ)), fitted to the differences' variogram, which no zero or drift biases
+  (non-negative least squares for w and a, τ on a grid).
 
 A mismatch that does not repeat (a car's first loading differing from the next) counts as noise
 there: a cause is then judged against a noise it partly makes, which loses sensitivity, never
