@@ -3,11 +3,13 @@
 1. The baseline vehicle plays exactly the recorded tests, case by case (the recordings carry their
    scenarios; a scenario's ``bushings:`` choice is a simulation option and is ignored: the
    vehicle's own laws are the model under test). Every measured channel but the rig inputs is
-   compared in units of its measurement noise, estimated from the data (sample-to-sample
-   differences of the residual, which a smooth model error hardly affects); each channel's zero
-   error in each recording is a nuisance, removed, and so is each acquisition path's response
-   (a low-pass filter and a delay behind the rig inputs, :mod:`elastokin.diagnosis.kc_lags`):
-   estimated on the baseline, what is left of it fitted with every hypothesis.
+   compared in units of its measurement noise, white and coloured, estimated from the data
+   (differences of the residual that a model error cancels from, :mod:`elastokin.diagnosis.kc_noise`);
+   each channel's zero error in each recording is a nuisance, removed, and so are each acquisition
+   path's response (a low-pass filter and a delay behind the rig inputs, :mod:`elastokin.diagnosis.kc_lags`:
+   estimated on the baseline, what is left of it fitted with every hypothesis) and the rig's
+   transducers' errors (the inputs' and the channels' gains, cross-talk,
+   :mod:`elastokin.diagnosis.kc_transducers`: fitted with every hypothesis).
 2. Screening: every catalogue cause at every place it can sit (:mod:`elastokin.diagnosis.kc_catalogue`)
    is run once on the training tests (every other one) at mid-range magnitude (a sided cause, whose
    sign picks another effect, or one whose effect is not odd in its magnitude, such as a cross
