@@ -192,7 +192,7 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, executor: Execut
             elsewhere), all in parallel."""
             jobs = [(label, t, j) for label, js, tests in sets for t, j in zip(tests, js)]
             flat: list[dict[str, np.ndarray]] = [{}] * len(jobs)
-            each = max(1, len(jobs) // len(sets))
+            each = max(1, len(jobs) // max(len(sets), 1))   # no set at all: a campaign whose inputs never move
             with closing(pool.each(run_job, [j for _, _, j in jobs])) as outcomes:   # a failure cancels the others at once
                 for done, o in enumerate(outcomes, 1):
                     if o.error:
