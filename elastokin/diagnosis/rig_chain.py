@@ -65,20 +65,40 @@ GROUPS = {"wheel_sensors": ("camber", "toe", "steer", "wheel_travel", "half_trac
 #: gains, mild noise); the cross-talk's are assumed of the gains' order, and the 1/f noise's of the
 #: AR(1)'s. No vendor datasheet was at hand to check them against (this machine has no internet
 #: beyond the package registries).
+#: ``rig``: the rig's own mechanics (:mod:`elastokin.vehicle.scenarios.rig_file`'s keys), drawn
+#: uniformly in these: the floating pads' residual friction and their lateral compliance, the body
+#: clamp's compliance left after the rig's correction of the body's motion. No published figure was
+#: at hand for any of them (Morse Measurements, "What exactly is K&C testing?", 2020, says only that
+#: a rig without floating pads, whose tyres scrub, is easily 10 % off in ride rate): they are set so
+#: that each shows in the default car's campaign at about the noise (20 N of pad friction and
+#: 0.02 mm/kN of lateral clamp compliance give 1.8 and 2.3 × the noise in the lateral-force test),
+#: a good rig's at a fifth of a typical one's.
 GRADES = {
     "typical": {"delay_ms": {"wheel_sensors": (12.0, 15.0), "pad_sensors": (0.0, 5.0)},
                 "low_pass_hz": {"wheel_sensors": (8.0, 10.0), "pad_sensors": (15.0, 25.0)},
                 "gain": (0.005, 0.02), "crosstalk": (0.005, 0.02), "ar1": (1.0, 2.0),
-                "ar1_time_constant_s": (0.5, 5.0), "pink": (1.0, 2.0), "drift": (1.0, 2.0)},
+                "ar1_time_constant_s": (0.5, 5.0), "pink": (1.0, 2.0), "drift": (1.0, 2.0),
+                "rig": {"pad_friction_n": (5.0, 20.0), "pad_compliance_mm_per_kn": (2.0, 5.0),
+                        "clamp_lateral_mm_per_kn": (0.005, 0.02), "clamp_vertical_mm_per_kn": (0.005, 0.02),
+                        "clamp_roll_deg_per_knm": (0.001, 0.005), "clamp_pitch_deg_per_knm": (0.001, 0.005)}},
     "good": {"delay_ms": {"wheel_sensors": (2.0, 4.0), "pad_sensors": (0.0, 2.0)},
              "low_pass_hz": {"wheel_sensors": (18.0, 25.0), "pad_sensors": (25.0, 40.0)},
              "gain": (0.002, 0.005), "crosstalk": (0.001, 0.005), "ar1": (0.3, 0.7),
-             "ar1_time_constant_s": (0.5, 5.0), "pink": (0.3, 0.7), "drift": (0.3, 0.7)},
+             "ar1_time_constant_s": (0.5, 5.0), "pink": (0.3, 0.7), "drift": (0.3, 0.7),
+             "rig": {"pad_friction_n": (1.0, 4.0), "pad_compliance_mm_per_kn": (1.0, 2.0),
+                     "clamp_lateral_mm_per_kn": (0.001, 0.004), "clamp_vertical_mm_per_kn": (0.001, 0.004),
+                     "clamp_roll_deg_per_knm": (0.0002, 0.001), "clamp_pitch_deg_per_knm": (0.0002, 0.001)}},
 }
 #: Which quantity's transducer sees which other of the same wheel when a chain is drawn.
 CROSSTALK = {"toe": "camber", "pad_fz": "pad_fy"}
-#: What :func:`draw_chain` can draw, alone or together (``input_gain``: the servoed inputs' transducers).
-DRAWN = ("delay", "low_pass", "gain", "crosstalk", "ar1", "pink", "drift", "input_gain")
+#: What :func:`draw_rig` draws of a rig's mechanics: the pads' friction (with their compliance), the
+#: body clamp's compliance (its four directions).
+RIG_DRAWN = {"pad_friction": ("pad_friction_n", "pad_compliance_mm_per_kn"),
+             "clamp": ("clamp_lateral_mm_per_kn", "clamp_vertical_mm_per_kn", "clamp_roll_deg_per_knm",
+                       "clamp_pitch_deg_per_knm")}
+#: What :func:`draw_chain` and :func:`draw_rig` can draw, alone or together (``input_gain``: the
+#: servoed inputs' transducers).
+DRAWN = ("delay", "low_pass", "gain", "crosstalk", "ar1", "pink", "drift", "input_gain", *RIG_DRAWN)
 _SIGNED = ("gain",)
 _FILTER_ORDER = 2
 #: The rate, in multiples of the recording's, at which the analogue filter is computed.
@@ -278,3 +298,11 @@ def draw_chain(rng: np.random.Generator, grade: str, white_noise: Mapping[str, f
         for channel in INPUT_CHANNELS:
             out[channel] = {"gain": round(signed(ranges["gain"]), 5)}
     return {k: v for k, v in out.items() if v}
+
+
+def draw_rig(rng: np.random.Generator, grade: str, elements: tuple[str, ...] = DRAWN) -> dict[str, float]:
+    """A rig's mechanics drawn in ``grade``'s ranges (:data:`GRADES`), as a truth's ``rig`` mapping
+    (file units); ``elements``: those of :data:`RIG_DRAWN` among them are drawn, the rest ideal."""
+    ranges = GRADES[grade]["rig"]
+    return {key: round(float(rng.uniform(*ranges[key])), 6) for element, keys in RIG_DRAWN.items()
+            if element in elements for key in keys}

@@ -18,6 +18,7 @@ TRUTH.yaml (K&C level; paths relative to this file)::
       - {cause: backlash, location: e1_front.y, backlash: 0.2}          # mm, outside the catalogue
     measurement: {angle_noise_deg: 0.003, ...}       # MEASUREMENT_DEFAULTS keys
     chain: {toe: {delay_ms: 15, low_pass_hz: 9}, ...}  # optional: elastokin/diagnosis/rig_chain.py
+    rig: {pad_friction_n: 12, clamp_roll_deg_per_knm: 0.003}   # optional: the rig's own mechanics
     seed: 0
 
 The rig measures what :func:`elastokin.recordings.rig_recordings.measured_channels` lists. Every measured channel gets
@@ -25,7 +26,10 @@ a zero error drawn once per dataset (uniform in ± its offset), Gaussian noise a
 of its sensor, by unit: deg (angle), mm (length), N (force), N·m (torque), after the truth's
 measurement ``chain`` if it has one (gains, filters, lags, drifts, coloured noise: drawn from a
 stream of their own, so that a truth without a chain measures as before). The rig inputs (pad
-displacements, forces and torques, rack) are the commanded values and are written as commanded.
+displacements, forces and torques, rack) are the commanded values and are written as commanded. A
+truth's ``rig`` (:mod:`elastokin.vehicle.scenarios.rig_file`) gives the rig's pads friction and
+compliance and its body clamp compliance: the car plays every scenario on that rig, the recordings
+saying nothing of it.
 """
 
 from __future__ import annotations
@@ -38,10 +42,13 @@ from typing import Any, Callable, Mapping
 import numpy as np
 
 from elastokin.vehicle.model.definition import VehicleDefinition
+from elastokin.vehicle.model.elements import RigMechanics
 from elastokin.vehicle.model.vehicle_file import load_vehicle
 from elastokin.vehicle.scenarios.channels import INPUT_CHANNELS
+from elastokin.vehicle.scenarios.rig_file import parse_rig
 from elastokin.vehicle.scenarios.scenario import Scenario
 from elastokin.vehicle.scenarios.scenario_file import load_scenario
+from elastokin.core.documents import Document
 from elastokin.core.errors import InputError
 from elastokin.core.files import atomic_directory, is_file
 from elastokin.core.shipped import DEFAULT_VEHICLE, KC_SCENARIO_DIR
@@ -74,7 +81,7 @@ MEASUREMENT_DEFAULTS = {
 #: Run unit of a channel -> (sensor kind, key suffix) in MEASUREMENT_DEFAULTS.
 SENSORS = {"deg": ("angle", "deg"), "mm": ("length", "mm"), "N": ("force", "n"), "N·m": ("torque", "nm")}
 RIG_NAME = "virtual K&C rig"
-_KEYS = ("level", "vehicle", "scenarios", "duration_scale", "effects", "measurement", "chain", "seed")
+_KEYS = ("level", "vehicle", "scenarios", "duration_scale", "effects", "measurement", "chain", "rig", "seed")
 #: The chain's random stream: apart from the noise's, which stays as it was without a chain.
 _CHAIN_STREAM = 53
 #: Causes the K&C virtual rig can hide: the catalogue's, and backlash (outside it).
@@ -93,6 +100,7 @@ class KCTruth:
     seed: int
     duration_scale: float = 1.0
     chain: Mapping[str, ChannelChain] = field(default_factory=dict)   #: measured channel -> its chain
+    rig: RigMechanics = RigMechanics()   #: the rig's own pads and body clamp
 
     @property
     def vehicle(self) -> VehicleDefinition:
@@ -232,7 +240,8 @@ def parse_kc_truth(data: Any, source: str, base_dir: Path | None = None) -> KCTr
     if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
         raise InputError(f"expected a whole number >= 0, got {seed!r}", source=source, key="seed")
     chain = parse_chain(data.get("chain"), measured_channels(), INPUT_CHANNELS, source)
-    truth = KCTruth(source, baseline, scenarios, effects, measurement, seed, duration_scale, chain)
+    rig = parse_rig(Document.of_data(data, source), ("rig",), data.get("rig", {}))
+    truth = KCTruth(source, baseline, scenarios, effects, measurement, seed, duration_scale, chain, rig)
     try:
         truth.vehicle  # every effect together (e.g. two couplings of one bushing)
     except InputError as exc:
@@ -247,14 +256,18 @@ def sensor(unit: str, measurement: Mapping[str, float]) -> tuple[float, float, f
     return tuple(measurement[f"{kind}_{what}_{suffix}"] for what in ("noise", "offset", "resolution"))
 
 
-def rig_description(measurement: Mapping[str, float], chain: bool = False) -> dict[str, Any]:
+def rig_description(measurement: Mapping[str, float], chain: bool = False, mechanics: bool = False
+                    ) -> dict[str, Any]:
     """What ``rig.yaml`` and every recording say about the rig: its name, notes and sensor accuracy
-    (a ``chain`` is said to be there, not what it is: a rig does not know its own errors)."""
+    (a ``chain`` and the rig's own ``mechanics`` are said to be there, not what they are: a rig does
+    not know its own errors)."""
     return {"name": RIG_NAME,
             "notes": "simulated K&C rig (vsim): body clamped, pads driven; every measured channel carries a "
                      "zero error drawn once per dataset, Gaussian noise and the sensor's quantisation"
                      + ("; some pass a chain of calibration errors, filters, lags, drifts and coloured noise, "
-                        "not stated" if chain else "") + "; the rig inputs are written as commanded",
+                        "not stated" if chain else "")
+                     + ("; its pads' friction and compliance and its body clamp's compliance, not stated"
+                        if mechanics else "") + "; the rig inputs are written as commanded",
             "accuracy": {k: float(v) for k, v in measurement.items()}}
 
 
@@ -267,7 +280,7 @@ def measure_kc(truth: KCTruth, output: str | os.PathLike[str], *, overwrite: boo
     :func:`elastokin.recordings.rig_recordings.measured_channels`, adds to each measured one its zero error (drawn once
     per dataset), noise and quantisation, and writes the inputs as commanded (a truth's ``chain``
     goes before those on the channels it names; a servoed input's transducer gain g gives the car
-    the command / (1 + g)). Recordings are
+    the command / (1 + g); the car stands on the truth's ``rig``). Recordings are
     ``NN_<scenario name>.mcap`` in the order played, plus ``rig.yaml``. The dataset is written as a
     whole (a temporary folder renamed at the end); an existing ``output`` is refused unless
     ``overwrite``. ``progress(i, n, scenario name)`` is called before each scenario.
@@ -280,14 +293,15 @@ def measure_kc(truth: KCTruth, output: str | os.PathLike[str], *, overwrite: boo
     offsets = {name: rng.uniform(-1.0, 1.0) * sensor(unit, m)[1] for name, unit in channels.items()
                if name not in INPUT_CHANNELS}
     vehicle = truth.vehicle
-    rig = rig_description(m, chain=bool(truth.chain))
+    rig = rig_description(m, chain=bool(truth.chain), mechanics=not truth.rig.ideal)
     with atomic_directory(root, overwrite=overwrite) as tmp:
         files = []
         for i, scenario in enumerate(truth.scenarios):
             if progress is not None:
                 progress(i, len(truth.scenarios), scenario.name)
             played = servoed(scenario, truth.chain)   # the command the servoed inputs' transducers read
-            run = simulate(replace(played, bushing_model=None), vehicle, duration_scale=truth.duration_scale)
+            run = simulate(replace(played, bushing_model=None, rig=truth.rig), vehicle,
+                           duration_scale=truth.duration_scale)
             signals = {}
             for name, unit in channels.items():
                 if name not in run.signals:

@@ -55,6 +55,7 @@ CLOSURE_SOLIMP = (0.9999, 0.9999, 0.001, 0.5, 2.0)
 SLEEVE_MASS = 0.4          #: mass of a closed bushing's sleeve [kg], taken from its part's mass
 BEAM_CENTRE_MASS = 1.0    #: share of each arm's mass carried by the beam-centre body [kg]
 PAD_MASS = 1.0             #: rig pad and carriage masses [kg] (gravity compensated)
+PAD_NOSLIP_ITERATIONS = 10  #: MuJoCo's no-slip passes a step when the rig's pads have friction
 _NO_COLLISION = dict(contype=0, conaffinity=0)
 
 
@@ -213,6 +214,8 @@ class _Builder:
                             v.body.inertia)
         if not self.o.clamped:
             chassis.add_freejoint(name="chassis_free")
+        elif self.o.rig:
+            self.clamp(chassis)
         chassis.add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, size=[1.6, 0.6, 0.05],
                          pos=self.local("chassis", [v.body.cg[0], 0, 0.45]), rgba=[0.3, 0.4, 0.7, 0.3],
                          **_NO_COLLISION)
@@ -229,6 +232,19 @@ class _Builder:
             raise InputError(f"MuJoCo cannot build this vehicle: {exc}", source=str(v.path)) from None
         return CarModel(v, self.o, self.spec, model, self.channels, self.elements, self.closures, self.corners,
                         self.cross)
+
+    def clamp(self, chassis):
+        """The body clamp's compliant directions (:meth:`RigMechanics.clamp`): a joint each at the
+        body's centre of mass, its spring the clamp's, critically damped on the body alone (its lag,
+        c/k, a few ms: nothing at the rig's rates)."""
+        body = self.v.body
+        for kind, axis, compliance in self.o.rig_mechanics.clamp():
+            i = "xyz".index(axis)
+            j = chassis.add_joint(name=f"clamp_{kind}_{axis}", pos=body.cg, axis=np.eye(3)[i],
+                                  type=mujoco.mjtJoint.mjJNT_SLIDE if kind == "slide" else mujoco.mjtJoint.mjJNT_HINGE)
+            k = 1.0 / compliance
+            j.stiffness = [k, 0.0, 0.0]
+            j.damping = [2.0 * math.sqrt(k * (body.mass if kind == "slide" else body.inertia[i])), 0.0, 0.0]
 
     def rack(self):
         f = self.v.front
@@ -396,13 +412,37 @@ class _Builder:
             self.bodies[pad].add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, size=[0.2, 0.15, 0.01],
                                       pos=[0, 0, -0.012], rgba=[0.7, 0.5, 0.2, 1], **_NO_COLLISION)
             carriage = f"carriage_{corner}"
-            self.body(pad, carriage, contact, np.eye(3), PAD_MASS, contact, [0.01] * 3, gravcomp=1.0)
-            self.bodies[carriage].add_joint(name=f"pad_x_{corner}", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[1, 0, 0])
-            self.bodies[carriage].add_joint(name=f"pad_y_{corner}", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[0, 1, 0])
+            self.body(self.pad_float(pad, corner, contact), carriage, contact, np.eye(3), PAD_MASS, contact, [0.01] * 3,
+                      gravcomp=1.0)
+            for axis, direction in (("x", [1, 0, 0]), ("y", [0, 1, 0])):
+                j = self.bodies[carriage].add_joint(name=f"pad_{axis}_{corner}", type=mujoco.mjtJoint.mjJNT_SLIDE,
+                                                    axis=direction)
+                if self.o.rig_mechanics.pad_friction_n > 0.0:
+                    j.frictionloss = self.o.rig_mechanics.pad_friction_n
+                    j.solref_friction, j.solimp_friction = list(CLOSURE_SOLREF), list(CLOSURE_SOLIMP)
+                    # MuJoCo's solver lets a stuck friction creep (a pad holding 300 N, 0.2 mm/s): no-slip holds it
+                    self.spec.option.noslip_iterations = PAD_NOSLIP_ITERATIONS
             self.drive(f"pad_drive_{corner}", f"pad_z_{corner}")
             self.closure(f"contact_{corner}", mujoco.mjtEq.mjEQ_CONNECT, name, carriage, contact)
             names |= {"pad_drive": f"pad_drive_{corner}", "pad_z": f"pad_z_{corner}", "contact_eq": f"contact_{corner}"}
         self.corners[corner] = names
+
+
+    def pad_float(self, pad: str, corner: str, contact) -> str:
+        """The body the pad's carriage floats on: the pad itself, or, for a compliant pad
+        (:attr:`RigMechanics.pad_compliance_m_per_n`), its top plate on x and y springs (critically
+        damped), so that the carriage's friction acts through the compliance."""
+        compliance = self.o.rig_mechanics.pad_compliance_m_per_n
+        if compliance == 0.0:
+            return pad
+        top = f"pad_top_{corner}"
+        self.body(pad, top, contact, np.eye(3), PAD_MASS, contact, [0.01] * 3, gravcomp=1.0)
+        for axis, direction in (("x", [1, 0, 0]), ("y", [0, 1, 0])):
+            j = self.bodies[top].add_joint(name=f"pad_top_{axis}_{corner}", type=mujoco.mjtJoint.mjJNT_SLIDE,
+                                           axis=direction)
+            j.stiffness = [1.0 / compliance, 0.0, 0.0]
+            j.damping = [2.0 * math.sqrt(PAD_MASS / compliance), 0.0, 0.0]
+        return top
 
 
 def build(vehicle: VehicleDefinition, options: BuildOptions = BuildOptions()) -> CarModel:

@@ -13,6 +13,42 @@ from elastokin.vehicle.model.definition import DIRECTIONS, Curve, Spring
 
 
 @dataclass(frozen=True)
+class RigMechanics:
+    """What the K&C rig's own structure does between its commands and the car (SI; all zero: the
+    ideal rig, pads floating without friction, the body held rigidly).
+
+    The pads float in x and y on bearings whose Coulomb friction each carriage feels (``pad_friction_n``),
+    through the pad's own lateral compliance in series with it (``pad_compliance_m_per_n``: a
+    Jenkins element, the compliance taking the force before the bearing slips); a lateral force
+    commanded at a pad reaches the contact patch less that friction. The body's clamps yield
+    (``clamp_*``: about the body's centre of mass, in y, z, roll and pitch): the body moves with the
+    loads the pads put through the car, while the rig measures the wheels against its bedplate."""
+
+    pad_friction_n: float = 0.0                    #: each pad's bearing friction, x and y [N]
+    pad_compliance_m_per_n: float = 0.0            #: each pad's lateral compliance in series with it [m/N]
+    clamp_lateral_m_per_n: float = 0.0             #: the body clamp's compliance in y [m/N]
+    clamp_vertical_m_per_n: float = 0.0            #: in z [m/N]
+    clamp_roll_rad_per_nm: float = 0.0             #: about x [rad/(N·m)]
+    clamp_pitch_rad_per_nm: float = 0.0            #: about y [rad/(N·m)]
+
+    def __post_init__(self):
+        bad = [f"{k} = {v!r}" for k, v in vars(self).items() if not (math.isfinite(v) and v >= 0.0)]
+        if bad:
+            raise ValueError(f"rig mechanics: {bad[0]}; expected a finite value >= 0")
+
+    @property
+    def ideal(self) -> bool:
+        """Whether the rig adds nothing (the default rig's model)."""
+        return not any(vars(self).values())
+
+    def clamp(self) -> tuple[tuple[str, str, float], ...]:
+        """The body clamp's compliant directions: (joint type, axis, compliance) of each one not rigid."""
+        return tuple((kind, axis, c) for kind, axis, c in (
+            ("slide", "y", self.clamp_lateral_m_per_n), ("slide", "z", self.clamp_vertical_m_per_n),
+            ("hinge", "x", self.clamp_roll_rad_per_nm), ("hinge", "y", self.clamp_pitch_rad_per_nm)) if c > 0.0)
+
+
+@dataclass(frozen=True)
 class BuildOptions:
     """How to build: rig or road, clamped or free body, bushing model override, time step."""
 
@@ -28,6 +64,8 @@ class BuildOptions:
     #: inputs: elastokin.vehicle.scenarios.schedule.timestep). At 2 ms the rig's camber loop moves by
     #: < 0.005° and the road's yaw-rate response time by < 0.1 ms when it halves (tools/benchmarks).
     timestep: float = 2e-3
+    #: the K&C rig's pads and body clamp (``rig`` only)
+    rig_mechanics: RigMechanics = RigMechanics()
 
     def __post_init__(self):
         unknown = sorted(set(self.bushing_model_directions) - set(DIRECTIONS))

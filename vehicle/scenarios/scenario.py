@@ -11,7 +11,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from elastokin.vehicle.model.elements import BuildOptions
+from elastokin.vehicle.model.elements import BuildOptions, RigMechanics
 
 #: Scenario types driving one input quantity with a triangle or a sine, and that quantity.
 SIGNAL_TYPES = {"pumping": "pad_z", "roll": "pad_z", "lateral_force": "pad_fy",
@@ -158,6 +158,8 @@ class Scenario:
     settle: Settle
     limits: Limits
     cases: tuple[Case, ...]
+    #: the rig's own pads and body clamp as the car meets them (default: the ideal rig)
+    rig: RigMechanics = RigMechanics()
 
     @property
     def x_quantity(self) -> str | None:

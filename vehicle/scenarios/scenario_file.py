@@ -16,6 +16,7 @@ import numpy as np
 from elastokin.vehicle.model.definition import BUSHING_MODELS
 from elastokin.vehicle.scenarios.channels import (AXLES, CORNER_TAGS, FILE_UNITS, INPUT_CHANNELS, csv_columns, file_si,
                                         channel_quantity)
+from elastokin.vehicle.scenarios.rig_file import parse_rig
 from elastokin.vehicle.scenarios.road_scenario import ROAD_TOP_KEYS, ROAD_TYPES, RoadScenario, parse_road_scenario
 from elastokin.vehicle.scenarios.scenario import (BISINE_INPUTS, MAX_FREQUENCY_HZ, MAX_INPUT_S, MAX_SETTLE_S, SHAPES,
                                         SIGNAL_TYPES, TYPES, Case, InputTable, Limits, Scenario, Settle, Waveform)
@@ -190,7 +191,7 @@ def read_input_csv(path: Path) -> InputTable:
 
 # -- the file ---------------------------------------------------------------------------------------
 _TOP_KEYS = ("name", "description", "type", "vehicle", "bushings", "axles", "output_rate_hz", "settle",
-             "limits", "defaults", "cases")
+             "limits", "rig", "defaults", "cases")
 _RACK_TYPES = ("rack_step", "double_rack_step", "csv")
 
 
@@ -256,4 +257,5 @@ def parse_scenario(text: str, path: Path, source: str | None = None) -> Scenario
     return Scenario(
         name=scenario_name(top, path), description=top.text("description", ""), path=path, text=text, type=kind,
         vehicle=vehicle, bushing_model=top.choice("bushings", BUSHING_MODELS, None), axles=axles,
-        output_rate_hz=output_rate(top), settle=settle, limits=limits, cases=tuple(cases))
+        output_rate_hz=output_rate(top), settle=settle, limits=limits, cases=tuple(cases),
+        rig=parse_rig(doc, top.path("rig"), top.raw("rig", {})))

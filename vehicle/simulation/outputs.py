@@ -18,7 +18,7 @@ class WheelOutputs:
     steer: float                #: yaw of the wheel heading [rad], to the left positive
     half_track: float           #: |y| of the wheel centre [m]
     travel: float               #: wheel-centre height from design [m], bump positive
-    wheel_centre: np.ndarray    #: [m], world (= body, clamped) frame
+    wheel_centre: np.ndarray    #: [m], world frame (the rig's bedplate; the body's, clamped rigidly)
     pad_force: np.ndarray       #: force of the pad on the wheel (Fx, Fy, Fz) [N]
     pad_height: float           #: measured pad (contact-point) displacement [m], bump positive
     pad_torque: float           #: aligning torque applied about the vertical [N·m]

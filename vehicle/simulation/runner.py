@@ -130,7 +130,8 @@ class PlayedScenario:
         if timestep_s is not None:
             check_timestep(scenario, timestep_s)
         self.options = BuildOptions(bushing_model=scenario.bushing_model,
-                                    timestep=timestep(scenario) if timestep_s is None else timestep_s)
+                                    timestep=timestep(scenario) if timestep_s is None else timestep_s,
+                                    **({"rig_mechanics": scenario.rig} if isinstance(scenario, Scenario) else {}))
         self.dt = self.options.timestep
         self.plan = schedule(scenario, duration_scale, self.dt)   # checks the scale before the build
         #: The first case's car (each later case mounts its own on a copy of its model, as built).
