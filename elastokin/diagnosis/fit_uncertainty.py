@@ -17,25 +17,35 @@ import numpy as np
 def standard_errors(J: np.ndarray, r: np.ndarray, groups: np.ndarray, dof: int) -> np.ndarray:
     """Standard uncertainties (p,) of the parameters of a least-squares fit at its optimum: J (n, p)
     the residuals' Jacobian, r (n,) the residuals, ``groups`` (n,) the independent unit (test) each
-    residual belongs to, ``dof`` the fit's degrees of freedom. The larger of the linearised error
-    (its residual variance inflated for the residuals' sample-to-sample correlation ρ: n samples are
-    worth n(1 − ρ)/(1 + ρ)) and the cluster-robust one (module docstring). A parameter the residuals
-    do not depend on (a null column of J) has an unbounded uncertainty, the others taken from the
-    rest of J; all are unbounded when the rest cannot be inverted."""
+    residual belongs to, ``dof`` the fit's degrees of freedom: :func:`clustered_errors` of JᵀJ and
+    each unit's scores."""
+    units = np.unique(groups)
+    return clustered_errors(J.T @ J, np.array([J[groups == g].T @ r[groups == g] for g in units]), r, dof)
+
+
+def clustered_errors(gram: np.ndarray, scores: np.ndarray, r: np.ndarray, dof: int) -> np.ndarray:
+    """Standard uncertainties (p,) of the parameters of a least-squares fit at its optimum, from the
+    Jacobian's Gram matrix JᵀJ (p, p), each independent unit's scores J_gᵀ r_g (G, p), the residuals
+    r (n,) in the order their correlation runs and ``dof`` the fit's degrees of freedom. The larger of
+    the linearised error (its residual variance inflated for the residuals' sample-to-sample
+    correlation ρ: n samples are worth n(1 − ρ)/(1 + ρ)) and the cluster-robust one (module
+    docstring). A parameter the residuals do not depend on (a null column of J) has an unbounded
+    uncertainty, the others taken from the rest of J; all are unbounded when the rest cannot be
+    inverted."""
     rho = float(np.clip(np.dot(r[1:], r[:-1]) / max(np.dot(r, r), 1e-300), 0.0, 0.999))
     s2 = float(np.dot(r, r)) / max(dof, 1) * (1.0 + rho) / (1.0 - rho)
-    seen = np.linalg.norm(J, axis=0) > 1e-9 * max(float(np.linalg.norm(J)), 1e-300)
-    std = np.full(J.shape[1], np.inf)
+    norms = np.sqrt(np.clip(np.diag(gram), 0.0, None))
+    seen = norms > 1e-9 * max(float(np.sqrt(max(np.trace(gram), 0.0))), 1e-300)
+    std = np.full(len(gram), np.inf)
     try:
-        bread = np.linalg.inv(J[:, seen].T @ J[:, seen])
+        bread = np.linalg.inv(gram[np.ix_(seen, seen)])
     except np.linalg.LinAlgError:
         return std
-    units = np.unique(groups)
-    scores = np.array([J[groups == g][:, seen].T @ r[groups == g] for g in units])
+    scores = scores[:, seen]
     # centred: at a bound, or where the fit stopped short, the scores do not sum to zero, and what
     # they share is no disagreement between the tests
-    scores -= scores.mean(axis=0)
-    factor = len(units) / (len(units) - 1) if len(units) > 1 else 1.0
+    scores = scores - scores.mean(axis=0)
+    factor = len(scores) / (len(scores) - 1) if len(scores) > 1 else 1.0
     robust = np.diag(bread @ (scores.T @ scores) @ bread) * factor
     std[seen] = np.sqrt(np.clip(np.maximum(np.diag(bread) * s2, robust), 0.0, None))
     return std

@@ -9,7 +9,10 @@
    path's response (a low-pass filter and a delay behind the rig inputs, :mod:`elastokin.diagnosis.kc_lags`:
    estimated on the baseline, what is left of it fitted with every hypothesis) and the rig's
    transducers' errors (the inputs' and the channels' gains, cross-talk,
-   :mod:`elastokin.diagnosis.kc_transducers`: fitted with every hypothesis).
+   :mod:`elastokin.diagnosis.kc_transducers`) and its own mechanics (its pads' friction, its body
+   clamp's compliance, :mod:`elastokin.diagnosis.kc_rig_mechanics`): fitted with every hypothesis;
+   what they take out that a car cause would explain as well is said
+   (:mod:`elastokin.diagnosis.kc_rig_or_car`).
 2. Screening: every catalogue cause at every place it can sit (:mod:`elastokin.diagnosis.kc_catalogue`)
    is run once on the training tests (every other one) at mid-range magnitude (a sided cause, whose
    sign picks another effect, or one whose effect is not odd in its magnitude, such as a cross
@@ -62,6 +65,8 @@ from elastokin.diagnosis.kc_fits import (Candidate, Scorer, fit, fit_pair, halfw
                                     verify)
 from elastokin.diagnosis.kc_transducers import INPUT_GAIN, STEP, Reading, input_column, moved, reading_columns, stepped
 from elastokin.diagnosis.kc_lags import PathResponse
+from elastokin.diagnosis.kc_rig_mechanics import ELEMENTS, RIG, element_column, element_jobs
+from elastokin.diagnosis.kc_rig_or_car import RigOrCar, rig_or_car
 from elastokin.diagnosis.kc_noise import NoiseModel, coloured_noise
 from elastokin.diagnosis.kc_layout import Job, Layout, run_job
 from elastokin.diagnosis.verdict import (Outcome, Separation, decide, explained, misfit, misfit_stretch, pair_named,
@@ -120,10 +125,12 @@ class KCDiagnosis(Outcome):
     responses: list[PathResponse] = field(default_factory=list)
     #: the measurement noise, white and coloured, estimated from the baseline's residual (:mod:`elastokin.diagnosis.kc_noise`)
     noise_model: NoiseModel | None = None
-    #: the transducers' errors (the moved rig inputs' gains, the measured channels' gains and
-    #: cross-talk), fitted beside the final model and taken out of every comparison
-    #: (:mod:`elastokin.diagnosis.kc_transducers`)
+    #: the rig's errors (the moved rig inputs' gains, the measured channels' gains and cross-talk,
+    #: the rig's own mechanics), fitted beside the final model and taken out of every comparison
+    #: (:mod:`elastokin.diagnosis.kc_transducers`, :mod:`elastokin.diagnosis.kc_rig_mechanics`)
     transducers: list[Reading] = field(default_factory=list)
+    #: the rig errors taken out that car causes would explain as well (:mod:`elastokin.diagnosis.kc_rig_or_car`)
+    rig_or_car: list[RigOrCar] = field(default_factory=list)
 
     @property
     def final(self) -> Candidate:
@@ -216,10 +223,15 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, executor: Execut
             f"({int(heldout.sum())} held out)")
         (base,) = rows([vehicle], every)
         movers = moved(layout)
-        say(f"the baseline with each of the {len(movers)} rig inputs moved × {1 + STEP:g} (its transducer's gain)")
-        stepped_rows = runs([(f"{ch} × {1 + STEP:g}", stepped(layout, ch, tests), tests) for ch, tests in movers.items()])
+        say(f"the baseline with each of the {len(movers)} rig inputs moved × {1 + STEP:g} (its transducer's gain), "
+            f"and on a rig with each of {len(ELEMENTS)} elements of its mechanics moved (the pads' friction, the "
+            f"body clamp's compliance)")
+        nuisances = runs([(f"{ch} × {1 + STEP:g}", stepped(layout, ch, tests), tests) for ch, tests in movers.items()]
+                         + [(e.label, element_jobs(layout, e), every) for e in ELEMENTS])
         scorer = Scorer(layout, base, heldout, {**{(INPUT_GAIN, ch, None): input_column(r, base)
-                                                   for ch, r in zip(movers, stepped_rows)},
+                                                   for ch, r in zip(movers, nuisances)},
+                                                **{(RIG, e.key, None): element_column(r, base, e)
+                                                   for e, r in zip(ELEMENTS, nuisances[len(movers):])},
                                                 **reading_columns(layout, base)})
         before = scorer.heldout_error(base)
         say(f"held-out error of the baseline: {before:.3f} (1 = the measurement noise); one run of each of "
@@ -301,10 +313,17 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, executor: Execut
         out.extended = extended_vehicle(vehicle, named)
     out.responses = scorer.responses(out.final.simulated if out.named else base)
     out.noise_model = scorer.noise_model
-    out.transducers = scorer.transducers(out.final.simulated if out.named else base)
+    model = out.final.simulated if out.named else base
+    out.transducers = scorer.transducers(model)
     for g in out.transducers:
         if g.said:
-            say(f"{g.label}: {g.value:+.4f} ± {g.std:.2g} (taken out)")
+            say(f"{g.label}: {g.text} (taken out)")
+    out.rig_or_car = rig_or_car(scorer, model, out.transducers, list(zip(candidates, signatures)), base,
+                                [c.hypothesis for c in out.causes])
+    for c in out.rig_or_car:
+        say(f"what {c.group} took out, {' or '.join(h.label for h in c.rivals)} would explain as well "
+            f"({c.error_held:.3f} -> {c.error:.3f} with it, {' and '.join(f'{e:.3f}' for e in c.error_rivals)} "
+            f"with them): this campaign cannot tell them apart")
     for q, (white, coloured, tau) in coloured_noise(layout.channels, scorer.noise_model).items():
         say(f"the {q} channels' noise is coloured: {coloured / white:.2g} × their white noise, correlated over "
             f"{tau:.2g} s (counted in the noise, its uncertainties and thresholds)")

@@ -12,10 +12,11 @@ from typing import Callable, Mapping
 import numpy as np
 
 from elastokin.diagnosis.catalogue import Parameter
-from elastokin.diagnosis.fit_uncertainty import standard_errors
+from elastokin.diagnosis.fit_uncertainty import clustered_errors, standard_errors
 from elastokin.diagnosis.kc_catalogue import Hypothesis, parameters
+from elastokin.diagnosis.kc_columns import Columns, OneChannel
 from elastokin.diagnosis.kc_lags import PathResponse, Response, fit_response, paths
-from elastokin.diagnosis.kc_transducers import INPUT_GAIN, Key, Reading, reading
+from elastokin.diagnosis.kc_transducers import Key, Reading, bounded_solve, bounds, reading
 from elastokin.diagnosis.kc_layout import Layout
 from elastokin.diagnosis.kc_noise import estimate_noise, white_noise
 
@@ -23,9 +24,6 @@ from elastokin.diagnosis.kc_noise import estimate_noise, white_noise
 PARAMETER_PENALTY = 0.02
 #: Standard uncertainties by which a fitted magnitude must stand off no effect to be a cause found.
 SIGNIFICANT = 2.0
-#: The largest rig input's gain fitted (its command's scale): a rig's calibration is good to ±0.5–2 %
-#: (issue 53); what a larger one would take (a test's whole response scaled) is left to the car's causes.
-INPUT_GAIN_BOUND = 0.025
 
 
 @dataclass
@@ -69,10 +67,10 @@ class Scorer:
     each channel's zero error in each recording removed; errors per test."""
 
     def __init__(self, layout: Layout, baseline: np.ndarray, heldout: np.ndarray,
-                 transducers: Mapping[Key, np.ndarray] | None = None):
+                 transducers: Mapping[Key, np.ndarray | OneChannel] | None = None):
         """``transducers``: the rows' derivative (N, C) with respect to each transducer error fitted
-        with every prediction (:mod:`elastokin.diagnosis.kc_transducers`), as the rig's acquisition
-        delivers it (here)."""
+        with every prediction (:mod:`elastokin.diagnosis.kc_transducers`; one channel's alone for a
+        :class:`~elastokin.diagnosis.kc_columns.OneChannel`), as the rig's acquisition delivers it (here)."""
         self.layout, self.heldout = layout, heldout
         self.held_rows = heldout[layout.test]
         self.paths = paths(layout.channels)
@@ -86,28 +84,38 @@ class Scorer:
         self.noise_model = estimate_noise(layout, layout.measured - delivered)
         self.noise = self.noise_model.sigma
         self._rates, self._taps = self.response.rates(delivered), self.response.taps(delivered)
-        self._transducers = {k: self._delivered(c) for k, c in (transducers or {}).items()}   # linear in the rows
-        self._columns: dict[bytes, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
-        #: which of the transducers' columns are rig inputs' gains (held within a bound)
-        self._inputs = np.array([key[0] == INPUT_GAIN for key in self._transducers], dtype=bool)
+        self._transducers = {k: self._delivered_column(c) for k, c in (transducers or {}).items()}
+        self._columns: dict[bytes, tuple[Columns, np.ndarray, np.ndarray]] = {}
+        #: the bounds of the transducers' coefficients (a rig input's gain, a rig's mechanics: held within them)
+        self._bounds = np.array([bounds(key) for key in self._transducers]).reshape(-1, 2)
         #: the last residual: (the prediction, its rows and zero, the residual), read-only
         self._last: tuple[np.ndarray, tuple, np.ndarray] | None = None
 
     def _delivered(self, rows: np.ndarray) -> np.ndarray:
         return self.response.apply(rows, self.cutoffs_hz, self.delays_s)
 
-    def _zeroed(self, r: np.ndarray, rows: np.ndarray, zero: Callable[..., np.ndarray]) -> np.ndarray:
-        """``r`` (the selected rows) with each channel's ``zero`` in each recording removed, in noise units."""
+    def _delivered_column(self, column: np.ndarray | OneChannel) -> np.ndarray | OneChannel:
+        """A column through the acquisition (linear in the rows, channel by channel)."""
+        if not isinstance(column, OneChannel):
+            return self._delivered(column)
+        rows = np.zeros(self.layout.measured.shape)
+        rows[:, column.channel] = column.values
+        return OneChannel(column.channel, self._delivered(rows)[:, column.channel])
+
+    def _zeroed(self, r: np.ndarray, rows: np.ndarray, zero: Callable[..., np.ndarray],
+                channel: int | None = None) -> np.ndarray:
+        """``r`` (the selected rows; of one ``channel`` alone if given) with each channel's ``zero`` in
+        each recording removed, in noise units."""
         rec = self.layout.recording[rows]
         for k in np.unique(rec):
             r[rec == k] -= zero(r[rec == k], axis=0)
-        return r / self.noise
+        return r / (self.noise if channel is None else self.noise[channel])
 
-    def _nuisance(self, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _nuisance(self, rows: np.ndarray) -> tuple[Columns, np.ndarray, np.ndarray]:
         """On the selected rows, zeroed as the residual is: the columns fitted with every prediction
-        (K, n, C) (each path's taps (:meth:`elastokin.diagnosis.kc_lags.Response.taps`) on its
-        channels in the tests of each sampling rate, then each transducer's), their Gram matrix and
-        its pseudo-inverse; cached per selection."""
+        (each path's taps (:meth:`elastokin.diagnosis.kc_lags.Response.taps`) on its channels in the
+        tests of each sampling rate, then each transducer's), their Gram matrix and its
+        pseudo-inverse; cached per selection."""
         key = rows.tobytes()
         if key not in self._columns:
             taps = [c[rows] for c in self._taps]
@@ -120,35 +128,45 @@ class Scorer:
                         own = np.zeros_like(tap)
                         own[np.ix_(steps == step, idx)] = tap[np.ix_(steps == step, idx)]
                         columns.append(self._zeroed(own, rows, np.mean))
-            columns += [self._zeroed(c[rows], rows, np.mean) for c in self._transducers.values()]
-            stack = np.array(columns).reshape(len(columns), int(rows.sum()), len(self.layout.channels))
-            flat = stack.reshape(len(columns), stack[0].size if columns else 0)
-            gram = flat @ flat.T
+            columns += [OneChannel(c.channel, self._zeroed(c.values[rows], rows, np.mean, c.channel))
+                        if isinstance(c, OneChannel) else self._zeroed(c[rows], rows, np.mean)
+                        for c in self._transducers.values()]
+            stack = Columns(columns, (int(rows.sum()), len(self.layout.channels)))
+            gram = stack.gram()
             self._columns[key] = (stack, gram, np.linalg.pinv(gram))
         return self._columns[key]
 
-    def _fitted(self, r: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _fitted(self, r: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, Columns, np.ndarray]:
         """The residual ``r`` on the selected rows with the nuisance columns fitted out, the columns
-        and their coefficients. A rig input's gain is held within ± :data:`INPUT_GAIN_BOUND` (a
-        calibrated rig's): beyond, it is held at the bound and the other columns refitted, what is
-        left being the car's."""
+        and their coefficients. A rig input's gain is held within ± :data:`~elastokin.diagnosis.kc_transducers.INPUT_GAIN_BOUND` (a
+        calibrated rig's), a rig's mechanics between none and a rig's most
+        (:mod:`elastokin.diagnosis.kc_rig_mechanics`): beyond, one is held at its bound and the other
+        columns refitted (:func:`~elastokin.diagnosis.kc_transducers.bounded_solve`), what is left being the car's."""
         stack, gram, inverse = self._nuisance(rows)
         if not len(stack):
             return r, stack, np.zeros(0)
-        flat = stack.reshape(len(stack), r.size)
-        seen = flat @ r.ravel()
-        coef = inverse @ seen
-        over = np.zeros(len(coef), dtype=bool)
-        over[len(coef) - len(self._inputs):] = self._inputs
-        over &= np.abs(coef) > INPUT_GAIN_BOUND
-        if over.any():
-            coef[over] = np.clip(coef[over], -INPUT_GAIN_BOUND, INPUT_GAIN_BOUND)
-            free = ~over
-            coef[free] = np.linalg.pinv(gram[np.ix_(free, free)]) @ (seen[free] - gram[np.ix_(free, over)] @ coef[over])
-        return r - (coef @ flat).reshape(r.shape), stack, coef
+        coef = bounded_solve(gram, stack.products(r), self._column_bounds(len(stack)), inverse)
+        return r - stack.combine(coef).reshape(r.shape), stack, coef
 
-    def _raw(self, predicted: np.ndarray, rows: np.ndarray, zero: Callable[..., np.ndarray]) -> np.ndarray:
+    def _raw(self, predicted: np.ndarray, rows: np.ndarray, zero: Callable[..., np.ndarray] = np.mean) -> np.ndarray:
         return self._zeroed(self.layout.measured[rows] - self._delivered(predicted)[rows], rows, zero)
+
+    def raw(self, predicted: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        """(measured − predicted) / noise on the selected rows as :meth:`residual` has it before the
+        nuisances are fitted out (each recording's zeros, their means, removed)."""
+        return self._raw(predicted, rows)
+
+    def nuisances(self, rows: np.ndarray) -> tuple[Columns, np.ndarray, np.ndarray, list[Key | None]]:
+        """The nuisance columns on the selected rows as :meth:`residual` fits them out; their Gram
+        matrix (K, K); each one's bounds (K, 2); each one's key (None for the acquisition's taps)."""
+        stack, gram, _ = self._nuisance(rows)
+        return (stack, gram, self._column_bounds(len(stack)),
+                [None] * (len(stack) - len(self._transducers)) + list(self._transducers))
+
+    def _column_bounds(self, columns: int) -> np.ndarray:
+        """(columns, 2) the bounds of every nuisance coefficient: the acquisition's taps free, the
+        transducers' and the rig's as :func:`~elastokin.diagnosis.kc_transducers.bounds` says."""
+        return np.vstack([np.tile([-np.inf, np.inf], (columns - len(self._transducers), 1)), self._bounds])
 
     def responses(self, predicted: np.ndarray) -> list[PathResponse]:
         """Each acquisition path's response as fitted beside ``predicted`` (all rows): its filter,
@@ -175,20 +193,26 @@ class Scorer:
         every = np.ones(len(predicted), dtype=bool)
         left, stack, coef = self._fitted(self._raw(predicted, every, np.mean), every)
         first = len(stack) - len(self._transducers)
-        std = np.sqrt(self.variances(left, list(stack), every))[first:]
+        std = np.sqrt(self.variances(left, stack, every))[first:]
         return [reading(key, float(coef[first + k]), float(s)) for k, (key, s) in enumerate(zip(self._transducers, std))]
 
-    def variances(self, residual: np.ndarray, columns: list[np.ndarray], rows: np.ndarray) -> np.ndarray:
+    def variances(self, residual: np.ndarray, columns: list[np.ndarray] | Columns, rows: np.ndarray) -> np.ndarray:
         """The variances of the coefficients of ``columns`` fitted to leave ``residual`` on the selected
-        ``rows`` (each (rows, channels) over the same channels, or raveled from them row by row):
-        :func:`elastokin.diagnosis.fit_uncertainty.standard_errors` with the tests as the independent
+        ``rows`` (each (rows, channels) over the same channels, or raveled from them row by row; or
+        the nuisances' :class:`~elastokin.diagnosis.kc_columns.Columns`):
+        :func:`elastokin.diagnosis.fit_uncertainty.clustered_errors` with the tests as the independent
         units, the samples' correlation taken along time, channel by channel (coloured noise, a smooth
         model error)."""
         tests = self.layout.test[rows]
         along = lambda x: x.reshape(len(tests), -1).T.ravel()   # channel after channel, time running
-        jacobian = np.column_stack([along(c) for c in columns])
+        dof = residual.size - len(columns)
+        if isinstance(columns, Columns):
+            r = residual.reshape(len(tests), -1)
+            scores = np.array([columns.products(np.where((tests == g)[:, None], r, 0.0)) for g in np.unique(tests)])
+            return clustered_errors(columns.gram(), scores, along(residual), dof) ** 2
         width = residual.size // len(tests)
-        return standard_errors(jacobian, along(residual), np.tile(tests, width), residual.size - len(columns)) ** 2
+        jacobian = np.column_stack([along(c) for c in columns])
+        return standard_errors(jacobian, along(residual), np.tile(tests, width), dof) ** 2
 
     def residual(self, predicted: np.ndarray, rows: np.ndarray, zero: Callable[..., np.ndarray] = np.mean
                  ) -> np.ndarray:
@@ -256,7 +280,7 @@ def fit(h: Hypothesis, signature: np.ndarray, base: np.ndarray, scorer: Scorer,
     var = scorer.variances(mismatch - sum(c * x for c, x in zip(coef, columns)), columns, train)
     if len(columns) == 2:
         std[params[1].name] = math.sqrt(var[1])
-    value, std[first.name], scale = _magnitude(first, at[first.name], coef[0], math.sqrt(var[0]))
+    value, std[first.name], scale = scaled_magnitude(first, at[first.name], coef[0], math.sqrt(var[0]))
     rest = sum(c * x for c, x in zip(coef[1:], columns[1:]))
     trained = float(math.sqrt(np.mean((mismatch - scale * columns[0] - rest) ** 2)))
     return Candidate(replace(h, values={**at, first.name: value}), math.nan, std, screened_error=trained,
@@ -296,7 +320,7 @@ def fit_pair(first: Candidate, second: Candidate, base: np.ndarray, scorer: Scor
     for c, k, s in zip((first, second), coef, sd):
         p = parameters(c.hypothesis.cause)[0]
         values = at if c is second else c.hypothesis.values
-        value, std, scale = _magnitude(p, values[p.name], float(k), float(s))
+        value, std, scale = scaled_magnitude(p, values[p.name], float(k), float(s))
         # the first's uncertainty at least its shift (the second's: :func:`kept`)
         out.append(Candidate(replace(c.hypothesis, values={**values, p.name: value}), math.nan,
                              {**c.std, **(extra if c is second else {}),
@@ -349,7 +373,7 @@ def _side_bounds(second: Parameter, first_value: float) -> tuple[float, float]:
     return lo, hi
 
 
-def _magnitude(p: Parameter, at: float, coef: float, sd: float) -> tuple[float, float, float]:
+def scaled_magnitude(p: Parameter, at: float, coef: float, sd: float) -> tuple[float, float, float]:
     """A first parameter's value when its effect at ``at`` is scaled by ``coef`` (standard deviation
     ``sd``), kept within its bounds and on its side: the value, its uncertainty, and the scale of the
     effect it gives."""

@@ -15,20 +15,24 @@ A moved input's comes from a baseline run of the tests it moves in with its comm
 :data:`STEP`) (first order, the car's own nonlinearity in it); a channel's gain is its own
 prediction; a cross-talk is the other quantity (the prediction, or the rig's command for an input)
 placed in the channel. The columns are projected out of every residual with the acquisition's
-(:class:`elastokin.diagnosis.kc_fits.Scorer`), so that each cause is fitted jointly with them, and
-what the data tell of each is reported. A gain is common to every test of its channel while a car's
-cause acts on each test its own way, so the campaign tells most causes from the gains; one that acts
-as a gain does (every response of a channel, or to an input, scaled alike) is not told from it: the
-fit leaves it to the gain, and a static calibration of the transducer separates them.
+(:class:`elastokin.diagnosis.kc_fits.Scorer`), so that each cause is fitted jointly with them, each
+within its :func:`bounds` (:func:`bounded_solve`), and what the data tell of each is reported. A
+gain is common to every test of its channel while a car's cause acts on each test its own way, so
+the campaign tells most causes from the gains; one that acts as a gain does (every response of a
+channel, or to an input, scaled alike) is not told from it: the fit leaves it to the gain, and a
+static calibration of the transducer separates them (:mod:`elastokin.diagnosis.kc_rig_or_car`).
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 
 import numpy as np
 
+from elastokin.diagnosis.kc_columns import OneChannel
 from elastokin.diagnosis.kc_layout import Job, Layout
+from elastokin.diagnosis.kc_rig_mechanics import BY_KEY, RIG
 from elastokin.vehicle.scenarios.channels import INPUT_CHANNELS, channel_quantity, channel_wheel
 
 #: The relative step of an input's command in the runs that give its gain's column.
@@ -39,28 +43,43 @@ CROSSTALK = {"toe": "camber", "pad_fz": "pad_fy"}
 #: good transducer's calibration).
 SAID_STD, SAID_SHARE = 3.0, 0.002
 INPUT_GAIN, GAIN, CROSS = "input gain", "gain", "cross-talk"
+#: The largest rig input's gain fitted (its command's scale): a rig's calibration is good to ±0.5–2 %
+#: (issue 53); what a larger one would take (a test's whole response scaled) is left to the car's causes.
+INPUT_GAIN_BOUND = 0.025
 
 
 @dataclass(frozen=True)
 class Reading:
-    """A transducer's error as fitted beside a model."""
+    """A rig's error as fitted beside a model: a transducer's, or an element of the rig's own
+    mechanics (:mod:`elastokin.diagnosis.kc_rig_mechanics`)."""
 
-    kind: str             #: INPUT_GAIN, GAIN or CROSS
-    channel: str          #: the channel it reads (a rig input's for INPUT_GAIN)
+    kind: str             #: INPUT_GAIN, GAIN, CROSS or RIG
+    channel: str          #: the channel it reads (a rig input's for INPUT_GAIN; the rig file key for RIG)
     source: str | None    #: the quantity of the same wheel a cross-talk sees
-    value: float          #: a gain g (it reads (1 + g) × the truth), or a cross-talk's coefficient
-    #: [the channel's unit per the source's]
+    value: float          #: a gain g (it reads (1 + g) × the truth), a cross-talk's coefficient [the
+    #: channel's unit per the source's], or a rig element's value [its unit]
     std: float            #: its standard uncertainty
 
     @property
     def said(self) -> bool:
-        """Whether the data show it (beyond SAID_STD standard uncertainties and SAID_SHARE)."""
-        return abs(self.value) > max(SAID_STD * self.std, SAID_SHARE)
+        """Whether the data show it (beyond SAID_STD standard uncertainties and SAID_SHARE, a rig
+        element's floor)."""
+        floor = BY_KEY[self.channel].floor if self.kind == RIG else SAID_SHARE
+        return abs(self.value) > max(SAID_STD * self.std, floor)
 
     @property
     def label(self) -> str:
-        """``pad_fy_fl (input gain)``, ``toe_fl sees camber``, ``camber_fr (gain)``."""
+        """``pad_fy_fl (input gain)``, ``toe_fl sees camber``, ``camber_fr (gain)``, ``the pads' friction``."""
+        if self.kind == RIG:
+            return BY_KEY[self.channel].label
         return f"{self.channel} sees {self.source}" if self.kind == CROSS else f"{self.channel} ({self.kind})"
+
+    @property
+    def text(self) -> str:
+        """Its value for people: a gain or a cross-talk (both ratios) in %, a rig element in its unit."""
+        if self.kind == RIG:
+            return f"{self.value:.3g} ± {self.std:.2g} {BY_KEY[self.channel].unit}"
+        return f"{100 * self.value:+.2f} ± {100 * self.std:.2g} %"
 
 
 Key = tuple[str, str, "str | None"]
@@ -91,29 +110,63 @@ def input_column(stepped_rows: np.ndarray, baseline: np.ndarray) -> np.ndarray:
     return np.nan_to_num((stepped_rows - baseline) / STEP, nan=0.0)
 
 
-def reading_columns(layout: Layout, baseline: np.ndarray) -> dict[Key, np.ndarray]:
+def reading_columns(layout: Layout, baseline: np.ndarray) -> dict[Key, OneChannel]:
     """Each measured channel's gain and cross-talk columns (module docstring), from the baseline's
-    rows (N, C) and the rig's recorded commands."""
+    rows (N, C) and the rig's recorded commands: each on its channel alone."""
     index = {c: i for i, c in enumerate(layout.channels)}
-    out: dict[Key, np.ndarray] = {}
+    out: dict[Key, OneChannel] = {}
     for i, c in enumerate(layout.channels):
-        own = np.zeros_like(baseline)
-        own[:, i] = baseline[:, i]
-        out[(GAIN, c, None)] = own
+        out[(GAIN, c, None)] = OneChannel(i, baseline[:, i].copy())
         source = CROSSTALK.get(channel_quantity(c))
         seen = f"{source}_{channel_wheel(c)}" if source else None
         if seen in index or (seen in INPUT_CHANNELS and layout.inputs is not None):
-            other = np.zeros_like(baseline)
-            other[:, i] = baseline[:, index[seen]] if seen in index else layout.inputs[:, INPUT_CHANNELS.index(seen)]
-            out[(CROSS, c, source)] = other
+            out[(CROSS, c, source)] = OneChannel(i, baseline[:, index[seen]].copy() if seen in index
+                                                 else layout.inputs[:, INPUT_CHANNELS.index(seen)].copy())
     return out
 
 
 def reading(key: Key, coef: float, std: float) -> Reading:
     """The transducer error a fitted coefficient of ``key``'s column stands for: the coefficient for a
-    measured channel's gain or cross-talk; for an input, the gain g whose servo gives the car its
-    command × (1 + ``coef``) (1 + coef = 1 / (1 + g)), its uncertainty carried to first order."""
+    measured channel's gain or cross-talk and a rig element's value; for an input, the gain g whose
+    servo gives the car its command × (1 + ``coef``) (1 + coef = 1 / (1 + g)), its uncertainty
+    carried to first order."""
     kind, channel, source = key
     if kind == INPUT_GAIN:
         return Reading(kind, channel, None, 1.0 / (1.0 + coef) - 1.0, std / (1.0 + coef) ** 2)
     return Reading(kind, channel, source, coef, std)
+
+
+def bounded_solve(gram: np.ndarray, seen: np.ndarray, limits: np.ndarray, inverse: np.ndarray | None = None
+                  ) -> np.ndarray:
+    """The coefficients of columns (their ``gram`` matrix, their products ``seen`` with what they fit)
+    that fit it best within ``limits`` (K, 2) (:func:`bounds`), those whose limits meet held there:
+    the least-squares fit (``inverse``: the Gram matrix's pseudo-inverse, when nothing is held), then
+    each coefficient beyond its limits held at the nearer and the others refitted."""
+    lo, hi = limits.T
+    held = lo == hi
+    coef = np.where(held, lo, 0.0)
+
+    def refit():
+        free = ~held
+        coef[free] = np.linalg.pinv(gram[np.ix_(free, free)]) @ (seen[free] - gram[np.ix_(free, held)] @ coef[held])
+
+    if held.any() or inverse is None:
+        refit()
+    else:
+        coef = inverse @ seen
+    over = (coef < lo) | (coef > hi)
+    if over.any():
+        held |= over
+        coef[held] = np.clip(coef[held], lo[held], hi[held])
+        refit()
+    return coef
+
+
+def bounds(key: Key) -> tuple[float, float]:
+    """The bounds of a transducer's or the rig's coefficient (its column's scale)."""
+    kind, name, _ = key
+    if kind == INPUT_GAIN:
+        return -INPUT_GAIN_BOUND, INPUT_GAIN_BOUND
+    if kind == RIG:
+        return 0.0, BY_KEY[name].bound
+    return -math.inf, math.inf

@@ -18,6 +18,7 @@ from elastokin.diagnosis.kc_catalogue import Hypothesis, extended_vehicle_yaml, 
 from elastokin.diagnosis.kc_diagnosis import KCDiagnosis, Misfit
 from elastokin.diagnosis.kc_fits import Candidate
 from elastokin.diagnosis.kc_noise import coloured_noise
+from elastokin.diagnosis.kc_rig_mechanics import BY_KEY, RIG
 from elastokin.diagnosis.kc_transducers import INPUT_GAIN
 from elastokin.diagnosis.verdict import MISFIT_CHANCE, NOISE_FACTOR, Separation
 from elastokin.presentation.diagnosis_report import Report, partly_explained, ranking_chart, separation_clause
@@ -94,7 +95,15 @@ def summary(d: KCDiagnosis) -> dict[str, Any]:
                          "cutoff_hz": r.cutoff_hz or None, "delay_ms": 1e3 * r.delay_s, "delay_std_ms": 1e3 * r.std_s}
                         for r in d.responses],
         "transducers": [{"kind": g.kind, "channel": g.channel, "source": g.source, "value": g.value, "std": g.std}
-                        for g in d.transducers],
+                        for g in d.transducers if g.kind != RIG],
+        "rig": [{"element": g.channel, "value": g.value, "std": g.std, "unit": BY_KEY[g.channel].unit}
+                for g in d.transducers if g.kind == RIG],
+        "rig_or_car": [{"group": c.group, "readings": [f"{g.label} {g.text}" for g in c.readings],
+                        "rivals": [{"cause": h.cause, "location": h.location_json(), "parameters": dict(h.values)}
+                                   for h in c.rivals],
+                        "remedy": c.remedy, "training_error_held": c.error_held,
+                        "training_error_rivals": list(c.error_rivals), "training_error": c.error}
+                       for c in d.rig_or_car],
         "damage": list(d.layout.damage),
         "wall_s": d.wall_s,
     }
@@ -122,9 +131,8 @@ def _alike_sentence(d: KCDiagnosis) -> str:
     """What the campaign cannot tell apart, and the test that would."""
     out = ""
     for c, sep in zip(d.alike, d.separations):
-        values = ", ".join(f"{k} = {v:.4g} {p.unit}" for (k, v), p in zip(c.hypothesis.values.items(),
-                                                                           parameters(c.hypothesis.cause)))
-        out += (f" These tests cannot tell it from **{c.hypothesis.cause}** at {_where(c)} ({values}; held-out error "
+        out += (f" These tests cannot tell it from **{c.hypothesis.cause}** at {_where(c.hypothesis)} "
+                f"({_values(c.hypothesis)}; held-out error "
                 f"{c.heldout_error:.2f}): ")
         if sep is None:
             out += ("the dataset holds every shipped rig test." if not d.extra_tests else
@@ -133,6 +141,11 @@ def _alike_sentence(d: KCDiagnosis) -> str:
         else:
             out += separation_clause(sep, "rig test")
     return out
+
+
+def _values(h: Hypothesis) -> str:
+    """A hypothesis's parameters with their units."""
+    return ", ".join(f"{k} = {v:.4g} {p.unit}" for (k, v), p in zip(h.values.items(), parameters(h.cause)))
 
 
 def _misfit(m: Misfit) -> dict[str, Any]:
@@ -145,8 +158,8 @@ def excess(error: float) -> float:
     return math.sqrt(max(error ** 2 - 1.0, 0.0))
 
 
-def _where(c: Candidate) -> str:
-    loc = c.hypothesis.location_json() or {}
+def _where(h: Hypothesis) -> str:
+    loc = h.location_json() or {}
     return ", ".join(f"{k} {'/'.join(v) if isinstance(v, list) else v}" for k, v in loc.items())
 
 
@@ -165,14 +178,25 @@ def _acquisition_sentence(d: KCDiagnosis) -> str:
 
 
 def _transducers_sentence(d: KCDiagnosis) -> str:
-    """Which transducers the data show misreading, if any."""
-    said = [g for g in d.transducers if g.said]
-    if not said:
-        return ""
-    return (" The rig's transducers misread: " + ", ".join(
-        f"{g.label} {100 * g.value:+.2f} ± {100 * g.std:.2g} %" for g in said)
-            + " (fitted with every hypothesis and taken out; a cause acting on the campaign as such an error does "
-              "is not told from it: a static calibration of the transducer separates them).")
+    """Which transducers the data show misreading, and what of the rig's own mechanics they show, if any."""
+    said = [g for g in d.transducers if g.said and g.kind != RIG]
+    mechanics = [g for g in d.transducers if g.said and g.kind == RIG]
+    out = "" if not said else (
+        " The rig's transducers misread: " + ", ".join(f"{g.label} {g.text}" for g in said)
+        + " (fitted with every hypothesis and taken out; a cause acting on the campaign as such an error does "
+          "is not told from it: a static calibration of the transducer separates them).")
+    return out + ("" if not mechanics else (
+        " The rig itself shows: " + ", ".join(f"{g.label} {g.text}" for g in mechanics)
+        + " (fitted with every hypothesis and taken out: the rig's, not the car's)."))
+
+
+def _rig_or_car_sentence(d: KCDiagnosis) -> str:
+    """The rig errors taken out that a car cause would explain as well, and the check that tells them apart."""
+    return "".join(
+        f" What the data show of {c.group} ({', '.join(f'{g.label} {g.text}' for g in c.readings[:3])}"
+        f"{', …' if len(c.readings) > 3 else ''}) "
+        + " or ".join(f"**{h.cause}** at {_where(h)} ({_values(h)})" for h in c.rivals)
+        + f" would explain as well: this campaign cannot tell them apart; {c.remedy}." for c in d.rig_or_car)
 
 
 def _noise_sentence(d: KCDiagnosis) -> str:
@@ -188,7 +212,8 @@ def _noise_sentence(d: KCDiagnosis) -> str:
 def verdict_sentence(d: KCDiagnosis) -> str:
     """One sentence for people: the cause, what was taken out as the rig's acquisition and its
     transducers' errors, and the noise's colour."""
-    return _cause_sentence(d) + _acquisition_sentence(d) + _transducers_sentence(d) + _noise_sentence(d)
+    return (_cause_sentence(d) + _acquisition_sentence(d) + _transducers_sentence(d) + _rig_or_car_sentence(d)
+            + _noise_sentence(d))
 
 
 def _cause_sentence(d: KCDiagnosis) -> str:
@@ -208,7 +233,7 @@ def _cause_sentence(d: KCDiagnosis) -> str:
         return (f"The mismatch is real ({before:.2f} × the noise on held-out tests) but no catalogue cause explains "
                 f"it; the best, {best.hypothesis.label}, only brings it to {best.heldout_error:.2f}.")
     named = " and ".join(
-        f"**{c.hypothesis.cause}** at {_where(c)} (" + ", ".join(
+        f"**{c.hypothesis.cause}** at {_where(c.hypothesis)} (" + ", ".join(
             f"{k} = {v['value']:.4g} ± {v['std']:.2g} {v['unit']}" if v["fitted"] else
             f"{k} = {v['value']:.4g} {v['unit']} (held at mid-range)" for k, v in _parameters(d, c).items()) + ")"
         for c in d.causes)
@@ -305,12 +330,17 @@ def write_report(d: KCDiagnosis, baseline: VehicleDefinition, out_dir: Path, dat
     report.table(("path", "channels", "lag at low frequency [ms]", "low-pass [Hz]", "delay [ms]"),
                  [(r.path, f"{len(r.channels)}", f"{1e3 * r.lag_s:.2f}", f"{r.cutoff_hz:.3g}" if r.cutoff_hz else "none",
                    f"{1e3 * r.delay_s:.2f} ± {1e3 * r.std_s:.2g}") for r in d.responses])
-    shown = [g for g in d.transducers if g.kind == INPUT_GAIN or g.said]
+    shown = [g for g in d.transducers if g.kind == INPUT_GAIN or (g.said and g.kind != RIG)]
     if shown:
         report.paragraph("The transducers' errors fitted with every hypothesis (`elastokin/diagnosis/kc_transducers.py`): "
                          "each moved rig input's gain g (it reads (1 + g) × the truth; the car got the command / (1 + g)), "
                          "and each measured channel's gain or cross-talk the data show:")
         report.table(("transducer", "value [%]"), [(g.label, f"{100 * g.value:+.3f} ± {100 * g.std:.2g}") for g in shown])
+    mechanics = [g for g in d.transducers if g.kind == RIG]
+    if mechanics:
+        report.paragraph("The rig's own mechanics fitted with every hypothesis (`elastokin/diagnosis/kc_rig_mechanics.py`): "
+                         "its floating pads' friction and its body clamp's compliance, each from none to a rig's most:")
+        report.table(("element", "value"), [(g.label, g.text) for g in mechanics])
     report.paragraph("The measurement noise per quantity, from the residual's differences between successive "
                      "samples (white) and, in the tests whose input repeats, between the samples a period apart "
                      "(coloured: what each recording's zero leaves of it; `elastokin/diagnosis/kc_noise.py`):")
