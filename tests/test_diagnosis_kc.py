@@ -660,6 +660,165 @@ def test_a_spring_on_a_rig_whose_pads_have_friction_is_named_and_the_friction_ta
     assert "The rig itself shows: the pads' friction" in verdict_sentence(diagnosis)
 
 
+def test_a_clean_car_through_a_rigs_lag_and_force_gain_is_given_no_car_cause(tmp_path):
+    """A clean car measured through :data:`E2E_CHAIN` and brought in as a rig's SAE CSV exports:
+    "none", the lag and the gains recovered (without the gains' fit: a coupling and a stiffness)."""
+    result = diagnose_fresh(through_a_rigs_csv(tmp_path, [], 2))
+    check(result, None)
+    assert_the_chain_recovered(result)
+
+
+def test_report_of_a_one_scenario_dataset_and_a_bushing_stiffer_than_its_law(tmp_path):
+    """The rear pivot's axial direction 250 N/mm where the car's file says 200 (a harder rubber,
+    ×1.25), measured on the lateral-force test alone at 10 times its speed through a rig's lag and
+    force gain, brought in as the rig's SAE CSV exports (:func:`through_a_rigs_csv`): a stiffness
+    factor named at its place, its factor within 3 standard uncertainties and 3 %, not an asymmetry;
+    the chain recovered; the same verdict, every number of it, on a local Dask cluster and serially;
+    ``-o`` writes the report, its pictures, diagnosis.json and an extended vehicle file that carries
+    the fitted factor where it was found."""
+    h = Hypothesis("stiffness", ("e1_rear", "x"), {"stiffness_scale": 1.25})
+    measured = through_a_rigs_csv(tmp_path, [h], 2)
+    report = tmp_path / "report"
+    result = diagnose_fresh(measured, "-o", str(report))   # on a local Dask cluster of 2 workers
+    check(result, h)
+    fitted = result["parameters"]["stiffness_scale"]
+    assert abs(fitted["value"] - 1.25) <= min(3.0 * fitted["std"], 0.03 * 1.25), fitted
+    assert all(c["cause"] != "asymmetry" for c in result["causes"])
+    assert_the_chain_recovered(result)
+    # the same verdict, every number of it, serially in this process
+    serial = diagnose_kc(read_kc_dataset(measured), load_vehicle(DEFAULT_VEHICLE), executor=SerialExecutor())
+    assert ({k: v for k, v in json.loads(json.dumps(summary(serial))).items() if k != "wall_s"}
+            == {k: v for k, v in result.items() if k != "wall_s"})
+    assert json.loads((report / "diagnosis.json").read_text())["cause"] == "stiffness"
+    text = (report / "report.md").read_text()
+    assert text.count("![") == 3 and all((report / name).stat().st_size > 0 for name in
+                                         ("overlays.png", "residuals.png", "ranking.png"))
+    assert "pad_fy_fl" in text and "transducer" in text   # the gains said and tabled
+    extended = {b.name: b for b in load_vehicle(report / "extended_vehicle.yaml").bushings}
+    baseline = {b.name: b for b in load_vehicle(DEFAULT_VEHICLE).bushings}
+    assert extended["e1_rear"].directions["x"].params["K0"] == pytest.approx(
+        fitted["value"] * baseline["e1_rear"].directions["x"].params["K0"], rel=1e-6)
+    assert extended["e1_rear"].directions["y"] == baseline["e1_rear"].directions["y"]
+
+
+def test_a_hardpoint_off_is_named_or_reported_with_its_rivals(tmp_path):
+    """A tie rod's inner end 2 mm high (bump steer) hidden in the car, measured in pumping alone at 10
+    times its speed: named with its offset, or reported among the rivals these tests cannot tell
+    from the named cause, each with the shipped test that separates it best."""
+    root = Path(__file__).resolve().parents[1]
+    h = Hypothesis("hardpoint", ("front", "tie_rod_inner", "z"), {"offset": 2.0})
+    measured = measure_truth(tmp_path, [h], 3, duration_scale=0.1,
+                             scenarios=[str(root / "scenarios" / "kc" / "pumping.yaml")])
+    result = json.loads(json.dumps(summary(diagnose_kc(read_kc_dataset(measured), load_vehicle(DEFAULT_VEHICLE),
+                                                       executor=SerialExecutor()))))
+    check(result, h)
+    for rival in result["alike"]:
+        separated = rival["separated_by"]
+        assert Path(separated["file"]).is_file() and separated["scenario"] != "kc_pumping"
+        assert separated["separates"] == (separated["difference"] >= math.sqrt(1 / 0.9 ** 2 - 1))
+
+
+@pytest.mark.slow
+def test_two_drawn_causes_are_both_named_at_their_places(tmp_path):
+    hs = hidden_pair(SEED)
+    check_pair(diagnose_fresh(measure_truth(tmp_path, hs, SEED, duration_scale=0.25)), hs)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("cause", KC_CAUSES + ["none", "backlash", PAIR])
+def test_success_rate_over_many_seeds(tmp_path, record_property, cause):
+    """At least OWN_FORM_SUCCESS_RATE of the draws per catalogue cause diagnosed right (20) and of
+    clean draws naming nothing (10), MIN_SUCCESS_RATE of backlashes (outside the catalogue) never a
+    confident cause, both causes of MIN_PAIR_SUCCESS_RATE of the pairs (20; the tally goes to the
+    run's summary)."""
+    def attempt(case: Path, seed: int) -> str:
+        if cause == PAIR:
+            hs = hidden_pair(seed)
+            check_pair(diagnose_fresh(measure_truth(case, hs, seed, duration_scale=0.25)), hs)
+            return ""
+        h, measured = measure(case, cause, seed)
+        return check(diagnose_fresh(measured), h)
+
+    seeds = SLOW_SEEDS[:max(len(SLOW_SEEDS) // 2, 1)] if cause == "none" else SLOW_SEEDS
+    assert_success_rate(cause, seeds, tmp_path, attempt, record_property,
+                        MIN_PAIR_SUCCESS_RATE if cause == PAIR else MIN_SUCCESS_RATE if cause == "backlash"
+                        else OWN_FORM_SUCCESS_RATE)
+
+
+#: How close a path's lag at low frequency must come to the chain's [s], beyond 3 of its standard
+#: uncertainties: its filter's shape is fitted, not known (a filter's lag is √2/(2π f_c)).
+LAG_TOLERANCE_S = 5e-4
+
+
+def _chain_lags(chain: dict) -> dict[str, float]:
+    """Each acquisition path's lag at low frequency in a drawn chain [s] (its filter's and its delay)."""
+    out = {}
+    for path, stem in (("wheel sensors", "toe"), ("pad sensors", "pad_fz")):
+        e = chain.get(stem, {})
+        cutoff = e.get("low_pass_hz", 0.0)
+        out[path] = 1e-3 * e.get("delay_ms", 0.0) + (math.sqrt(2.0) / (2.0 * math.pi * cutoff) if cutoff else 0.0)
+    return out
+
+
+def _chain_reading(chain: dict, reading: dict) -> float:
+    """A drawn chain's value of a transducer error the diagnosis reports (a gain; a cross-talk's
+    coefficient), from the channel's own entry over its quantity's."""
+    entry = {**chain.get(reading["channel"].rsplit("_", 1)[0], {}), **chain.get(reading["channel"], {})}
+    if reading["kind"] == "cross-talk":
+        return entry.get("crosstalk", {}).get(reading["source"], 0.0)
+    return entry.get("gain", 0.0)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("cause, elements", [("none", (e,)) for e in DRAWN] + [("none", DRAWN)]
+                         + [(c, DRAWN) for c in KC_CAUSES])
+def test_success_rate_through_a_rigs_acquisition(tmp_path, record_property, cause, elements):
+    """Measured through a typical rig's chain drawn from the seed, on a rig of its own mechanics drawn
+    too (each element alone on clean cars, all of them; all of them with each cause): a clean car
+    never given a car cause, a cause named as without the chain (check), each path's lag and each
+    moved input's transducer gain recovered within 3 of its standard uncertainties (and
+    LAG_TOLERANCE_S, 0.1 %), each element of the rig's mechanics within 3 and a tenth of its value (issue 53)."""
+    def attempt(case: Path, seed: int) -> str:
+        rng = np.random.default_rng([seed, 53])
+        chain = draw_chain(rng, "typical", WHITE, elements)
+        h = None if cause == "none" else draw(cause, rng)
+        rig = draw_rig(rng, "typical", elements)
+        result = diagnose_fresh(measure_truth(case, [h] if h else [], seed, duration_scale=0.25, chain=chain,
+                                              rig=rig))
+        for a in result["acquisition"]:
+            truth = _chain_lags(chain)[a["path"]]
+            assert abs(1e-3 * a["lag_ms"] - truth) <= 3e-3 * a["delay_std_ms"] + LAG_TOLERANCE_S, (a, truth)
+        for g in result["transducers"]:
+            truth = _chain_reading(chain, g)
+            assert abs(g["value"] - truth) <= 3.0 * g["std"] + 1e-3, (g, truth)
+        for g in result["rig"]:   # the diagnosis's pads have no compliance: a tenth of the value besides
+            truth = rig.get(g["element"], 0.0)
+            assert abs(g["value"] - truth) <= 3.0 * g["std"] + 0.1 * truth + BY_KEY[g["element"]].floor, (g, truth)
+        return check(result, h)
+
+    assert_success_rate(f"{cause} through {'+'.join(elements)}", SLOW_SEEDS, tmp_path, attempt, record_property,
+                        OWN_FORM_SUCCESS_RATE)
+
+
+@pytest.mark.slow
+def test_a_damaged_dataset_used_as_it_is_still_names_its_cause(tmp_path):
+    """The shipped dataset (a rear coupling of 70 N/mm, data/README.md) with a chunk of its roll
+    recording failing its CRC (8.6 s of the roll test missing), diagnosed with --use-damaged: the
+    same cause at its place, the stiffness within two of its standard deviations, the damage in the
+    report."""
+    folder = damaged_kc_dataset(tmp_path)
+    with pytest.warns(DamagedRecording):
+        data = read_kc_dataset(folder, use_damaged=True)
+    result = diagnose_kc(data, load_vehicle(DEFAULT_VEHICLE), executor=SerialExecutor())
+    out = summary(result)
+    assert out["cause"] == "coupling" and out["location"]["bushing"] == "e1_rear"
+    stiffness = out["parameters"]["stiffness"]
+    assert abs(stiffness["value"] - 70.0) <= 2 * stiffness["std"]
+    assert out["damage"] == [f"02_kc_roll.mcap: {data.tests[1].run.reason}"]
+    write_report(result, load_vehicle(DEFAULT_VEHICLE), tmp_path / "report", str(folder))
+    assert "**Diagnosed on a damaged dataset**" in (tmp_path / "report" / "report.md").read_text()
+
+
 def test_a_rig_error_a_car_cause_would_explain_as_well_is_said_with_it():
     """A channel reading 3 % high (its transducer's gain) where one hypothesis's effect is that very
     scaling and another's moves the other channel too: the gain is taken out, and the first is said to
