@@ -373,16 +373,24 @@ def _side_bounds(second: Parameter, first_value: float) -> tuple[float, float]:
     return lo, hi
 
 
-def scaled_magnitude(p: Parameter, at: float, coef: float, sd: float) -> tuple[float, float, float]:
-    """A first parameter's value when its effect at ``at`` is scaled by ``coef`` (standard deviation
-    ``sd``), kept within its bounds and on its side: the value, its uncertainty, and the scale of the
-    effect it gives."""
+def value_bounds(p: Parameter, at: float) -> tuple[float, float]:
+    """The values a fit may move a first parameter to from ``at``: its bounds, not below none for
+    one not signed, on ``at``'s side for a sided one."""
     x0 = p.effect(at)
     lo, hi = p.bounds
     if not p.signed or (p.sided and x0 > 0.0):
         lo = max(lo, 0.0)
     if p.sided and x0 < 0.0:
         hi = min(hi, 0.0)
+    return lo, hi
+
+
+def scaled_magnitude(p: Parameter, at: float, coef: float, sd: float) -> tuple[float, float, float]:
+    """A first parameter's value when its effect at ``at`` is scaled by ``coef`` (standard deviation
+    ``sd``), kept within its bounds and on its side: the value, its uncertainty, and the scale of the
+    effect it gives."""
+    x0 = p.effect(at)
+    lo, hi = value_bounds(p, at)
     # clipped before from_effect: a hypothesis with almost no effect gets a huge coefficient (a factor's exp overflowed)
     value = float(np.clip(p.from_effect(min(coef * x0, p.effect(hi))), lo, hi))
     scale = p.effect(value) / x0 if x0 != 0.0 else 0.0   # at no effect (clipped to it): none from here

@@ -25,7 +25,7 @@ from typing import Sequence
 import numpy as np
 
 from elastokin.diagnosis.kc_catalogue import Hypothesis, parameters
-from elastokin.diagnosis.kc_fits import Scorer, scaled_magnitude
+from elastokin.diagnosis.kc_fits import Scorer, scaled_magnitude, value_bounds
 from elastokin.diagnosis.kc_rig_mechanics import BY_KEY, RIG
 from elastokin.diagnosis.kc_transducers import CROSS, GAIN, INPUT_GAIN, Key, Reading, bounded_solve
 from elastokin.diagnosis.verdict import decide, told_apart
@@ -98,20 +98,30 @@ def rig_or_car(scorer: Scorer, model: np.ndarray, readings: Sequence[Reading],
                     continue
                 d = m - scorer.raw(model + (rows - base), train)
                 effects.append((h, columns.products(d), float(np.sum(d * d)), float(np.sum(d * m))))
-        tried = []
+        tried = {}   # the best of each place (a cause screened on both signs is fitted from each)
         for h, products, dd, dm in effects:
             if dd == 0.0:
                 continue
             matrix = np.block([[gram, products[:, None]], [products[None, :], np.array([[dd]])]])
             both = np.append(seen, dm)
-            coef = bounded_solve(matrix, both, np.vstack([held, [-np.inf, np.inf]]))
-            tried.append((error(coef, matrix, both), h, coef[-1]))
-        rivals = sorted((t for t in tried if decide(error_held, t[0], 1.0) == "named"
+            coef = bounded_solve(matrix, both, np.vstack([held, _scales(h)]))
+            e = error(coef, matrix, both)
+            if e < tried.get((h.cause, h.location), (math.inf,))[0]:
+                tried[(h.cause, h.location)] = (e, h, coef[-1])
+        rivals = sorted((t for t in tried.values() if decide(error_held, t[0], 1.0) == "named"
                          and not told_apart(t[0], fitted, 1.0)), key=lambda t: t[0])[:RIVALS]
         if rivals:
             out.append(RigOrCar(what, tuple(shown), tuple(_scaled(h, k) for _, h, k in rivals), remedy, error_held,
                                 tuple(e for e, _, _ in rivals), fitted))
     return out
+
+
+def _scales(h: Hypothesis) -> tuple[float, float]:
+    """The scales of ``h``'s effect its first parameter's bounds allow (:func:`value_bounds`)."""
+    first = parameters(h.cause)[0]
+    x0 = first.effect(h.values[first.name])
+    lo, hi = sorted(first.effect(v) / x0 for v in value_bounds(first, h.values[first.name])) if x0 else (0.0, 0.0)
+    return lo, hi
 
 
 def _scaled(h: Hypothesis, scale: float) -> Hypothesis:
