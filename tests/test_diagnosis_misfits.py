@@ -13,7 +13,7 @@ import pytest
 from elastokin.vehicle.scenarios.scenario import Scenario
 from elastokin.diagnosis.kc_diagnosis import located_misfits
 from elastokin.diagnosis.kc_layout import Job, Layout, Test
-from elastokin.diagnosis.kc_fits import Scorer
+from elastokin.diagnosis.kc_scorer import Scorer
 from scipy.special import gammaincc
 
 from elastokin.diagnosis.verdict import (MIN_GAIN, MISFIT_CHANCE, alike, decide, explained, misfit, misfit_stretch,

@@ -10,7 +10,7 @@ import math
 import numpy as np
 import pytest
 
-from elastokin.diagnosis.kc_fits import Scorer
+from elastokin.diagnosis.kc_scorer import Scorer
 from elastokin.diagnosis.kc_lags import Response, paths
 from elastokin.diagnosis import kc_layout
 
@@ -142,3 +142,33 @@ def test_a_fits_uncertainty_holds_for_coloured_noise():
     scatter = float(np.std(fitted))
     assert np.median(claimed) == pytest.approx(scatter, rel=0.25)
     assert 1.0 / math.sqrt(float(np.sum(column * column))) < scatter / 5.0
+
+
+def test_a_slow_coloured_noise_is_counted_whole_and_in_the_uncertainties():
+    """AR(1) noise of twice the white noise correlated over 4 s, longer than the shorter tests'
+    period (differences a period apart tell its drift rate, not its correlation time): the noise the
+    scorer counts is what a recording's zero leaves of it (√(1 + 4 × 0.59), within 20 %), so the perfect
+    model's error is the noise, no stretch of it a misfit; an effect proportional to the input fitted
+    on such noise gets an uncertainty of its scatter over 100 draws (within 30 %)."""
+    from elastokin.diagnosis.kc_diagnosis import located_misfits
+    tau = 4.0
+    chains = {c: ChannelChain(ar1_sigma=2.0 * NOISE[c], ar1_time_constant_s=tau) for c in range(len(CHANNELS))}
+    layout, true = _layout(chains, 5)
+    scorer = Scorer(layout, true, np.array([False, True, False, True]))
+    assert np.median(scorer.noise / NOISE) == pytest.approx(math.sqrt(1.0 + 4.0 * 0.59), rel=0.2)
+    assert scorer.heldout_error(true) == pytest.approx(1.0, abs=0.15)
+    assert located_misfits(layout, scorer, true) == []
+    every = np.ones(len(true), dtype=bool)
+    column = true / scorer.noise
+    rng = np.random.default_rng(6)
+    fitted, claimed = [], []
+    for _ in range(100):
+        noise = np.vstack([np.column_stack([ChannelChain(ar1_sigma=2.0 * NOISE[c], ar1_time_constant_s=tau).apply(
+            layout.input_time[t.rows], np.zeros(len(t.rows)), rng) + rng.normal(0.0, NOISE[c], len(t.rows))
+            for c in range(len(CHANNELS))]) for t in layout.tests]) / scorer.noise
+        for t in layout.tests:   # each recording's zero out, as the scorer's residuals have it
+            noise[t.rows] -= noise[t.rows].mean(axis=0)
+        coef = float(np.sum(column * noise) / np.sum(column * column))
+        fitted.append(coef)
+        claimed.append(math.sqrt(scorer.variances(noise - coef * column, [column], every)[0]))
+    assert np.median(claimed) == pytest.approx(float(np.std(fitted)), rel=0.3)

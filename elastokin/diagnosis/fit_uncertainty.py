@@ -14,24 +14,27 @@ from __future__ import annotations
 import numpy as np
 
 
-def standard_errors(J: np.ndarray, r: np.ndarray, groups: np.ndarray, dof: int) -> np.ndarray:
+def standard_errors(J: np.ndarray, r: np.ndarray, groups: np.ndarray, dof: int,
+                    noise: np.ndarray | None = None) -> np.ndarray:
     """Standard uncertainties (p,) of the parameters of a least-squares fit at its optimum: J (n, p)
     the residuals' Jacobian, r (n,) the residuals, ``groups`` (n,) the independent unit (test) each
     residual belongs to, ``dof`` the fit's degrees of freedom: :func:`clustered_errors` of JᵀJ and
-    each unit's scores."""
+    each unit's scores (and ``noise``, JᵀΣJ for a model of the noise, if given)."""
     units = np.unique(groups)
-    return clustered_errors(J.T @ J, np.array([J[groups == g].T @ r[groups == g] for g in units]), r, dof)
+    return clustered_errors(J.T @ J, np.array([J[groups == g].T @ r[groups == g] for g in units]), r, dof, noise)
 
 
-def clustered_errors(gram: np.ndarray, scores: np.ndarray, r: np.ndarray, dof: int) -> np.ndarray:
+def clustered_errors(gram: np.ndarray, scores: np.ndarray, r: np.ndarray, dof: int,
+                     noise: np.ndarray | None = None) -> np.ndarray:
     """Standard uncertainties (p,) of the parameters of a least-squares fit at its optimum, from the
     Jacobian's Gram matrix JᵀJ (p, p), each independent unit's scores J_gᵀ r_g (G, p), the residuals
-    r (n,) in the order their correlation runs and ``dof`` the fit's degrees of freedom. The larger of
+    r (n,) in the order their correlation runs and ``dof`` the fit's degrees of freedom. The largest of
     the linearised error (its residual variance inflated for the residuals' sample-to-sample
-    correlation ρ: n samples are worth n(1 − ρ)/(1 + ρ)) and the cluster-robust one (module
-    docstring). A parameter the residuals do not depend on (a null column of J) has an unbounded
-    uncertainty, the others taken from the rest of J; all are unbounded when the rest cannot be
-    inverted."""
+    correlation ρ: n samples are worth n(1 − ρ)/(1 + ρ)), the cluster-robust one (module
+    docstring) and, given ``noise`` = JᵀΣJ (p, p) for a model Σ of the noise's covariance, the error
+    that noise gives (JᵀJ)⁻¹JᵀΣJ(JᵀJ)⁻¹ (a slow noise, which one ρ of all the residuals undercounts).
+    A parameter the residuals do not depend on (a null column of J) has an unbounded uncertainty, the
+    others taken from the rest of J; all are unbounded when the rest cannot be inverted."""
     rho = float(np.clip(np.dot(r[1:], r[:-1]) / max(np.dot(r, r), 1e-300), 0.0, 0.999))
     s2 = float(np.dot(r, r)) / max(dof, 1) * (1.0 + rho) / (1.0 - rho)
     norms = np.sqrt(np.clip(np.diag(gram), 0.0, None))
@@ -47,5 +50,6 @@ def clustered_errors(gram: np.ndarray, scores: np.ndarray, r: np.ndarray, dof: i
     scores = scores - scores.mean(axis=0)
     factor = len(scores) / (len(scores) - 1) if len(scores) > 1 else 1.0
     robust = np.diag(bread @ (scores.T @ scores) @ bread) * factor
-    std[seen] = np.sqrt(np.clip(np.maximum(np.diag(bread) * s2, robust), 0.0, None))
+    modelled = np.diag(bread @ noise[np.ix_(seen, seen)] @ bread) if noise is not None else 0.0
+    std[seen] = np.sqrt(np.clip(np.maximum(np.maximum(np.diag(bread) * s2, robust), modelled), 0.0, None))
     return std

@@ -1,4 +1,4 @@
-"""The nuisance columns a K&C diagnosis fits with every prediction (:class:`elastokin.diagnosis.kc_fits.Scorer`),
+"""The nuisance columns a K&C diagnosis fits with every prediction (:class:`elastokin.diagnosis.kc_scorer.Scorer`),
 over the compared rows (samples × channels). Most of them act on one channel alone (a transducer's
 gain, a cross-talk): those are held as that channel's samples, not as a (samples × channels) array
 of zeros around them, so that the columns' products with a residual, their Gram matrix and their
@@ -36,6 +36,14 @@ class Columns:
 
     def __len__(self) -> int:
         return len(self.one)
+
+    def extended(self, dense: Sequence[np.ndarray]) -> "Columns":
+        """These columns and the ``dense`` ones (each (n, C)) after them."""
+        out = Columns([], self.shape)
+        out.one = np.concatenate([self.one, np.zeros(len(dense), dtype=bool)])
+        out.dense = np.concatenate([self.dense, np.reshape(dense, (-1, *self.shape))])
+        out.single, out.channel = self.single, self.channel
+        return out
 
     def _flat(self) -> np.ndarray:
         """(Kd, n·C) the dense columns, each raveled as a residual is."""

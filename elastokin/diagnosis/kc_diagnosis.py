@@ -61,13 +61,14 @@ from elastokin.diagnosis.catalogue import PAIR_SEPARATOR
 from elastokin.diagnosis.kc_alike import alike, extra_scenarios, run_unless_diverged, separations
 from elastokin.diagnosis.kc_catalogue import (BUSHING_CAUSES, VEHICLE_CAUSES, Hypothesis, extended_vehicle, locations,
                                          parameters)
-from elastokin.diagnosis.kc_fits import (Candidate, Scorer, fit, fit_pair, halfway, kept, nominal, nudged, significant,
+from elastokin.diagnosis.kc_fits import (Candidate, fit, fit_pair, halfway, kept, nominal, nudged, significant,
                                     verify)
 from elastokin.diagnosis.kc_transducers import INPUT_GAIN, STEP, Reading, input_column, moved, reading_columns, stepped
 from elastokin.diagnosis.kc_lags import PathResponse
 from elastokin.diagnosis.kc_rig_mechanics import ELEMENTS, RIG, element_column, element_jobs
 from elastokin.diagnosis.kc_rig_or_car import RigOrCar, rig_or_car
 from elastokin.diagnosis.kc_noise import NoiseModel, coloured_noise
+from elastokin.diagnosis.kc_scorer import Scorer
 from elastokin.diagnosis.kc_layout import Job, Layout, run_job
 from elastokin.diagnosis.verdict import (Outcome, Separation, decide, explained, misfit, misfit_stretch, pair_named,
                                     pair_shares, second_cause_wanted, single_verdict, split)
@@ -314,7 +315,7 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, executor: Execut
     out.responses = scorer.responses(out.final.simulated if out.named else base)
     out.noise_model = scorer.noise_model
     model = out.final.simulated if out.named else base
-    out.transducers = scorer.transducers(model)
+    out.transducers = scorer.transducers(model, _effects(out, base))
     for g in out.transducers:
         if g.said:
             say(f"{g.label}: {g.text} (taken out)")
@@ -372,6 +373,16 @@ def _slopes(top: list[Candidate], run_moved: Callable[[list[Hypothesis]], list[n
     moves = [nudged(c.hypothesis) if len(parameters(c.hypothesis.cause)) > 1 else None for c in top]
     moved = iter(run_moved([m[0] for m in moves if m]) if any(moves) else [])
     return [None if m is None else (next(moved) - c.simulated) / m[1] for c, m in zip(top, moves)]
+
+
+def _effects(d: KCDiagnosis, base: np.ndarray) -> list[np.ndarray]:
+    """The named causes' effects on the compared rows (N, C): the first's run less the baseline's, a
+    second's the pair's run less the first's."""
+    if not d.named:
+        return []
+    if d.second is None:
+        return [d.best.simulated - base]
+    return [d.best.simulated - base, d.second.simulated - d.best.simulated]
 
 
 def _alone(h: Hypothesis, ranking: list[Candidate]) -> Candidate:

@@ -1,24 +1,18 @@
-"""Scoring and fitting hypotheses on a K&C campaign's compared rows (:mod:`elastokin.diagnosis.kc_diagnosis`):
-residuals in units of the measured noise, each recording's zero errors removed; a hypothesis's
-magnitude fitted with its effect taken proportional to it from a vehicle run (one cause, a second
-parameter along one more run, or two causes together); candidates verified by full runs."""
+"""Fitting hypotheses on a K&C campaign's compared rows (:mod:`elastokin.diagnosis.kc_diagnosis`),
+scored by :class:`elastokin.diagnosis.kc_scorer.Scorer`: a hypothesis's magnitude fitted with its
+effect taken proportional to it from a vehicle run (one cause, a second parameter along one more
+run, or two causes together); candidates verified by full runs."""
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
-from typing import Callable, Mapping
 
 import numpy as np
 
 from elastokin.diagnosis.catalogue import Parameter
-from elastokin.diagnosis.fit_uncertainty import clustered_errors, standard_errors
 from elastokin.diagnosis.kc_catalogue import Hypothesis, parameters
-from elastokin.diagnosis.kc_columns import Columns, OneChannel
-from elastokin.diagnosis.kc_lags import PathResponse, Response, fit_response, paths
-from elastokin.diagnosis.kc_transducers import Key, Reading, bounded_solve, bounds, reading
-from elastokin.diagnosis.kc_layout import Layout
-from elastokin.diagnosis.kc_noise import estimate_noise, white_noise
+from elastokin.diagnosis.kc_scorer import Scorer
 
 #: Relative increase of the held-out score per fitted parameter.
 PARAMETER_PENALTY = 0.02
@@ -57,189 +51,6 @@ class Candidate:
     def score(self) -> float:
         """Penalised held-out error (verified) or training error (screened only); lower is better."""
         return self.penalised(self.heldout_error if self.verified else self.screened_error)
-
-
-class Scorer:
-    """Residuals in units of the measurement noise (white and coloured, :mod:`elastokin.diagnosis.kc_noise`):
-    the prediction through each acquisition path's filter and delay (:mod:`elastokin.diagnosis.kc_lags`,
-    estimated on the baseline; what is left of them to first order fitted with every prediction),
-    each transducer's error fitted with every prediction (:mod:`elastokin.diagnosis.kc_transducers`),
-    each channel's zero error in each recording removed; errors per test."""
-
-    def __init__(self, layout: Layout, baseline: np.ndarray, heldout: np.ndarray,
-                 transducers: Mapping[Key, np.ndarray | OneChannel] | None = None):
-        """``transducers``: the rows' derivative (N, C) with respect to each transducer error fitted
-        with every prediction (:mod:`elastokin.diagnosis.kc_transducers`; one channel's alone for a
-        :class:`~elastokin.diagnosis.kc_columns.OneChannel`), as the rig's acquisition delivers it (here)."""
-        self.layout, self.heldout = layout, heldout
-        self.held_rows = heldout[layout.test]
-        self.paths = paths(layout.channels)
-        self.response = Response(layout, self.paths)
-        every = np.ones(len(baseline), dtype=bool)
-        self.noise = white_noise(layout, layout.measured - baseline)   # the fit's weights, until the noise's model
-        self.cutoffs_hz, self.delays_s = fit_response(self.response, layout.measured, baseline,
-                                                      lambda r: self._zeroed(r, every, np.mean))
-        delivered = self._delivered(baseline)
-        #: the measurement noise, white and coloured (:mod:`elastokin.diagnosis.kc_noise`)
-        self.noise_model = estimate_noise(layout, layout.measured - delivered)
-        self.noise = self.noise_model.sigma
-        self._rates, self._taps = self.response.rates(delivered), self.response.taps(delivered)
-        self._transducers = {k: self._delivered_column(c) for k, c in (transducers or {}).items()}
-        self._columns: dict[bytes, tuple[Columns, np.ndarray, np.ndarray]] = {}
-        #: the bounds of the transducers' coefficients (a rig input's gain, a rig's mechanics: held within them)
-        self._bounds = np.array([bounds(key) for key in self._transducers]).reshape(-1, 2)
-        #: the last residual: (the prediction, its rows and zero, the residual), read-only
-        self._last: tuple[np.ndarray, tuple, np.ndarray] | None = None
-
-    def _delivered(self, rows: np.ndarray) -> np.ndarray:
-        return self.response.apply(rows, self.cutoffs_hz, self.delays_s)
-
-    def _delivered_column(self, column: np.ndarray | OneChannel) -> np.ndarray | OneChannel:
-        """A column through the acquisition (linear in the rows, channel by channel)."""
-        if not isinstance(column, OneChannel):
-            return self._delivered(column)
-        rows = np.zeros(self.layout.measured.shape)
-        rows[:, column.channel] = column.values
-        return OneChannel(column.channel, self._delivered(rows)[:, column.channel])
-
-    def _zeroed(self, r: np.ndarray, rows: np.ndarray, zero: Callable[..., np.ndarray],
-                channel: int | None = None) -> np.ndarray:
-        """``r`` (the selected rows; of one ``channel`` alone if given) with each channel's ``zero`` in
-        each recording removed, in noise units."""
-        rec = self.layout.recording[rows]
-        for k in np.unique(rec):
-            r[rec == k] -= zero(r[rec == k], axis=0)
-        return r / (self.noise if channel is None else self.noise[channel])
-
-    def _nuisance(self, rows: np.ndarray) -> tuple[Columns, np.ndarray, np.ndarray]:
-        """On the selected rows, zeroed as the residual is: the columns fitted with every prediction
-        (each path's taps (:meth:`elastokin.diagnosis.kc_lags.Response.taps`) on its channels in the
-        tests of each sampling rate, then each transducer's), their Gram matrix and its
-        pseudo-inverse; cached per selection."""
-        key = rows.tobytes()
-        if key not in self._columns:
-            taps = [c[rows] for c in self._taps]
-            # a sample's shift is a time at each sampling rate: the taps of the tests at each rate apart
-            steps = np.round(np.array(self.response.steps), 9)[self.layout.test[rows]]
-            columns = []
-            for idx in self.paths.values():
-                for step in np.unique(steps):
-                    for tap in taps:
-                        own = np.zeros_like(tap)
-                        own[np.ix_(steps == step, idx)] = tap[np.ix_(steps == step, idx)]
-                        columns.append(self._zeroed(own, rows, np.mean))
-            columns += [OneChannel(c.channel, self._zeroed(c.values[rows], rows, np.mean, c.channel))
-                        if isinstance(c, OneChannel) else self._zeroed(c[rows], rows, np.mean)
-                        for c in self._transducers.values()]
-            stack = Columns(columns, (int(rows.sum()), len(self.layout.channels)))
-            gram = stack.gram()
-            self._columns[key] = (stack, gram, np.linalg.pinv(gram))
-        return self._columns[key]
-
-    def _fitted(self, r: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, Columns, np.ndarray]:
-        """The residual ``r`` on the selected rows with the nuisance columns fitted out, the columns
-        and their coefficients. A rig input's gain is held within ± :data:`~elastokin.diagnosis.kc_transducers.INPUT_GAIN_BOUND` (a
-        calibrated rig's), a rig's mechanics between none and a rig's most
-        (:mod:`elastokin.diagnosis.kc_rig_mechanics`): beyond, one is held at its bound and the other
-        columns refitted (:func:`~elastokin.diagnosis.kc_transducers.bounded_solve`), what is left being the car's."""
-        stack, gram, inverse = self._nuisance(rows)
-        if not len(stack):
-            return r, stack, np.zeros(0)
-        coef = bounded_solve(gram, stack.products(r), self._column_bounds(len(stack)), inverse)
-        return r - stack.combine(coef).reshape(r.shape), stack, coef
-
-    def _raw(self, predicted: np.ndarray, rows: np.ndarray, zero: Callable[..., np.ndarray] = np.mean) -> np.ndarray:
-        return self._zeroed(self.layout.measured[rows] - self._delivered(predicted)[rows], rows, zero)
-
-    def raw(self, predicted: np.ndarray, rows: np.ndarray) -> np.ndarray:
-        """(measured − predicted) / noise on the selected rows as :meth:`residual` has it before the
-        nuisances are fitted out (each recording's zeros, their means, removed)."""
-        return self._raw(predicted, rows)
-
-    def nuisances(self, rows: np.ndarray) -> tuple[Columns, np.ndarray, np.ndarray, list[Key | None]]:
-        """The nuisance columns on the selected rows as :meth:`residual` fits them out; their Gram
-        matrix (K, K); each one's bounds (K, 2); each one's key (None for the acquisition's taps)."""
-        stack, gram, _ = self._nuisance(rows)
-        return (stack, gram, self._column_bounds(len(stack)),
-                [None] * (len(stack) - len(self._transducers)) + list(self._transducers))
-
-    def _column_bounds(self, columns: int) -> np.ndarray:
-        """(columns, 2) the bounds of every nuisance coefficient: the acquisition's taps free, the
-        transducers' and the rig's as :func:`~elastokin.diagnosis.kc_transducers.bounds` says."""
-        return np.vstack([np.tile([-np.inf, np.inf], (columns - len(self._transducers), 1)), self._bounds])
-
-    def responses(self, predicted: np.ndarray) -> list[PathResponse]:
-        """Each acquisition path's response as fitted beside ``predicted`` (all rows): its filter,
-        and its delay with what ``predicted``'s residual still shows of it to first order, with the
-        standard uncertainty (the residual's own correlation along time counted)."""
-        every = np.ones(len(predicted), dtype=bool)
-        r = self._raw(predicted, every, np.mean)
-        rates = self._zeroed(self._rates.copy(), every, np.mean)
-        out = []
-        for (name, idx), cutoff, delay in zip(self.paths.items(), self.cutoffs_hz, self.delays_s):
-            d = rates[:, idx]
-            dd = float(np.sum(d * d))
-            a = float(np.sum(d * r[:, idx])) / dd if dd > 0.0 else 0.0
-            std = math.sqrt(self.variances(r[:, idx] - a * d, [d], every)[0])
-            out.append(PathResponse(name, tuple(self.layout.channels[i] for i in idx), float(cutoff),
-                                    float(delay - a), std))
-        return out
-
-    def transducers(self, predicted: np.ndarray) -> list[Reading]:
-        """Each transducer error fitted beside ``predicted`` (all rows), with its standard
-        uncertainty (fitted with the acquisition's taps; the residual's correlation counted)."""
-        if not self._transducers:
-            return []
-        every = np.ones(len(predicted), dtype=bool)
-        left, stack, coef = self._fitted(self._raw(predicted, every, np.mean), every)
-        first = len(stack) - len(self._transducers)
-        std = np.sqrt(self.variances(left, stack, every))[first:]
-        return [reading(key, float(coef[first + k]), float(s)) for k, (key, s) in enumerate(zip(self._transducers, std))]
-
-    def variances(self, residual: np.ndarray, columns: list[np.ndarray] | Columns, rows: np.ndarray) -> np.ndarray:
-        """The variances of the coefficients of ``columns`` fitted to leave ``residual`` on the selected
-        ``rows`` (each (rows, channels) over the same channels, or raveled from them row by row; or
-        the nuisances' :class:`~elastokin.diagnosis.kc_columns.Columns`):
-        :func:`elastokin.diagnosis.fit_uncertainty.clustered_errors` with the tests as the independent
-        units, the samples' correlation taken along time, channel by channel (coloured noise, a smooth
-        model error)."""
-        tests = self.layout.test[rows]
-        along = lambda x: x.reshape(len(tests), -1).T.ravel()   # channel after channel, time running
-        dof = residual.size - len(columns)
-        if isinstance(columns, Columns):
-            r = residual.reshape(len(tests), -1)
-            scores = np.array([columns.products(np.where((tests == g)[:, None], r, 0.0)) for g in np.unique(tests)])
-            return clustered_errors(columns.gram(), scores, along(residual), dof) ** 2
-        width = residual.size // len(tests)
-        jacobian = np.column_stack([along(c) for c in columns])
-        return standard_errors(jacobian, along(residual), np.tile(tests, width), dof) ** 2
-
-    def residual(self, predicted: np.ndarray, rows: np.ndarray, zero: Callable[..., np.ndarray] = np.mean
-                 ) -> np.ndarray:
-        """(measured − predicted) / noise on the selected rows (a boolean mask): the prediction late
-        by each path's lag, each channel's ``zero`` over the selected rows of each recording removed
-        (its zero error: the mean, in which the residual stays affine in the prediction (the fits),
-        or the median, which a misfit confined to a stretch does not move for the rest of its
-        recording (the misfits' search)), and what is left of each path's response to first order
-        (its taps) and each transducer's error projected out: fitted with whatever the prediction is."""
-        key = (rows.tobytes(), zero)
-        last = self._last
-        if last is not None and last[0] is predicted and last[1] == key:   # the fits' mismatch: the same base
-            return last[2]
-        r, _, _ = self._fitted(self._raw(predicted, rows, zero), rows)
-        r.flags.writeable = False   # handed out again for the same prediction
-        self._last = (predicted, key, r)
-        return r
-
-    def test_errors(self, predicted: np.ndarray) -> np.ndarray:
-        """Per test, the RMS residual (1 = the noise)."""
-        r2 = (self.residual(predicted, np.ones(len(predicted), dtype=bool)) ** 2).mean(axis=1)
-        return np.array([math.sqrt(r2[t.rows].mean()) for t in self.layout.tests])
-
-    def heldout_error(self, predicted: np.ndarray) -> float:
-        """The RMS residual on the held-out tests (1 = the noise)."""
-        r = self.residual(predicted, np.ones(len(predicted), dtype=bool))[self.held_rows]
-        return float(math.sqrt(np.mean(r ** 2)))
 
 
 def nominal(cause: str) -> dict[str, float]:

@@ -27,6 +27,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy import signal as sps
 from scipy.optimize import nnls
 
 from elastokin.diagnosis.kc_layout import Layout
@@ -40,6 +41,9 @@ COLOURED_SAID = 0.3
 CLIP = 4.0
 #: Correlation times [s] tried for the coloured noise.
 CORRELATION_TIMES_S = np.geomspace(0.02, 60.0, 48)
+#: How much worse (relative, in the variogram fit's residual norm) a correlation time may fit than the
+#: best and still be taken (:func:`_coloured`).
+FIT_TOLERANCE = 0.1
 
 
 @dataclass(frozen=True)
@@ -57,6 +61,24 @@ class NoiseModel:
     def sigma(self) -> np.ndarray:
         """(C,) the whole noise's standard deviation [channel unit]."""
         return np.sqrt(self.white ** 2 + self.coloured ** 2)
+
+    def covariance_product(self, columns: np.ndarray, channel: int, segments: list[tuple[int, int, float]]
+                           ) -> np.ndarray:
+        """JᵀΣJ (K, K) for ``columns`` (K, n) on ``channel`` in units of its noise (:attr:`sigma`), Σ
+        its noise's covariance: white, plus the coloured noise's first-order autoregression within
+        each of ``segments`` (first, end, sampling interval [s]: a test's rows, uncorrelated with
+        the next test's)."""
+        sigma = max(float(self.sigma[channel]), 1e-300)
+        weighted = (self.white[channel] / sigma) ** 2 * columns
+        share, tau = (self.coloured[channel] / sigma) ** 2, float(self.correlation_time_s[channel])
+        if share > 0.0 and tau > 0.0:
+            for first, end, dt in segments:
+                seg = columns[:, first:end]
+                phi = math.exp(-dt / tau)
+                ahead = sps.lfilter([1.0], [1.0, -phi], seg, axis=1)
+                behind = sps.lfilter([1.0], [1.0, -phi], seg[:, ::-1], axis=1)[:, ::-1]
+                weighted[:, first:end] += share * (ahead + behind - seg)   # Σ_j φ^|i−j| c_j
+        return columns @ weighted.T
 
     def window_dof(self, width: int, dt_s: float) -> np.ndarray:
         """(C,) the degrees of freedom of the mean square of ``width`` successive samples ``dt_s`` [s]
@@ -139,7 +161,7 @@ def estimate_noise(layout: Layout, residual: np.ndarray) -> NoiseModel:
     differences = []
     for f in dict.fromkeys(family):
         idx = np.flatnonzero(family == f)
-        share, t, kept = _coloured(layout, residual[:, idx] / white[idx])
+        share, t, kept = _coloured(layout, residual[:, idx] / white[idx], span)
         coloured[idx], tau[idx] = white[idx] * math.sqrt(share * _left_by_the_zero(t, span)), t
         differences += [(dt, idx, d) for dt, d in kept]
     return NoiseModel(white, coloured, tau, tuple(differences))
@@ -155,12 +177,18 @@ def _left_by_the_zero(tau_s: float, span_s: float) -> float:
     return max(0.0, 1.0 - 2.0 * x * (1.0 - x * (1.0 - math.exp(-1.0 / x))))
 
 
-def _coloured(layout: Layout, residual: np.ndarray) -> tuple[float, float, list[tuple[float, np.ndarray]]]:
+def _coloured(layout: Layout, residual: np.ndarray, span_s: float
+              ) -> tuple[float, float, list[tuple[float, np.ndarray]]]:
     """The coloured noise's variance (in units of the white noise's, which ``residual`` is in) and its
     correlation time [s] from the period differences of the repeated tests: their variogram
     v(m) = ½ E[(d(t + m) − d(t))²] = c(0) − c(m), which no zero or drift of a recording biases, fitted
     for the noise's model (module docstring), (0, 0) where none repeats or none is found; and the
-    differences (their sampling interval [s], the differences clipped)."""
+    differences (their sampling interval [s], the differences clipped). A slow noise (correlated over
+    a period or more) shows in differences a period apart as a drift whose rate alone they tell, not
+    its correlation time: of the correlation times that fit the variogram within
+    :data:`FIT_TOLERANCE` of the best, the one that leaves the most of the noise over a recording
+    of ``span_s`` [s] once its zero is out (:func:`_left_by_the_zero`), which counts it the fewest
+    degrees of freedom: the noise is not under-estimated, nor a slow wander taken for a misfit."""
     rows, design, kept = [], [], []
     for t in layout.tests:
         if t.period <= 0:
@@ -180,7 +208,7 @@ def _coloured(layout: Layout, residual: np.ndarray) -> tuple[float, float, list[
     if not rows:
         return 0.0, 0.0, kept
     target = np.concatenate(rows)
-    best = (math.inf, 0.0, 0.0)
+    fits = []
     for tau in CORRELATION_TIMES_S:
         columns = []
         for m, period, dt in design:
@@ -188,7 +216,8 @@ def _coloured(layout: Layout, residual: np.ndarray) -> tuple[float, float, list[
             c = lambda k: 2.0 * phi ** k - phi ** (period + k) - phi ** np.abs(period - k)
             columns.append(np.column_stack([np.full(len(m), 2.0), c(0) - c(m)]))
         (_, a), norm = nnls(np.vstack(columns), target)
-        if norm < best[0]:
-            best = (norm, a, tau)
-    _, share, tau = best
-    return (share, float(tau), kept) if share > 0.0 else (0.0, 0.0, kept)
+        fits.append((norm, a, float(tau)))
+    best = min(norm for norm, _, _ in fits)
+    _, share, tau = max((f for f in fits if f[0] <= (1.0 + FIT_TOLERANCE) * best),
+                        key=lambda f: (f[1] * _left_by_the_zero(f[2], span_s), f[2]))
+    return (share, tau, kept) if share > 0.0 else (0.0, 0.0, kept)

@@ -11,9 +11,9 @@ the two it was, and the verdict must say so. For each group of rig errors the da
 its stead on the training tests (its effect from its screening run, the other nuisances refitted
 with it, all in the nuisances' span: no run). A hypothesis that explains what the group explained
 as a cause must (:func:`elastokin.diagnosis.verdict.decide` against the model with the group held)
-and that the group does not beat as a cause must beat its rival
-(:func:`elastokin.diagnosis.verdict.told_apart`) is reported beside the group with the check that
-separates them.
+and that the group does not beat as a cause must beat its rival, nor beats it
+(:func:`elastokin.diagnosis.verdict.told_apart`: one that explains more than the group did is a cause
+missed, not the group's rival) is reported beside the group with the check that separates them.
 """
 
 from __future__ import annotations
@@ -25,7 +25,8 @@ from typing import Sequence
 import numpy as np
 
 from elastokin.diagnosis.kc_catalogue import Hypothesis, parameters
-from elastokin.diagnosis.kc_fits import Scorer, scaled_magnitude, value_bounds
+from elastokin.diagnosis.kc_fits import scaled_magnitude, value_bounds
+from elastokin.diagnosis.kc_scorer import Scorer
 from elastokin.diagnosis.kc_rig_mechanics import BY_KEY, RIG
 from elastokin.diagnosis.kc_transducers import CROSS, GAIN, INPUT_GAIN, Key, Reading, bounded_solve
 from elastokin.diagnosis.verdict import decide, told_apart
@@ -109,7 +110,8 @@ def rig_or_car(scorer: Scorer, model: np.ndarray, readings: Sequence[Reading],
             if e < tried.get((h.cause, h.location), (math.inf,))[0]:
                 tried[(h.cause, h.location)] = (e, h, coef[-1])
         rivals = sorted((t for t in tried.values() if decide(error_held, t[0], 1.0) == "named"
-                         and not told_apart(t[0], fitted, 1.0)), key=lambda t: t[0])[:RIVALS]
+                         and not told_apart(t[0], fitted, 1.0) and not told_apart(fitted, t[0], 1.0)),
+                        key=lambda t: t[0])[:RIVALS]
         if rivals:
             out.append(RigOrCar(what, tuple(shown), tuple(_scaled(h, k) for _, h, k in rivals), remedy, error_held,
                                 tuple(e for e, _, _ in rivals), fitted))

@@ -15,7 +15,7 @@ A moved input's comes from a baseline run of the tests it moves in with its comm
 :data:`STEP`) (first order, the car's own nonlinearity in it); a channel's gain is its own
 prediction; a cross-talk is the other quantity (the prediction, or the rig's command for an input)
 placed in the channel. The columns are projected out of every residual with the acquisition's
-(:class:`elastokin.diagnosis.kc_fits.Scorer`), so that each cause is fitted jointly with them, each
+(:class:`elastokin.diagnosis.kc_scorer.Scorer`), so that each cause is fitted jointly with them, each
 within its :func:`bounds` (:func:`bounded_solve`), and what the data tell of each is reported. A
 gain is common to every test of its channel while a car's cause acts on each test its own way, so
 the campaign tells most causes from the gains; one that acts as a gain does (every response of a
@@ -44,7 +44,9 @@ CROSSTALK = {"toe": "camber", "pad_fz": "pad_fy"}
 SAID_STD, SAID_SHARE = 3.0, 0.002
 INPUT_GAIN, GAIN, CROSS = "input gain", "gain", "cross-talk"
 #: The largest rig input's gain fitted (its command's scale): a rig's calibration is good to ±0.5–2 %
-#: (issue 53); what a larger one would take (a test's whole response scaled) is left to the car's causes.
+#: (issue 53); what a larger one would take (a test's whole response scaled) is left to the car's
+#: causes. A measured channel's gain and cross-talk are not bounded: a car's cause is fitted with them
+#: (a bound reached by one fit and not by the next would take a share of the cause's effect).
 INPUT_GAIN_BOUND = 0.025
 
 
