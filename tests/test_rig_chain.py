@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 from elastokin.core.shipped import DEFAULT_VEHICLE
-from elastokin.diagnosis.rig_chain import CROSSTALK, DRAWN, GRADES, GROUPS, ChannelChain, draw_chain, parse_chain, servoed
+from elastokin.diagnosis.rig_chain import (CROSSTALK, DRAWN, GRADES, GROUPS, RIG_DRAWN, ChannelChain, draw_chain,
+                                          draw_rig, parse_chain, servoed)
 from elastokin.diagnosis.virtual_kc_rig import MEASUREMENT_DEFAULTS, measure_kc, parse_kc_truth, sensor
 from elastokin.recordings.kc_dataset import read_kc_dataset
 from elastokin.recordings.recorder import simulate
@@ -192,3 +193,19 @@ def test_a_servoed_inputs_gain_gives_the_car_the_command_over_one_plus_it(tmp_pa
     travel = commanded.signals["wheel_travel_fl"]
     # the car saw the pad's travel / 1.02: so, nearly, does its wheel (the tyre's and the rest's share alike)
     assert np.abs(run.signals["wheel_travel_fl"]).max() == pytest.approx(np.abs(travel).max() / 1.02, rel=3e-3)
+
+
+@pytest.mark.parametrize("grade", GRADES)
+def test_drawn_rigs_sit_in_their_grades_ranges_and_parse_as_a_truths(grade):
+    """Each element of the rig's mechanics drawn alone and together within its grade's range, the
+    others ideal, from the seed alone, read as a truth's ``rig``; an element not known refused."""
+    ranges = GRADES[grade]["rig"]
+    for elements in [(e,) for e in RIG_DRAWN] + [DRAWN, ("delay", "gain")]:
+        draw = draw_rig(np.random.default_rng(3), grade, elements)
+        assert draw == draw_rig(np.random.default_rng(3), grade, elements)
+        drawn = {key for e in elements if e in RIG_DRAWN for key in RIG_DRAWN[e]}
+        assert set(draw) == drawn and all(_within(draw[k], ranges[k]) for k in drawn)
+        rig = parse_kc_truth({"level": "kc", "rig": draw}, "drawn.yaml").rig
+        assert rig.ideal == (not drawn)
+    with pytest.raises(ValueError, match="unknown chain element 'clamps'"):
+        draw_rig(np.random.default_rng(3), grade, ("clamps",))

@@ -21,7 +21,6 @@ class OneChannel:
     values: np.ndarray
 
 
-
 class Columns:
     """Columns over (n, C) rows, in their order: dense ones (n, C) and :class:`OneChannel` ones."""
 
@@ -73,13 +72,4 @@ class Columns:
         coef = np.asarray(coef, dtype=float)
         out = np.tensordot(coef[~self.one], self.dense, axes=1) if len(self.dense) else np.zeros(self.shape)
         np.add.at(out.T, self.channel, coef[self.one][:, None] * self.single)
-        return out
-
-    def column(self, k: int) -> np.ndarray:
-        """(n, C) the ``k``-th column, dense."""
-        at = int(np.sum(self.one[:k] == self.one[k]))   # its place among its kind
-        if not self.one[k]:
-            return self.dense[at]
-        out = np.zeros(self.shape)
-        out[:, self.channel[at]] = self.single[at]
         return out

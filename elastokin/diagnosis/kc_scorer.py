@@ -108,13 +108,10 @@ class Scorer:
         coef = bounded_solve(gram, stack.products(r), self._column_bounds(len(stack)), inverse)
         return r - stack.combine(coef).reshape(r.shape), stack, coef
 
-    def _raw(self, predicted: np.ndarray, rows: np.ndarray, zero: Callable[..., np.ndarray] = np.mean) -> np.ndarray:
+    def raw(self, predicted: np.ndarray, rows: np.ndarray, zero: Callable[..., np.ndarray] = np.mean) -> np.ndarray:
+        """(n, C) (measured − predicted (N, C)) / noise on the ``rows`` selected (N,) as :meth:`residual`
+        has it before the nuisances are fitted out (each recording's ``zero``, their means, removed)."""
         return self._zeroed(self.layout.measured[rows] - self._delivered(predicted)[rows], rows, zero)
-
-    def raw(self, predicted: np.ndarray, rows: np.ndarray) -> np.ndarray:
-        """(measured − predicted) / noise on the selected rows as :meth:`residual` has it before the
-        nuisances are fitted out (each recording's zeros, their means, removed)."""
-        return self._raw(predicted, rows)
 
     def nuisances(self, rows: np.ndarray) -> tuple[Columns, np.ndarray, np.ndarray, list[Key | None]]:
         """The nuisance columns on the selected rows as :meth:`residual` fits them out; their Gram
@@ -133,7 +130,7 @@ class Scorer:
         and its delay with what ``predicted``'s residual still shows of it to first order, with the
         standard uncertainty (the residual's own correlation along time counted)."""
         every = np.ones(len(predicted), dtype=bool)
-        r = self._raw(predicted, every, np.mean)
+        r = self.raw(predicted, every, np.mean)
         rates = self._zeroed(self._rates.copy(), every, np.mean)
         out = []
         for (name, idx), cutoff, delay in zip(self.paths.items(), self.cutoffs_hz, self.delays_s):
@@ -153,7 +150,7 @@ class Scorer:
         if not self._transducers:
             return []
         every = np.ones(len(predicted), dtype=bool)
-        left, stack, coef = self._fitted(self._raw(predicted, every, np.mean), every)
+        left, stack, coef = self._fitted(self.raw(predicted, every, np.mean), every)
         first = len(stack) - len(self._transducers)
         joint = stack.extended([self._zeroed(self._delivered(e), every, np.mean) for e in effects])
         std = np.sqrt(self.variances(left, joint, every))[first:len(stack)]
@@ -192,8 +189,9 @@ class Scorer:
         out = np.zeros((len(columns), len(columns)))
         for k, c in enumerate(channels):
             if isinstance(columns, Columns):
-                idx = np.r_[np.flatnonzero(~columns.one), np.flatnonzero(columns.one)[columns.channel == k]]
-                on = np.vstack([columns.dense[:, :, k], columns.single[columns.channel == k]])
+                # the columns span every channel: channel c's own, at c
+                idx = np.r_[np.flatnonzero(~columns.one), np.flatnonzero(columns.one)[columns.channel == c]]
+                on = np.vstack([columns.dense[:, :, c], columns.single[columns.channel == c]])
             else:
                 idx = np.arange(len(columns))
                 on = np.array([np.reshape(x, (len(tests), len(channels)))[:, k] for x in columns])
@@ -212,7 +210,7 @@ class Scorer:
         last = self._last
         if last is not None and last[0] is predicted and last[1] == key:   # the fits' mismatch: the same base
             return last[2]
-        r, _, _ = self._fitted(self._raw(predicted, rows, zero), rows)
+        r, _, _ = self._fitted(self.raw(predicted, rows, zero), rows)
         r.flags.writeable = False   # handed out again for the same prediction
         self._last = (predicted, key, r)
         return r

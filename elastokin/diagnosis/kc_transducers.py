@@ -140,28 +140,33 @@ def reading(key: Key, coef: float, std: float) -> Reading:
 
 def bounded_solve(gram: np.ndarray, seen: np.ndarray, limits: np.ndarray, inverse: np.ndarray | None = None
                   ) -> np.ndarray:
-    """The coefficients of columns (their ``gram`` matrix, their products ``seen`` with what they fit)
-    that fit it best within ``limits`` (K, 2) (:func:`bounds`), those whose limits meet held there:
-    the least-squares fit (``inverse``: the Gram matrix's pseudo-inverse, when nothing is held), then
-    each coefficient beyond its limits held at the nearer and the others refitted."""
+    """The coefficients (K,) of columns (their ``gram`` matrix (K, K), their products ``seen`` (K,) with
+    what they fit) that fit it best within ``limits`` (K, 2) (:func:`bounds`; those whose limits meet
+    held there): the least-squares fit (``inverse``: the Gram matrix's pseudo-inverse, used when
+    nothing is held), then an active set: each coefficient beyond its limits held at the nearer and
+    the others refitted, a held one whose objective's slope points inwards let go, until none is
+    beyond and none would leave its limit (the bounded least squares' optimum)."""
     lo, hi = limits.T
-    held = lo == hi
-    coef = np.where(held, lo, 0.0)
-
-    def refit():
-        free = ~held
-        coef[free] = np.linalg.pinv(gram[np.ix_(free, free)]) @ (seen[free] - gram[np.ix_(free, held)] @ coef[held])
-
-    if held.any() or inverse is None:
-        refit()
-    else:
-        coef = inverse @ seen
-    over = (coef < lo) | (coef > hi)
-    if over.any():
-        held |= over
-        coef[held] = np.clip(coef[held], lo[held], hi[held])
-        refit()
-    return coef
+    fixed = lo == hi
+    at = np.where(fixed, lo, np.nan)   # each coefficient's held value; NaN where free
+    tol = 1e-9 * float(np.abs(seen).max(initial=0.0))   # a slope that is rounding's
+    for _ in range(2 * len(seen) + 1):
+        free = np.isnan(at)
+        coef = np.where(free, 0.0, at)
+        if free.all() and inverse is not None:
+            coef = inverse @ seen
+        elif free.any():
+            coef[free] = np.linalg.pinv(gram[np.ix_(free, free)]) @ (seen[free] - gram[np.ix_(free, ~free)] @ at[~free])
+        over = free & ((coef < lo) | (coef > hi))
+        if over.any():
+            at[over] = np.clip(coef[over], lo[over], hi[over])
+            continue
+        slope = gram @ coef - seen   # the half squared error's gradient
+        inwards = ~free & ~fixed & (((at == lo) & (slope < -tol)) | ((at == hi) & (slope > tol)))
+        if not inwards.any():
+            return coef
+        at[np.argmax(np.where(inwards, np.abs(slope), -1.0))] = np.nan
+    return np.clip(coef, lo, hi)
 
 
 def bounds(key: Key) -> tuple[float, float]:

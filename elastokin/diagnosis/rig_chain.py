@@ -66,13 +66,13 @@ GROUPS = {"wheel_sensors": ("camber", "toe", "steer", "wheel_travel", "half_trac
 #: AR(1)'s. No vendor datasheet was at hand to check them against (this machine has no internet
 #: beyond the package registries).
 #: ``rig``: the rig's own mechanics (:mod:`elastokin.vehicle.scenarios.rig_file`'s keys), drawn
-#: uniformly in these: the floating pads' residual friction and their lateral compliance, the body
+#: uniformly in these: the floating pads' residual friction and their compliance in x and y, the body
 #: clamp's compliance left after the rig's correction of the body's motion. No published figure was
 #: at hand for any of them (Morse Measurements, "What exactly is K&C testing?", 2020, says only that
 #: a rig without floating pads, whose tyres scrub, is easily 10 % off in ride rate): they are set so
 #: that each shows in the default car's campaign at about the noise (20 N of pad friction and
 #: 0.02 mm/kN of lateral clamp compliance give 1.8 and 2.3 × the noise in the lateral-force test),
-#: a good rig's at a fifth of a typical one's.
+#: a good rig's friction and clamp at a fifth of a typical one's, its pads' compliance at half.
 GRADES = {
     "typical": {"delay_ms": {"wheel_sensors": (12.0, 15.0), "pad_sensors": (0.0, 5.0)},
                 "low_pass_hz": {"wheel_sensors": (8.0, 10.0), "pad_sensors": (15.0, 25.0)},
@@ -257,6 +257,12 @@ def servoed(scenario: Scenario, chains: Mapping[str, ChannelChain]) -> Scenario:
         np.array([1.0 / (1.0 + chains[ch].gain) if ch in chains else 1.0 for ch in INPUT_CHANNELS]))
 
 
+def _check_drawn(elements: tuple[str, ...]) -> None:
+    unknown = [e for e in elements if e not in DRAWN]
+    if unknown:
+        raise ValueError(f"unknown chain element {unknown[0]!r}; expected one of {', '.join(DRAWN)}")
+
+
 def draw_chain(rng: np.random.Generator, grade: str, white_noise: Mapping[str, float],
                elements: tuple[str, ...] = DRAWN) -> dict[str, dict[str, Any]]:
     """A measurement chain drawn in ``grade``'s ranges (:data:`GRADES`), as a truth's ``chain``
@@ -264,9 +270,7 @@ def draw_chain(rng: np.random.Generator, grade: str, white_noise: Mapping[str, f
     each measured channel without its wheel [its unit], the scale of the drift and coloured noise;
     ``elements``: the ones of :data:`DRAWN` to draw (each alone, for the slow suite's kinds)."""
     ranges = GRADES[grade]
-    unknown = [e for e in elements if e not in DRAWN]
-    if unknown:
-        raise ValueError(f"unknown chain element {unknown[0]!r}; expected one of {', '.join(DRAWN)}")
+    _check_drawn(elements)
     signed = lambda bounds: float(rng.choice((-1.0, 1.0)) * rng.uniform(*bounds))
     out: dict[str, dict[str, Any]] = {}
     for group, stems in GROUPS.items():
@@ -302,7 +306,9 @@ def draw_chain(rng: np.random.Generator, grade: str, white_noise: Mapping[str, f
 
 def draw_rig(rng: np.random.Generator, grade: str, elements: tuple[str, ...] = DRAWN) -> dict[str, float]:
     """A rig's mechanics drawn in ``grade``'s ranges (:data:`GRADES`), as a truth's ``rig`` mapping
-    (file units); ``elements``: those of :data:`RIG_DRAWN` among them are drawn, the rest ideal."""
+    (file units); ``elements``: those of :data:`RIG_DRAWN` among them are drawn, the rest ideal
+    (ValueError for one not in :data:`DRAWN`)."""
     ranges = GRADES[grade]["rig"]
+    _check_drawn(elements)
     return {key: round(float(rng.uniform(*ranges[key])), 6) for element, keys in RIG_DRAWN.items()
             if element in elements for key in keys}

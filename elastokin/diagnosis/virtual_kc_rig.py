@@ -28,8 +28,8 @@ measurement ``chain`` if it has one (gains, filters, lags, drifts, coloured nois
 stream of their own, so that a truth without a chain measures as before). The rig inputs (pad
 displacements, forces and torques, rack) are the commanded values and are written as commanded. A
 truth's ``rig`` (:mod:`elastokin.vehicle.scenarios.rig_file`) gives the rig's pads friction and
-compliance and its body clamp compliance: the car plays every scenario on that rig, the recordings
-saying nothing of it.
+compliance and its body clamp compliance: the car plays every scenario on that rig (on the
+scenario's own ``rig`` where the truth has none), the recordings saying nothing of it.
 """
 
 from __future__ import annotations
@@ -280,7 +280,7 @@ def measure_kc(truth: KCTruth, output: str | os.PathLike[str], *, overwrite: boo
     :func:`elastokin.recordings.rig_recordings.measured_channels`, adds to each measured one its zero error (drawn once
     per dataset), noise and quantisation, and writes the inputs as commanded (a truth's ``chain``
     goes before those on the channels it names; a servoed input's transducer gain g gives the car
-    the command / (1 + g); the car stands on the truth's ``rig``). Recordings are
+    the command / (1 + g); the car stands on the truth's ``rig``, or the scenario's if the truth's is ideal). Recordings are
     ``NN_<scenario name>.mcap`` in the order played, plus ``rig.yaml``. The dataset is written as a
     whole (a temporary folder renamed at the end); an existing ``output`` is refused unless
     ``overwrite``. ``progress(i, n, scenario name)`` is called before each scenario.
@@ -300,7 +300,8 @@ def measure_kc(truth: KCTruth, output: str | os.PathLike[str], *, overwrite: boo
             if progress is not None:
                 progress(i, len(truth.scenarios), scenario.name)
             played = servoed(scenario, truth.chain)   # the command the servoed inputs' transducers read
-            run = simulate(replace(played, bushing_model=None, rig=truth.rig), vehicle,
+            on = played.rig if truth.rig.ideal else truth.rig
+            run = simulate(replace(played, bushing_model=None, rig=on), vehicle,
                            duration_scale=truth.duration_scale)
             signals = {}
             for name, unit in channels.items():

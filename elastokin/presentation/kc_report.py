@@ -47,6 +47,12 @@ def _candidate(c: Candidate) -> dict[str, Any]:
             "parameters": dict(c.hypothesis.values)}
 
 
+def _finite(x: float) -> float | None:
+    """``x``, or None (JSON's null) for an uncertainty the campaign does not bound (a rig element it
+    never moves)."""
+    return x if math.isfinite(x) else None
+
+
 def _training_error(c: Candidate) -> float | None:
     """The linearised fit's RMS on the training tests; None for a candidate no such fit gave (a pair
     refit's halved step, :func:`elastokin.diagnosis.kc_fits.halfway`), which only its runs scored."""
@@ -94,9 +100,9 @@ def summary(d: KCDiagnosis) -> dict[str, Any]:
         "acquisition": [{"path": r.path, "channels": list(r.channels), "lag_ms": 1e3 * r.lag_s,
                          "cutoff_hz": r.cutoff_hz or None, "delay_ms": 1e3 * r.delay_s, "delay_std_ms": 1e3 * r.std_s}
                         for r in d.responses],
-        "transducers": [{"kind": g.kind, "channel": g.channel, "source": g.source, "value": g.value, "std": g.std}
-                        for g in d.transducers if g.kind != RIG],
-        "rig": [{"element": g.channel, "value": g.value, "std": g.std, "unit": BY_KEY[g.channel].unit}
+        "transducers": [{"kind": g.kind, "channel": g.channel, "source": g.source, "value": g.value,
+                         "std": _finite(g.std)} for g in d.transducers if g.kind != RIG],
+        "rig": [{"element": g.channel, "value": g.value, "std": _finite(g.std), "unit": BY_KEY[g.channel].unit}
                 for g in d.transducers if g.kind == RIG],
         "rig_or_car": [{"group": c.group, "readings": [f"{g.label} {g.text}" for g in c.readings],
                         "rivals": [{"cause": h.cause, "location": h.location_json(), "parameters": dict(h.values)}
@@ -178,15 +184,17 @@ def _acquisition_sentence(d: KCDiagnosis) -> str:
 
 
 def _transducers_sentence(d: KCDiagnosis) -> str:
-    """Which transducers the data show misreading, and what of the rig's own mechanics they show, if any."""
+    """Which transducers the data show misreading, and what of the rig's own mechanics they show, if any
+    (over the scenarios' own ``rig``, when they state one: the columns move it from there)."""
     said = [g for g in d.transducers if g.said and g.kind != RIG]
     mechanics = [g for g in d.transducers if g.said and g.kind == RIG]
     out = "" if not said else (
         " The rig's transducers misread: " + ", ".join(f"{g.label} {g.text}" for g in said)
         + " (fitted with every hypothesis and taken out; a cause acting on the campaign as such an error does "
           "is not told from it: a static calibration of the transducer separates them).")
+    stated = any(not t.job.scenario.rig.ideal for t in d.layout.tests)
     return out + ("" if not mechanics else (
-        " The rig itself shows: " + ", ".join(f"{g.label} {g.text}" for g in mechanics)
+        " The rig itself shows" + (" beyond the mechanics its scenarios state" if stated else "") + ": " + ", ".join(f"{g.label} {g.text}" for g in mechanics)
         + " (fitted with every hypothesis and taken out: the rig's, not the car's)."))
 
 

@@ -18,14 +18,14 @@ class RigMechanics:
     ideal rig, pads floating without friction, the body held rigidly).
 
     The pads float in x and y on bearings whose Coulomb friction each carriage feels (``pad_friction_n``),
-    through the pad's own lateral compliance in series with it (``pad_compliance_m_per_n``: a
+    through the pad's own compliance in x and y in series with it (``pad_compliance_m_per_n``: a
     Jenkins element, the compliance taking the force before the bearing slips); a lateral force
     commanded at a pad reaches the contact patch less that friction. The body's clamps yield
     (``clamp_*``: about the body's centre of mass, in y, z, roll and pitch): the body moves with the
     loads the pads put through the car, while the rig measures the wheels against its bedplate."""
 
     pad_friction_n: float = 0.0                    #: each pad's bearing friction, x and y [N]
-    pad_compliance_m_per_n: float = 0.0            #: each pad's lateral compliance in series with it [m/N]
+    pad_compliance_m_per_n: float = 0.0            #: each pad's compliance in x and y in series with it [m/N]
     clamp_lateral_m_per_n: float = 0.0             #: the body clamp's compliance in y [m/N]
     clamp_vertical_m_per_n: float = 0.0            #: in z [m/N]
     clamp_roll_rad_per_nm: float = 0.0             #: about x [rad/(N·m)]

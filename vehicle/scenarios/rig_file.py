@@ -5,7 +5,7 @@ rig's truth's): the keys in the units chassis engineers quote them in, converted
 
     rig:
       pad_friction_n: 12                  # each floating pad's bearing friction, x and y [N]
-      pad_compliance_mm_per_kn: 3.0       # each pad's lateral compliance in series with it [mm/kN]
+      pad_compliance_mm_per_kn: 3.0       # each pad's compliance in x and y, in series [mm/kN]
       clamp_lateral_mm_per_kn: 0.01       # the body clamp's compliance in y [mm/kN]
       clamp_vertical_mm_per_kn: 0.01      # in z [mm/kN]
       clamp_roll_deg_per_knm: 0.003       # about x [deg/(kN·m)]
@@ -37,10 +37,15 @@ KEYS = {
 
 def parse_rig(doc: Document, path: KeyPath, data: Any) -> RigMechanics:
     """The rig mechanics of the ``rig`` mapping ``data`` (:data:`KEYS`, file units) found at ``path``
-    of ``doc``; InputError there for a key not known or a value negative, non-finite or beyond its bound."""
+    of ``doc``; InputError there for a key not known, a value negative, non-finite or beyond its
+    bound, or the pads' compliance without their friction."""
     fields = Fields.of(doc, path, data, tuple(KEYS))
-    return RigMechanics(**{name: si * fields.number(key, 0.0, nonneg=True, at_most=bound, unit=unit)
-                           for key, (name, si, bound, unit) in KEYS.items() if fields.has(key)})
+    rig = RigMechanics(**{name: si * fields.number(key, 0.0, nonneg=True, at_most=bound, unit=unit)
+                          for key, (name, si, bound, unit) in KEYS.items() if fields.has(key)})
+    if rig.pad_compliance_m_per_n and not rig.pad_friction_n:
+        raise fields.fail("pad_compliance_mm_per_kn", "acts only in series with the pads' friction: expected "
+                          "pad_friction_n beside it (a frictionless pad floats whatever its compliance)")
+    return rig
 
 
 def rig_values(rig: RigMechanics) -> dict[str, float]:
