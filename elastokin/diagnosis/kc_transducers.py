@@ -156,7 +156,8 @@ def bounded_solve(gram: np.ndarray, seen: np.ndarray, limits: np.ndarray, invers
         if free.all() and inverse is not None:
             coef = inverse @ seen
         elif free.any():
-            coef[free] = np.linalg.pinv(gram[np.ix_(free, free)]) @ (seen[free] - gram[np.ix_(free, ~free)] @ at[~free])
+            rest = seen[free] - gram[np.ix_(free, ~free)] @ at[~free]
+            coef[free] = np.linalg.pinv(gram[np.ix_(free, free)]) @ rest
         over = free & ((coef < lo) | (coef > hi))
         if over.any():
             at[over] = np.clip(coef[over], lo[over], hi[over])

@@ -258,6 +258,7 @@ def servoed(scenario: Scenario, chains: Mapping[str, ChannelChain]) -> Scenario:
 
 
 def _check_drawn(elements: tuple[str, ...]) -> None:
+    """ValueError for an element :func:`draw_chain` and :func:`draw_rig` cannot draw."""
     unknown = [e for e in elements if e not in DRAWN]
     if unknown:
         raise ValueError(f"unknown chain element {unknown[0]!r}; expected one of {', '.join(DRAWN)}")

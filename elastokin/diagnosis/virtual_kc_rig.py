@@ -280,8 +280,8 @@ def measure_kc(truth: KCTruth, output: str | os.PathLike[str], *, overwrite: boo
     :func:`elastokin.recordings.rig_recordings.measured_channels`, adds to each measured one its zero error (drawn once
     per dataset), noise and quantisation, and writes the inputs as commanded (a truth's ``chain``
     goes before those on the channels it names; a servoed input's transducer gain g gives the car
-    the command / (1 + g); the car stands on the truth's ``rig``, or the scenario's if the truth's is ideal). Recordings are
-    ``NN_<scenario name>.mcap`` in the order played, plus ``rig.yaml``. The dataset is written as a
+    the command / (1 + g); the car stands on the truth's ``rig``, or the scenario's if the truth's is
+    ideal). Recordings are ``NN_<scenario name>.mcap`` in the order played, plus ``rig.yaml``. The dataset is written as a
     whole (a temporary folder renamed at the end); an existing ``output`` is refused unless
     ``overwrite``. ``progress(i, n, scenario name)`` is called before each scenario.
     """

@@ -192,9 +192,10 @@ def _transducers_sentence(d: KCDiagnosis) -> str:
         " The rig's transducers misread: " + ", ".join(f"{g.label} {g.text}" for g in said)
         + " (fitted with every hypothesis and taken out; a cause acting on the campaign as such an error does "
           "is not told from it: a static calibration of the transducer separates them).")
-    stated = any(not t.job.scenario.rig.ideal for t in d.layout.tests)
+    beyond = " beyond the mechanics its scenarios state" if any(not t.job.scenario.rig.ideal
+                                                                for t in d.layout.tests) else ""
     return out + ("" if not mechanics else (
-        " The rig itself shows" + (" beyond the mechanics its scenarios state" if stated else "") + ": " + ", ".join(f"{g.label} {g.text}" for g in mechanics)
+        f" The rig itself shows{beyond}: " + ", ".join(f"{g.label} {g.text}" for g in mechanics)
         + " (fitted with every hypothesis and taken out: the rig's, not the car's)."))
 
 
