@@ -48,15 +48,15 @@ def _candidate(c: Candidate) -> dict[str, Any]:
 
 
 def _finite(x: float) -> float | None:
-    """``x``, or None (JSON's null) for an uncertainty the campaign does not bound (a rig element it
-    never moves)."""
+    """``x``, or None (JSON's null, which has no infinity) for a figure not bounded or not computed (an
+    uncertainty the campaign does not bound, a training error no fit gave)."""
     return x if math.isfinite(x) else None
 
 
 def _training_error(c: Candidate) -> float | None:
     """The linearised fit's RMS on the training tests; None for a candidate no such fit gave (a pair
     refit's halved step, :func:`elastokin.diagnosis.kc_fits.halfway`), which only its runs scored."""
-    return c.screened_error if math.isfinite(c.screened_error) else None
+    return _finite(c.screened_error)
 
 
 def _run_with(d: KCDiagnosis, c: Candidate) -> list[Hypothesis]:
