@@ -644,7 +644,7 @@ def assert_the_chain_recovered(result: dict, rig: dict | None = None) -> None:
 def test_a_spring_on_a_rig_whose_pads_have_friction_is_named_and_the_friction_taken_out(tmp_path):
     """The front springs 6 % stiffer, measured in pumping alone at 10 times its speed on a rig whose
     pads have 15 N of friction (with 3 mm/kN of compliance before they slip: the diagnosis's own
-    model of the pads has none): the springs named with their factor within 3 standard
+    pads have a typical 3.5): the springs named with their factor within 3 standard
     uncertainties and 2 % (the front pads' load cells' gains, which act on vertical loads much as a
     stiffer spring does, fitted with it and not taking it), the friction recovered within 3 standard
     uncertainties and a tenth, the rig's mechanics said as the rig's in the verdict."""
@@ -799,7 +799,7 @@ def test_success_rate_through_a_rigs_acquisition(tmp_path, record_property, caus
         for g in result["transducers"]:
             truth = _chain_reading(chain, g)
             assert abs(g["value"] - truth) <= 3.0 * g["std"] + 1e-3, (g, truth)
-        for g in result["rig"]:   # the diagnosis's pads have no compliance: a tenth of the value besides
+        for g in result["rig"]:   # the diagnosis's pads have a typical compliance, not the rig's: a tenth besides
             truth = rig.get(g["element"], 0.0)
             assert abs(g["value"] - truth) <= 3.0 * g["std"] + 0.1 * truth + BY_KEY[g["element"]].floor, (g, truth)
         return check(result, h)

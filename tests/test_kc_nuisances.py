@@ -1,13 +1,18 @@
 """The K&C diagnosis's nuisance algebra: the bounded least squares that holds a rig input's gain and
-the rig's mechanics within their bounds, and the one-channel columns held compactly, against the
-dense forms they stand for."""
+the rig's mechanics within their bounds, the one-channel columns held compactly, against the dense
+forms they stand for; the rigs the rig mechanics' columns are run on."""
 
 import numpy as np
 import pytest
 from scipy.optimize import lsq_linear
 
 from elastokin.diagnosis.kc_columns import Columns, OneChannel
+from elastokin.diagnosis import kc_layout
+from elastokin.diagnosis.kc_rig_mechanics import BY_KEY, RIG, with_element
+from elastokin.diagnosis.kc_scorer import Scorer
 from elastokin.diagnosis.kc_transducers import bounded_solve
+from elastokin.diagnosis.verdict import split
+from elastokin.vehicle.model.elements import RigMechanics
 
 
 @pytest.mark.parametrize("seed", range(5))
@@ -61,3 +66,45 @@ def test_one_channel_columns_act_as_their_dense_forms():
     assert stack.products(r) == pytest.approx(flat @ r.ravel(), rel=1e-12, abs=1e-12)
     assert stack.gram() == pytest.approx(flat @ flat.T, rel=1e-12, abs=1e-12)
     assert stack.combine(coef).ravel() == pytest.approx(coef @ flat, rel=1e-12, abs=1e-12)
+
+
+def test_the_pads_friction_column_runs_on_pads_with_a_compliance_in_series():
+    """The pads' friction moved by 10 N over a scenario's rig: on an ideal rig's pads, a typical pad's
+    3.5 mm/kN in series (the friction acts through it); on a rig stating its pads' compliance, that
+    one kept; a clamp's column leaves the pads as they are (SI: N, m/N)."""
+    friction, clamp = BY_KEY["pad_friction_n"], BY_KEY["clamp_lateral_mm_per_kn"]
+    ideal = with_element(RigMechanics(), friction, 10.0)
+    assert (ideal.pad_friction_n, ideal.pad_compliance_m_per_n) == (10.0, pytest.approx(3.5e-6, rel=1e-12))
+    stated = with_element(RigMechanics(pad_friction_n=4.0, pad_compliance_m_per_n=2e-6), friction, 10.0)
+    assert (stated.pad_friction_n, stated.pad_compliance_m_per_n) == (14.0, 2e-6)
+    clamped = with_element(RigMechanics(), clamp, 0.01)
+    assert clamped.clamp_lateral_m_per_n == pytest.approx(1e-8, rel=1e-12)
+    assert (clamped.pad_friction_n, clamped.pad_compliance_m_per_n) == (0.0, 0.0)
+
+
+def test_a_rig_element_linearised_at_a_value_reads_and_is_bounded_from_it():
+    """Runs made on a rig whose pads have 20 N of friction (``rig_at``), the data on one of 12 N
+    (the rows 8 × the column's change per N below the runs', in white noise): the reading is
+    12 N within 3 standard uncertainties, where a scorer taking the runs' rig as none holds it at
+    0; a rig without friction reads 0 N, one "below" it held at 0 N, its bound; the coefficient of
+    no friction is −20 N."""
+    rng = np.random.default_rng(11)
+    t = np.linspace(0.0, 1.0, 2000)
+    column = np.column_stack([np.sin(2 * np.pi * t), np.sign(np.cos(3 * np.pi * t))])
+    tests = [kc_layout.Test(name, None, rows, np.arange(len(rows)), True)
+             for name, rows in (("a", np.arange(1000)), ("b", np.arange(1000, 2000)))]
+    key, base = (RIG, "pad_friction_n", None), np.zeros_like(column)
+
+    def scorer(truth: float, rig_at: dict | None) -> Scorer:
+        measured = (truth - 20.0) * column + 0.2 * rng.standard_normal(column.shape)
+        layout = kc_layout.Layout(["c_x", "c_y"], measured, t, np.zeros(2000, dtype=int), np.repeat([0, 1], 1000),
+                                  tests)
+        return Scorer(layout, base, split(2), {key: column}, rig_at)
+
+    at = {"pad_friction_n": 20.0}
+    for truth in (12.0, 0.0):
+        (friction,) = scorer(truth, at).transducers(base)
+        assert friction.value == pytest.approx(truth, abs=3.0 * friction.std) and 0.0 < friction.std < 0.01
+    assert scorer(-10.0, at).transducers(base)[0].value == 0.0
+    assert scorer(12.0, None).transducers(base)[0].value == 0.0
+    assert scorer(12.0, at).nuisances(np.ones(2000, dtype=bool))[3][-1] == -20.0

@@ -12,7 +12,9 @@
    :mod:`elastokin.diagnosis.kc_transducers`) and its own mechanics (its pads' friction, its body
    clamp's compliance, :mod:`elastokin.diagnosis.kc_rig_mechanics`): fitted with every hypothesis;
    what they take out that a car cause would explain as well is said
-   (:mod:`elastokin.diagnosis.kc_rig_or_car`).
+   (:mod:`elastokin.diagnosis.kc_rig_or_car`). When the verdict shows the pads' friction (not
+   proportional in its effect, nor apart from a car cause that sticks and slips too), all of this
+   runs again on a rig with it, its column then the change from it.
 2. Screening: every catalogue cause at every place it can sit (:mod:`elastokin.diagnosis.kc_catalogue`)
    is run once on the training tests (every other one) at mid-range magnitude (a sided cause, whose
    sign picks another effect, or one whose effect is not odd in its magnitude, such as a cross
@@ -65,7 +67,8 @@ from elastokin.diagnosis.kc_fits import (Candidate, fit, fit_pair, halfway, kept
                                     verify)
 from elastokin.diagnosis.kc_transducers import INPUT_GAIN, STEP, Reading, input_column, moved, reading_columns, stepped
 from elastokin.diagnosis.kc_lags import PathResponse
-from elastokin.diagnosis.kc_rig_mechanics import ELEMENTS, RIG, element_column, element_jobs
+from elastokin.diagnosis.kc_rig_mechanics import (BY_KEY, ELEMENTS, RIG, element_column, element_jobs,
+                                                   not_proportional, on_rig)
 from elastokin.diagnosis.kc_rig_or_car import RigOrCar, rig_or_car
 from elastokin.diagnosis.kc_noise import NoiseModel, coloured_noise
 from elastokin.diagnosis.kc_scorer import Scorer
@@ -190,106 +193,120 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, executor: Execut
     started = time.perf_counter()
     say = progress or (lambda _: None)
     layout = Layout.of(data, vehicle)
+    with nullcontext(executor) if executor is not None else open_executor() as pool:
+        out = _diagnosis(layout, vehicle, pool, say, started)
+        at = not_proportional({g.channel: g.value for g in out.transducers if g.kind == RIG and g.said})
+        if at:
+            say(f"the rig shows {', '.join(f'{BY_KEY[k].label} {v:.3g} {BY_KEY[k].unit}' for k, v in at.items())}, "
+                f"not proportional in its effect: every run again on a rig with it")
+            out = replace(_diagnosis(on_rig(layout, at), vehicle, pool, say, started, at), layout=layout)
+    return out
+
+
+def _diagnosis(layout: Layout, vehicle: VehicleDefinition, pool: Executor, say: Callable[[str], None],
+               started: float, rig_at: dict[str, float] | None = None) -> KCDiagnosis:
+    """:func:`diagnose_kc` with its runs on ``pool``, each test on its job's rig; ``rig_at``: the
+    rig elements' values [their units] that rig adds to the scenarios' (their columns then the
+    change from them)."""
     every = range(len(layout.tests))
     heldout = split(len(layout.tests))
     training = [i for i in every if not heldout[i]]
     candidates = hypotheses(vehicle)
-    with nullcontext(executor) if executor is not None else open_executor() as pool:
-        def runs(sets: list[tuple[str, list[Job], Sequence[int]]]) -> list[np.ndarray]:
-            """The compared rows of each set of runs (what it is, its jobs, the tests they run: NaN
-            elsewhere), all in parallel."""
-            jobs = [(label, t, j) for label, js, tests in sets for t, j in zip(tests, js)]
-            flat: list[dict[str, np.ndarray]] = [{}] * len(jobs)
-            each = max(1, len(jobs) // max(len(sets), 1))   # no set at all: a campaign whose inputs never move
-            with closing(pool.each(run_job, [j for _, _, j in jobs])) as outcomes:   # a failure cancels the others at once
-                for done, o in enumerate(outcomes, 1):
-                    if o.error:
-                        label, test, _ = jobs[o.index]
-                        raise TaskFailed(f"{label} on {layout.tests[test].name}: {o.error}")
-                    flat[o.index] = o.result
-                    if len(sets) > 1 and done % each == 0:
-                        say(f"  {done}/{len(flat)} runs done on {pool.description}")
-            out, start = [], 0
-            for _, js, tests in sets:
-                out.append(layout.stack(flat[start:start + len(js)], tests))
-                start += len(js)
-            return out
+    def runs(sets: list[tuple[str, list[Job], Sequence[int]]]) -> list[np.ndarray]:
+        """The compared rows of each set of runs (what it is, its jobs, the tests they run: NaN
+        elsewhere), all in parallel."""
+        jobs = [(label, t, j) for label, js, tests in sets for t, j in zip(tests, js)]
+        flat: list[dict[str, np.ndarray]] = [{}] * len(jobs)
+        each = max(1, len(jobs) // max(len(sets), 1))   # no set at all: a campaign whose inputs never move
+        with closing(pool.each(run_job, [j for _, _, j in jobs])) as outcomes:   # a failure cancels the others at once
+            for done, o in enumerate(outcomes, 1):
+                if o.error:
+                    label, test, _ = jobs[o.index]
+                    raise TaskFailed(f"{label} on {layout.tests[test].name}: {o.error}")
+                flat[o.index] = o.result
+                if len(sets) > 1 and done % each == 0:
+                    say(f"  {done}/{len(flat)} runs done on {pool.description}")
+        out, start = [], 0
+        for _, js, tests in sets:
+            out.append(layout.stack(flat[start:start + len(js)], tests))
+            start += len(js)
+        return out
 
-        def rows(vehicles: list[VehicleDefinition], tests: Sequence[int]) -> list[np.ndarray]:
-            """The compared rows of each vehicle on ``tests`` (NaN elsewhere), the runs in parallel."""
-            return runs([(f"vehicle {k + 1} of {len(vehicles)}", layout.jobs(v, tests), tests)
-                         for k, v in enumerate(vehicles)])
+    def rows(vehicles: list[VehicleDefinition], tests: Sequence[int]) -> list[np.ndarray]:
+        """The compared rows of each vehicle on ``tests`` (NaN elsewhere), the runs in parallel."""
+        return runs([(f"vehicle {k + 1} of {len(vehicles)}", layout.jobs(v, tests), tests)
+                     for k, v in enumerate(vehicles)])
 
-        say(f"baseline {vehicle.name} on {len(data.tests)} recordings, {len(layout.tests)} tests "
-            f"({int(heldout.sum())} held out)")
-        (base,) = rows([vehicle], every)
-        movers = moved(layout)
-        say(f"the baseline with each of the {len(movers)} rig inputs moved × {1 + STEP:g} (its transducer's gain), "
-            f"and on a rig with each of {len(ELEMENTS)} elements of its mechanics moved (the pads' friction, the "
-            f"body clamp's compliance)")
-        nuisances = runs([(f"{ch} × {1 + STEP:g}", stepped(layout, ch, tests), tests) for ch, tests in movers.items()]
-                         + [(e.label, element_jobs(layout, e), every) for e in ELEMENTS])
-        scorer = Scorer(layout, base, heldout, {**{(INPUT_GAIN, ch, None): input_column(r, base)
-                                                   for ch, r in zip(movers, nuisances)},
-                                                **{(RIG, e.key, None): element_column(r, base, e)
-                                                   for e, r in zip(ELEMENTS, nuisances[len(movers):])},
-                                                **reading_columns(layout, base)})
-        before = scorer.heldout_error(base)
-        say(f"held-out error of the baseline: {before:.3f} (1 = the measurement noise); one run of each of "
-            f"{len(candidates)} hypotheses at mid-range magnitude on the {len(training)} training tests")
-        signatures = rows([extended_vehicle(vehicle, [h]) for h in candidates], training)
-        screened = _best_per_place(fit(h, sig - base, base, scorer) for h, sig in zip(candidates, signatures))
-        for c in screened[:VERIFIED]:
-            say(f"  {c.hypothesis.label}: training error {c.screened_error:.3f} with {_fmt(c.hypothesis.values)}")
-        top = screened[:VERIFIED]
-        say(f"the best {len(top)} on every test with their fitted magnitudes, then refitted along the effect they gave")
-        verify(top, rows([extended_vehicle(vehicle, [c.hypothesis]) for c in top], every), scorer)
-        shaped = sum(len(parameters(c.hypothesis.cause)) > 1 for c in top)
-        if shaped:
-            say(f"  {shaped} with a second parameter: run with it moved, to fit it too")
-        slopes = _slopes(top, lambda hs: rows([extended_vehicle(vehicle, [h]) for h in hs], training))
-        refit = [fit(c.hypothesis, c.simulated - base, base, scorer, s) for c, s in zip(top, slopes)]
-        top = kept(top, refit, rows([extended_vehicle(vehicle, [c.hypothesis]) for c in refit], every), scorer)
-        best = top[0]
-        found = located_misfits(layout, scorer, base)
-        left = located_misfits(layout, scorer, best.simulated)
-        pairs: list[Candidate] = []
-        second, alone = None, math.nan
-        # the tests not fitted by the best single cause, or by the baseline if that cause makes things worse
-        unfitted = left if best.heldout_error < before else found
-        if second_cause_wanted(before, best.heldout_error, 1.0, bool(unfitted)):
-            say(f"{best.hypothesis.label} leaves {best.heldout_error:.3f} × the noise"
-                f"{' and tests it does not fit' if left else ''}: every other hypothesis beside it")
-            others = [(h, sig) for h, sig in zip(candidates, signatures)
-                      if (h.cause, h.location) != (best.hypothesis.cause, best.hypothesis.location)]
-            pairs = _second_stage(best, others, base, scorer,
-                                  lambda hs, tests: rows([extended_vehicle(vehicle, h) for h in hs], tests), every,
-                                  training)
-            # a second cause whose magnitude is not told from none is the first's joint refit, not a cause
-            k = next((i for i, c in enumerate(pairs) if significant(c)), len(pairs))
-            for c in pairs[:k]:
-                say(f"  beside it, {c.hypothesis.label} is not told from no effect: {_fmt(c.hypothesis.values)}")
-            if k < len(pairs) and pair_named(before, best.heldout_error, pairs[k].heldout_error, 1.0):
-                second = pairs[k]
-                single = _alone(second.hypothesis, top + screened[VERIFIED:])
-                if not single.verified:   # its single fit, run on every test as the first cause's was
-                    single = replace(single)
-                    verify([single], rows([extended_vehicle(vehicle, [single.hypothesis])], every), scorer)
-                alone = single.heldout_error
-        rivals: list[Candidate] = []
-        apart: list[Separation | None] = []
-        extra: list = []
-        if second is None and decide(before, best.heldout_error, 1.0) == "named":
-            rivals = alike(best, top, before)
-        if rivals:   # the shipped scenarios read only then
-            extra = extra_scenarios({t.job.scenario.name for t in layout.tests})
-            say(f"{best.hypothesis.label} cannot be told apart on these tests from "
-                f"{', '.join(c.hypothesis.label for c in rivals)}: both run on the {len(extra)} shipped tests the "
-                f"dataset lacks")
-            apart = separations([extended_vehicle(vehicle, [c.hypothesis]) for c in (best, *rivals)], extra,
-                                layout.channels, scorer.noise,
-                                float(np.median([t.job.duration_scale for t in layout.tests])),
-                                lambda jobs: pool.map(run_unless_diverged, jobs))
+    say(f"baseline {vehicle.name} on {len(np.unique(layout.recording))} recordings, {len(layout.tests)} tests "
+        f"({int(heldout.sum())} held out)")
+    (base,) = rows([vehicle], every)
+    movers = moved(layout)
+    say(f"the baseline with each of the {len(movers)} rig inputs moved × {1 + STEP:g} (its transducer's gain), "
+        f"and on a rig with each of {len(ELEMENTS)} elements of its mechanics moved (the pads' friction, the "
+        f"body clamp's compliance)")
+    nuisances = runs([(f"{ch} × {1 + STEP:g}", stepped(layout, ch, tests), tests) for ch, tests in movers.items()]
+                     + [(e.label, element_jobs(layout, e), every) for e in ELEMENTS])
+    scorer = Scorer(layout, base, heldout, {**{(INPUT_GAIN, ch, None): input_column(r, base)
+                                               for ch, r in zip(movers, nuisances)},
+                                            **{(RIG, e.key, None): element_column(r, base, e)
+                                               for e, r in zip(ELEMENTS, nuisances[len(movers):])},
+                                            **reading_columns(layout, base)}, rig_at)
+    before = scorer.heldout_error(base)
+    say(f"held-out error of the baseline: {before:.3f} (1 = the measurement noise); one run of each of "
+        f"{len(candidates)} hypotheses at mid-range magnitude on the {len(training)} training tests")
+    signatures = rows([extended_vehicle(vehicle, [h]) for h in candidates], training)
+    screened = _best_per_place(fit(h, sig - base, base, scorer) for h, sig in zip(candidates, signatures))
+    for c in screened[:VERIFIED]:
+        say(f"  {c.hypothesis.label}: training error {c.screened_error:.3f} with {_fmt(c.hypothesis.values)}")
+    top = screened[:VERIFIED]
+    say(f"the best {len(top)} on every test with their fitted magnitudes, then refitted along the effect they gave")
+    verify(top, rows([extended_vehicle(vehicle, [c.hypothesis]) for c in top], every), scorer)
+    shaped = sum(len(parameters(c.hypothesis.cause)) > 1 for c in top)
+    if shaped:
+        say(f"  {shaped} with a second parameter: run with it moved, to fit it too")
+    slopes = _slopes(top, lambda hs: rows([extended_vehicle(vehicle, [h]) for h in hs], training))
+    refit = [fit(c.hypothesis, c.simulated - base, base, scorer, s) for c, s in zip(top, slopes)]
+    top = kept(top, refit, rows([extended_vehicle(vehicle, [c.hypothesis]) for c in refit], every), scorer)
+    best = top[0]
+    found = located_misfits(layout, scorer, base)
+    left = located_misfits(layout, scorer, best.simulated)
+    pairs: list[Candidate] = []
+    second, alone = None, math.nan
+    # the tests not fitted by the best single cause, or by the baseline if that cause makes things worse
+    unfitted = left if best.heldout_error < before else found
+    if second_cause_wanted(before, best.heldout_error, 1.0, bool(unfitted)):
+        say(f"{best.hypothesis.label} leaves {best.heldout_error:.3f} × the noise"
+            f"{' and tests it does not fit' if left else ''}: every other hypothesis beside it")
+        others = [(h, sig) for h, sig in zip(candidates, signatures)
+                  if (h.cause, h.location) != (best.hypothesis.cause, best.hypothesis.location)]
+        pairs = _second_stage(best, others, base, scorer,
+                              lambda hs, tests: rows([extended_vehicle(vehicle, h) for h in hs], tests), every,
+                              training)
+        # a second cause whose magnitude is not told from none is the first's joint refit, not a cause
+        k = next((i for i, c in enumerate(pairs) if significant(c)), len(pairs))
+        for c in pairs[:k]:
+            say(f"  beside it, {c.hypothesis.label} is not told from no effect: {_fmt(c.hypothesis.values)}")
+        if k < len(pairs) and pair_named(before, best.heldout_error, pairs[k].heldout_error, 1.0):
+            second = pairs[k]
+            single = _alone(second.hypothesis, top + screened[VERIFIED:])
+            if not single.verified:   # its single fit, run on every test as the first cause's was
+                single = replace(single)
+                verify([single], rows([extended_vehicle(vehicle, [single.hypothesis])], every), scorer)
+            alone = single.heldout_error
+    rivals: list[Candidate] = []
+    apart: list[Separation | None] = []
+    extra: list = []
+    if second is None and decide(before, best.heldout_error, 1.0) == "named":
+        rivals = alike(best, top, before)
+    if rivals:   # the shipped scenarios read only then
+        extra = extra_scenarios({t.job.scenario.name for t in layout.tests})
+        say(f"{best.hypothesis.label} cannot be told apart on these tests from "
+            f"{', '.join(c.hypothesis.label for c in rivals)}: both run on the {len(extra)} shipped tests the "
+            f"dataset lacks")
+        apart = separations([extended_vehicle(vehicle, [c.hypothesis]) for c in (best, *rivals)], extra,
+                            layout.channels, scorer.noise,
+                            float(np.median([t.job.duration_scale for t in layout.tests])),
+                            lambda jobs: pool.map(run_unless_diverged, jobs))
     errors = scorer.test_errors(base)
     for m in found:
         say(f"the baseline does not fit {m.test}{' (held out)' if m.heldout else ''}: {m.error:.2f} × the noise, "

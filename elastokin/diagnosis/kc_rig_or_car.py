@@ -76,7 +76,7 @@ def rig_or_car(scorer: Scorer, model: np.ndarray, readings: Sequence[Reading],
     model's own causes); the groups that have any (module docstring)."""
     train = ~scorer.held_rows
     m = scorer.raw(model, train)
-    columns, gram, bounds, keys = scorer.nuisances(train)
+    columns, gram, bounds, none, keys = scorer.nuisances(train)
     seen, mm, size = columns.products(m), float(np.sum(m * m)), m.size
     error = lambda coef, matrix, products: math.sqrt(max(mm - 2.0 * coef @ products + coef @ matrix @ coef, 0.0)
                                                      / size)
@@ -90,7 +90,7 @@ def rig_or_car(scorer: Scorer, model: np.ndarray, readings: Sequence[Reading],
         if not shown:
             continue
         held = bounds.copy()
-        held[members] = 0.0
+        held[members] = none[members, None]
         error_held = error(bounded_solve(gram, seen, held), gram, seen)
         if effects is None:
             effects = []

@@ -15,6 +15,7 @@ from elastokin.diagnosis.kc_columns import Columns, OneChannel
 from elastokin.diagnosis.kc_lags import PathResponse, Response, fit_response, paths
 from elastokin.diagnosis.kc_layout import Layout
 from elastokin.diagnosis.kc_noise import estimate_noise, white_noise
+from elastokin.diagnosis.kc_rig_mechanics import RIG
 from elastokin.diagnosis.kc_transducers import Key, Reading, bounded_solve, bounds, reading
 
 
@@ -26,10 +27,14 @@ class Scorer:
     each channel's zero error in each recording removed; errors per test."""
 
     def __init__(self, layout: Layout, baseline: np.ndarray, heldout: np.ndarray,
-                 transducers: Mapping[Key, np.ndarray | OneChannel] | None = None):
+                 transducers: Mapping[Key, np.ndarray | OneChannel] | None = None,
+                 rig_at: Mapping[str, float] | None = None):
         """``transducers``: the rows' derivative (N, C) with respect to each transducer error fitted
         with every prediction (:mod:`elastokin.diagnosis.kc_transducers`; one channel's alone for a
-        :class:`~elastokin.diagnosis.kc_columns.OneChannel`), as the rig's acquisition delivers it (here)."""
+        :class:`~elastokin.diagnosis.kc_columns.OneChannel`), as the rig's acquisition delivers it (here).
+        ``rig_at``: each rig element's value [its unit] the runs were made at beyond the scenarios'
+        rigs (default none): its column's coefficient is the change from it, held so that the element
+        stays within its bounds, and its reading the value."""
         self.layout, self.heldout = layout, heldout
         self.held_rows = heldout[layout.test]
         self.paths = paths(layout.channels)
@@ -45,8 +50,10 @@ class Scorer:
         self._rates, self._taps = self.response.rates(delivered), self.response.taps(delivered)
         self._transducers = {k: self._delivered_column(c) for k, c in (transducers or {}).items()}
         self._columns: dict[bytes, tuple[Columns, np.ndarray, np.ndarray]] = {}
+        #: each transducer coefficient's value at no change from the runs (a rig element's: the value they were made at)
+        self._at = np.array([(rig_at or {}).get(key[1], 0.0) if key[0] == RIG else 0.0 for key in self._transducers])
         #: the bounds of the transducers' coefficients (a rig input's gain, a rig's mechanics: held within them)
-        self._bounds = np.array([bounds(key) for key in self._transducers]).reshape(-1, 2)
+        self._bounds = np.array([bounds(key) for key in self._transducers]).reshape(-1, 2) - self._at[:, None]
         #: the last residual: (the prediction, its rows and zero, the residual), read-only
         self._last: tuple[np.ndarray, tuple, np.ndarray] | None = None
 
@@ -113,12 +120,14 @@ class Scorer:
         has it before the nuisances are fitted out (each recording's ``zero``, their means, removed)."""
         return self._zeroed(self.layout.measured[rows] - self._delivered(predicted)[rows], rows, zero)
 
-    def nuisances(self, rows: np.ndarray) -> tuple[Columns, np.ndarray, np.ndarray, list[Key | None]]:
+    def nuisances(self, rows: np.ndarray) -> tuple[Columns, np.ndarray, np.ndarray, np.ndarray, list[Key | None]]:
         """The nuisance columns on the selected rows as :meth:`residual` fits them out; their Gram
-        matrix (K, K); each one's bounds (K, 2); each one's key (None for the acquisition's taps)."""
+        matrix (K, K); each one's bounds (K, 2); each one's coefficient of no error (K,: a rig
+        element's minus the value the runs were made at); each one's key (None for the acquisition's taps)."""
         stack, gram, _ = self._nuisance(rows)
-        return (stack, gram, self._column_bounds(len(stack)),
-                [None] * (len(stack) - len(self._transducers)) + list(self._transducers))
+        taps = len(stack) - len(self._transducers)
+        return (stack, gram, self._column_bounds(len(stack)), np.concatenate([np.zeros(taps), -self._at]),
+                [None] * taps + list(self._transducers))
 
     def _column_bounds(self, columns: int) -> np.ndarray:
         """(columns, 2) the bounds of every nuisance coefficient: the acquisition's taps free, the
@@ -154,7 +163,8 @@ class Scorer:
         first = len(stack) - len(self._transducers)
         joint = stack.extended([self._zeroed(self._delivered(e), every, np.mean) for e in effects])
         std = np.sqrt(self.variances(left, joint, every))[first:len(stack)]
-        return [reading(key, float(coef[first + k]), float(s)) for k, (key, s) in enumerate(zip(self._transducers, std))]
+        return [reading(key, float(at + coef[first + k]), float(s))
+                for k, (key, at, s) in enumerate(zip(self._transducers, self._at, std))]
 
     def variances(self, residual: np.ndarray, columns: list[np.ndarray] | Columns, rows: np.ndarray,
                   channels: np.ndarray | None = None) -> np.ndarray:
