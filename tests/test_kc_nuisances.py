@@ -70,13 +70,15 @@ def test_one_channel_columns_act_as_their_dense_forms():
 
 def test_the_pads_friction_column_runs_on_pads_with_a_compliance_in_series():
     """The pads' friction moved by 10 N over a scenario's rig: on an ideal rig's pads, a typical pad's
-    3.5 mm/kN in series (the friction acts through it); on a rig stating its pads' compliance, that
-    one kept; a clamp's column leaves the pads as they are (SI: N, m/N)."""
+    3.5 mm/kN in series (the friction acts through it); on a rig stating its pads' friction, their
+    compliance kept, none included; a clamp's column leaves the pads as they are (SI: N, m/N)."""
     friction, clamp = BY_KEY["pad_friction_n"], BY_KEY["clamp_lateral_mm_per_kn"]
     ideal = with_element(RigMechanics(), friction, 10.0)
     assert (ideal.pad_friction_n, ideal.pad_compliance_m_per_n) == (10.0, pytest.approx(3.5e-6, rel=1e-12))
     stated = with_element(RigMechanics(pad_friction_n=4.0, pad_compliance_m_per_n=2e-6), friction, 10.0)
     assert (stated.pad_friction_n, stated.pad_compliance_m_per_n) == (14.0, 2e-6)
+    rigid = with_element(RigMechanics(pad_friction_n=4.0), friction, 10.0)
+    assert (rigid.pad_friction_n, rigid.pad_compliance_m_per_n) == (14.0, 0.0)
     clamped = with_element(RigMechanics(), clamp, 0.01)
     assert clamped.clamp_lateral_m_per_n == pytest.approx(1e-8, rel=1e-12)
     assert (clamped.pad_friction_n, clamped.pad_compliance_m_per_n) == (0.0, 0.0)

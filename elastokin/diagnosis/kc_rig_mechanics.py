@@ -46,7 +46,7 @@ class Element:
     nominal: float    #: the value its column's run adds to the scenario's rig [unit]
     bound: float      #: the largest value fitted [unit]: a rig's, generously
     floor: float      #: a value worth a word beyond this [unit] (and 3 standard uncertainties)
-    beside: tuple[tuple[str, float], ...] = ()  #: (rig file key, value) its column's run sets where the rig has none
+    beside: tuple[tuple[str, float], ...] = ()  #: (rig file key, value) its column's run sets where the rig has neither
     proportional: bool = True   #: whether its effect is, to first order, proportional to its value
 
 
@@ -66,9 +66,10 @@ BY_KEY = {e.key: e for e in ELEMENTS}
 
 def with_element(rig: RigMechanics, element: Element, value: float) -> RigMechanics:
     """``rig`` with ``value`` [the element's unit] added to the element, and what it acts beside
-    (:attr:`Element.beside`) set where ``rig`` has none."""
+    (:attr:`Element.beside`) set where ``rig`` has neither (a rig stating the element keeps its own)."""
     name, si, _, _ = KEYS[element.key]
-    beside = {KEYS[key][0]: v * KEYS[key][1] for key, v in element.beside if not getattr(rig, KEYS[key][0])}
+    beside = {KEYS[key][0]: v * KEYS[key][1] for key, v in element.beside
+              if not getattr(rig, name) and not getattr(rig, KEYS[key][0])}
     return replace(rig, **{name: getattr(rig, name) + value * si}, **beside)
 
 
