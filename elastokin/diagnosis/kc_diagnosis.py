@@ -212,6 +212,7 @@ def _diagnosis(layout: Layout, vehicle: VehicleDefinition, pool: Executor, say: 
     heldout = split(len(layout.tests))
     training = [i for i in every if not heldout[i]]
     candidates = hypotheses(vehicle)
+
     def runs(sets: list[tuple[str, list[Job], Sequence[int]]]) -> list[np.ndarray]:
         """The compared rows of each set of runs (what it is, its jobs, the tests they run: NaN
         elsewhere), all in parallel."""
