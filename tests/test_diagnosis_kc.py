@@ -40,7 +40,6 @@ from elastokin.diagnosis.kc_fits import (Candidate, fit, fit_pair, halfway, nomi
 from elastokin.diagnosis.kc_scorer import Scorer
 from elastokin.diagnosis.kc_layout import Layout, Test
 from elastokin.diagnosis.kc_rig_mechanics import BY_KEY
-from elastokin.diagnosis.kc_rig_or_car import rig_or_car
 from elastokin.diagnosis.verdict import Separation, pair_named, split, told_apart
 from elastokin.diagnosis.rig_chain import DRAWN, GROUPS, draw_chain, draw_rig
 from elastokin.diagnosis.virtual_kc_rig import DEFAULT_SCENARIOS, measure_kc, parse_kc_truth
@@ -830,32 +829,3 @@ def test_a_damaged_dataset_used_as_it_is_still_names_its_cause(tmp_path):
     write_report(result, load_vehicle(DEFAULT_VEHICLE), tmp_path / "report", str(folder))
     assert "**Diagnosed on a damaged dataset**" in (tmp_path / "report" / "report.md").read_text()
 
-
-def test_a_rig_error_a_car_cause_would_explain_as_well_is_said_with_it():
-    """A channel reading 2 % high (its transducer's gain) where one hypothesis's effect is that very
-    scaling and another's moves the other channel too: the gain is taken out, and the first is said to
-    explain it as well (at the value that scales its effect to it), the second not; with the rival's
-    effect on a second channel beyond the noise, nothing is said."""
-    rng = np.random.default_rng(5)
-    t = np.linspace(0.0, 1.0, 4000)
-    base = np.column_stack([np.sin(2 * np.pi * t), np.cos(3 * np.pi * t)])
-    measured = base * [1.02, 1.0] + 0.002 * rng.standard_normal(base.shape)
-    tests = [Test(name, None, rows, np.arange(1000), True)
-             for name, rows in zip("abcd", np.split(np.arange(4000), 4))]
-    layout = Layout(["c_x", "c_y"], measured, np.zeros(4000), np.zeros(4000, dtype=int), np.repeat(np.arange(4), 1000),
-                    tests)
-    heldout = split(4)
-    own = lambda k: np.where(np.arange(2) == k, base, 0.0)
-    scorer = Scorer(layout, base, heldout, {("gain", "c_x", None): own(0), ("gain", "c_y", None): own(1)})
-    readings = scorer.transducers(base)
-    assert readings[0].value == pytest.approx(0.02, abs=1e-3) and readings[0].said and not readings[1].said
-    nominal_offset = 2.0
-    alike_h = Hypothesis("hardpoint", ("front", "lower_ball_joint", "z"), {"offset": nominal_offset})
-    apart = Hypothesis("hardpoint", ("front", "tie_rod_inner", "z"), {"offset": nominal_offset})
-    effect = 0.01 * own(0)   # the nominal offset scales c_x by 1 %
-    screened = [(alike_h, base + effect), (apart, base + effect + 0.01 * own(1))]
-    (said,) = rig_or_car(scorer, base, readings, screened, base)
-    assert [h.location for h in said.rivals] == [alike_h.location]
-    assert said.rivals[0].values["offset"] == pytest.approx(2.0 * nominal_offset, rel=0.05)
-    assert said.readings == (readings[0],) and said.error_held > 1.5 > said.error_rivals[0]
-    assert rig_or_car(scorer, base, readings, screened[1:], base) == []

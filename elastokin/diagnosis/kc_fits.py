@@ -73,27 +73,26 @@ def fit(h: Hypothesis, signature: np.ndarray, base: np.ndarray, scorer: Scorer,
     first = params[0]
     at = dict(h.values)
     train = ~scorer.held_rows
-    mismatch = scorer.residual(base, train).ravel()
-    # the signature and the slope in noise units (the residual is affine in the prediction)
-    columns = [mismatch - scorer.residual(base + d, train).ravel() for d in (signature, slope) if d is not None]
-    gram = _gram(columns)
-    if len(columns) == 2 and _alike(gram):
-        columns, gram = columns[:1], gram[:1, :1]   # the second parameter changes nothing the first does not
-    coef = np.linalg.solve(gram, [float(np.dot(c, mismatch)) for c in columns]) if gram[0, 0] > 0.0 \
-        else np.zeros(len(columns))
+    effects = [d for d in (signature, slope) if d is not None]
+    limits = np.array([(-math.inf, math.inf)] + [np.subtract(_side_bounds(params[1], at[first.name]),
+                                                             at[params[1].name]) for _ in effects[1:]])
+    coef, left, columns = scorer.fit_effects(base, effects, train, limits)
+    if len(columns) == 2 and _alike(_gram([c.ravel() for c in columns])):
+        # the second parameter changes nothing the first does not
+        effects, limits = effects[:1], limits[:1]
+        coef, left, columns = scorer.fit_effects(base, effects, train, limits)
     std = {}
     if len(columns) == 2:
         second = params[1]
-        moved = float(np.clip(at[second.name] + coef[1], *_side_bounds(second, at[first.name])))
-        coef[1] = moved - at[second.name]
-        coef[0] = float(np.dot(columns[0], mismatch - coef[1] * columns[1])) / gram[0, 0]
-        at[second.name] = moved
-    var = scorer.variances(mismatch - sum(c * x for c, x in zip(coef, columns)), columns, train)
+        at[second.name] = float(np.clip(at[second.name] + coef[1], *_side_bounds(second, at[first.name])))
+    var = scorer.variances(left.ravel(), [c.ravel() for c in columns], train)
     if len(columns) == 2:
         std[params[1].name] = math.sqrt(var[1])
     value, std[first.name], scale = scaled_magnitude(first, at[first.name], coef[0], math.sqrt(var[0]))
-    rest = sum(c * x for c, x in zip(coef[1:], columns[1:]))
-    trained = float(math.sqrt(np.mean((mismatch - scale * columns[0] - rest) ** 2)))
+    if not math.isclose(scale, coef[0], rel_tol=1e-9):   # held where its bounds allow, the rest refitted
+        limits[0] = scale
+        _, left, _ = scorer.fit_effects(base, effects, train, limits)
+    trained = float(math.sqrt(np.mean(left ** 2)))
     return Candidate(replace(h, values={**at, first.name: value}), math.nan, std, screened_error=trained,
                      z=separation(first, value, std[first.name]))
 
@@ -106,27 +105,23 @@ def fit_pair(first: Candidate, second: Candidate, base: np.ndarray, scorer: Scor
     that parameter too, linearly along it, as :func:`fit` does: the second cause with the first, as
     refitted, ``beside`` it; None when the two effects are alike on the campaign (nothing to refit)."""
     train = ~scorer.held_rows
-    mismatch = scorer.residual(base, train).ravel()
-    columns = [mismatch - scorer.residual(rows, train).ravel() for rows in (first.simulated, second.simulated)]
-    columns[1] = columns[1] - columns[0]     # the second's own effect
-    gram = _gram(columns)
-    if _alike(gram):
+    free = (-math.inf, math.inf)
+    effects, limits = [first.simulated - base, second.simulated - first.simulated], np.array([free, free])
+    coef, left, columns = scorer.fit_effects(base, effects, train, limits)   # the second's effect: its own
+    if _alike(_gram([c.ravel() for c in columns])):
         return None                          # the two act alike on the campaign: nothing to refit
     at = dict(second.hypothesis.values)
     extra = {}
     if slope is not None:
-        shape = mismatch - scorer.residual(base + slope, train).ravel()
-        wide = _gram([*columns, shape])
-        if not _alike(wide):   # else it changes nothing the two do not
-            coef = np.linalg.solve(wide, [float(np.dot(c, mismatch)) for c in (*columns, shape)])
-            magnitude, shape_p = parameters(second.hypothesis.cause)[:2]
-            moved = float(np.clip(at[shape_p.name] + coef[2], *_side_bounds(shape_p, at[magnitude.name])))
-            mismatch = mismatch - (moved - at[shape_p.name]) * shape   # the magnitudes refitted given it
-            extra = {shape_p.name: math.sqrt(scorer.variances(mismatch - coef[:2] @ np.array(columns),
-                                                               [*columns, shape], train)[2])}
-            at[shape_p.name] = moved
-    coef = np.linalg.solve(gram, [float(np.dot(c, mismatch)) for c in columns])
-    sd = np.sqrt(scorer.variances(mismatch - coef @ np.array(columns), columns, train))
+        magnitude, shape_p = parameters(second.hypothesis.cause)[:2]
+        wide = np.vstack([limits, np.subtract(_side_bounds(shape_p, at[magnitude.name]), at[shape_p.name])])
+        shaped = scorer.fit_effects(base, [*effects, slope], train, wide)
+        if not _alike(_gram([c.ravel() for c in shaped[2]])):   # else it changes nothing the two do not
+            coef, left, columns = shaped
+            effects, limits = [*effects, slope], wide
+            extra = {shape_p.name: math.sqrt(scorer.variances(left.ravel(), [c.ravel() for c in columns], train)[2])}
+            at[shape_p.name] = float(np.clip(at[shape_p.name] + coef[2], *_side_bounds(shape_p, at[magnitude.name])))
+    sd = np.sqrt(scorer.variances(left.ravel(), [c.ravel() for c in columns[:2]], train))
     out, scales = [], []
     for c, k, s in zip((first, second), coef, sd):
         p = parameters(c.hypothesis.cause)[0]
@@ -138,7 +133,9 @@ def fit_pair(first: Candidate, second: Candidate, base: np.ndarray, scorer: Scor
                               p.name: max(std, abs(value - values[p.name])) if c is first else std},
                              z=separation(p, value, std)))
         scales.append(scale)
-    left = mismatch - scales[0] * columns[0] - scales[1] * columns[1]
+    if not np.allclose(scales, coef[:2], rtol=1e-9, atol=0.0):   # held where their bounds allow, the rest refitted
+        limits[:2] = np.array(scales)[:, None]
+        _, left, _ = scorer.fit_effects(base, effects, train, limits)
     out[1].screened_error = float(math.sqrt(np.mean(left ** 2)))
     out[1].beside = out[0]
     return out[1]

@@ -104,8 +104,8 @@ class Scorer:
 
     def _fitted(self, r: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, Columns, np.ndarray]:
         """The residual ``r`` on the selected rows with the nuisance columns fitted out, the columns
-        and their coefficients. A rig input's gain is held within a calibrated rig's
-        (:data:`~elastokin.diagnosis.kc_transducers.INPUT_GAIN_BOUND`), a rig's mechanics between none
+        and their coefficients. A transducer's gain or cross-talk is held within a calibrated rig's
+        (:data:`~elastokin.diagnosis.kc_transducers.CALIBRATION_BOUND`), a rig's mechanics between none
         and a rig's most (:mod:`elastokin.diagnosis.kc_rig_mechanics`): beyond, one is held at its
         bound and the other columns refitted (:func:`~elastokin.diagnosis.kc_transducers.bounded_solve`),
         what is left being the car's."""
@@ -119,6 +119,28 @@ class Scorer:
         """(n, C) (measured − predicted (N, C)) / noise on the ``rows`` selected (N,) as :meth:`residual`
         has it before the nuisances are fitted out (each recording's ``zero``, their means, removed)."""
         return self._zeroed(self.layout.measured[rows] - self._delivered(predicted)[rows], rows, zero)
+
+    def fit_effects(self, predicted: np.ndarray, effects: Sequence[np.ndarray], rows: np.ndarray,
+                    limits: np.ndarray) -> tuple[np.ndarray, np.ndarray, list[np.ndarray]]:
+        """The coefficients (E,) of ``effects`` (each (N, C): a change of ``predicted``) fitted on the
+        selected ``rows`` jointly with the nuisances, each within its bounds and each effect's within
+        ``limits`` (E, 2) (:func:`~elastokin.diagnosis.kc_transducers.bounded_solve`): what the
+        prediction moved by them leaves (n, C), and each effect as the residual sees it with the
+        nuisances' span projected out (n, C) (its uncertainty's column). Fitted jointly, not each
+        effect's residual apart: a transducer's error at its bound in one and within it in the other
+        would take a share of the effect (a hardpoint's tilt of camber as the camber heads' gain)."""
+        m = self.raw(predicted, rows)
+        stack, gram, inverse = self._nuisance(rows)
+        seen = [m - self.raw(predicted + e, rows) for e in effects]   # the residual is affine in the prediction
+        cross = np.array([stack.products(d) for d in seen]).reshape(len(seen), len(stack))
+        own = np.array([[float(np.sum(a * b)) for b in seen] for a in seen])
+        matrix = np.block([[gram, cross.T], [cross, own]])
+        both = np.concatenate([stack.products(m), [float(np.sum(d * m)) for d in seen]])
+        coef = bounded_solve(matrix, both, np.vstack([self._column_bounds(len(stack)), limits]))
+        k = len(stack)
+        left = m - stack.combine(coef[:k]).reshape(m.shape) - sum(c * d for c, d in zip(coef[k:], seen))
+        projected = [d - stack.combine(inverse @ x).reshape(m.shape) for d, x in zip(seen, cross)]
+        return coef[k:], left, projected
 
     def nuisances(self, rows: np.ndarray) -> tuple[Columns, np.ndarray, np.ndarray, np.ndarray, list[Key | None]]:
         """The nuisance columns on the selected rows as :meth:`residual` fits them out; their Gram
@@ -163,7 +185,8 @@ class Scorer:
         first = len(stack) - len(self._transducers)
         joint = stack.extended([self._zeroed(self._delivered(e), every, np.mean) for e in effects])
         std = np.sqrt(self.variances(left, joint, every))[first:len(stack)]
-        return [reading(key, float(at + coef[first + k]), float(s))
+        held = coef[first:] != np.clip(coef[first:], self._bounds[:, 0] + 1e-12, self._bounds[:, 1] - 1e-12)
+        return [reading(key, float(at + coef[first + k]), float(s), bool(held[k] and at + coef[first + k] != 0.0))
                 for k, (key, at, s) in enumerate(zip(self._transducers, self._at, std))]
 
     def variances(self, residual: np.ndarray, columns: list[np.ndarray] | Columns, rows: np.ndarray,

@@ -101,9 +101,9 @@ def summary(d: KCDiagnosis) -> dict[str, Any]:
                          "cutoff_hz": r.cutoff_hz or None, "delay_ms": 1e3 * r.delay_s, "delay_std_ms": 1e3 * r.std_s}
                         for r in d.responses],
         "transducers": [{"kind": g.kind, "channel": g.channel, "source": g.source, "value": g.value,
-                         "std": _finite(g.std)} for g in d.transducers if g.kind != RIG],
-        "rig": [{"element": g.channel, "value": g.value, "std": _finite(g.std), "unit": BY_KEY[g.channel].unit}
-                for g in d.transducers if g.kind == RIG],
+                         "std": _finite(g.std), "at_bound": g.at_bound} for g in d.transducers if g.kind != RIG],
+        "rig": [{"element": g.channel, "value": g.value, "std": _finite(g.std), "unit": BY_KEY[g.channel].unit,
+                 "at_bound": g.at_bound} for g in d.transducers if g.kind == RIG],
         "rig_or_car": [{"group": c.group, "readings": [f"{g.label} {g.text}" for g in c.readings],
                         "rivals": [{"cause": h.cause, "location": h.location_json(), "parameters": dict(h.values)}
                                    for h in c.rivals],
@@ -344,7 +344,8 @@ def write_report(d: KCDiagnosis, baseline: VehicleDefinition, out_dir: Path, dat
         report.paragraph("The transducers' errors fitted with every hypothesis (`elastokin/diagnosis/kc_transducers.py`): "
                          "each moved rig input's gain g (it reads (1 + g) × the truth; the car got the command / (1 + g)), "
                          "and each measured channel's gain or cross-talk the data show:")
-        report.table(("transducer", "value [%]"), [(g.label, f"{100 * g.value:+.3f} ± {100 * g.std:.2g}") for g in shown])
+        report.table(("transducer", "value [%]"), [(g.label, f"{100 * g.value:+.3f} ± {100 * g.std:.2g}"
+                                                    + (" (at its bound)" if g.at_bound else "")) for g in shown])
     mechanics = [g for g in d.transducers if g.kind == RIG]
     if mechanics:
         report.paragraph("The rig's own mechanics fitted with every hypothesis (`elastokin/diagnosis/kc_rig_mechanics.py`): "
