@@ -105,8 +105,8 @@ def test_a_rig_element_linearised_at_a_value_reads_and_is_bounded_from_it():
 
     at = {"pad_friction_n": 20.0}
     for truth in (12.0, 0.0):
-        (friction,) = scorer(truth, at).transducers(base)
+        (friction,) = scorer(truth, at).rig_errors(base)
         assert friction.value == pytest.approx(truth, abs=3.0 * friction.std) and 0.0 < friction.std < 0.01
-    assert scorer(-10.0, at).transducers(base)[0].value == 0.0
-    assert scorer(12.0, None).transducers(base)[0].value == 0.0
+    assert scorer(-10.0, at).rig_errors(base)[0].value == 0.0
+    assert scorer(12.0, None).rig_errors(base)[0].value == 0.0
     assert scorer(12.0, at).nuisances(np.ones(2000, dtype=bool))[3][-1] == -20.0

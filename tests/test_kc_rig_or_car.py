@@ -38,7 +38,7 @@ def test_a_rig_error_a_car_cause_would_explain_as_well_is_said_with_it():
     channel's gain held where the data have it, at none); with the rival's effect on a second channel
     beyond the noise, nothing is said."""
     scorer, base = campaign(["c_x", "c_y"], [1.02, 1.0])
-    readings = scorer.transducers(base)
+    readings = scorer.rig_errors(base)
     assert readings[0].value == pytest.approx(0.02, abs=1e-3) and readings[0].said and not readings[1].said
     alike_h = Hypothesis("hardpoint", ("front", "lower_ball_joint", "z"), {"offset": NOMINAL_OFFSET_MM})
     apart = Hypothesis("hardpoint", ("front", "tie_rod_inner", "z"), {"offset": NOMINAL_OFFSET_MM})
@@ -56,7 +56,7 @@ def test_each_family_of_rig_errors_is_held_apart_from_the_others():
     by 1 % per 2 mm is said to explain the camber heads' gains (both, at 4 mm), though it explains
     nothing of the toe head's, which stays taken out beside it; the toe head's family has no rival."""
     scorer, base = campaign(["camber_fl", "camber_fr", "toe_fl"], [1.02, 1.02, 0.98])
-    readings = scorer.transducers(base)
+    readings = scorer.rig_errors(base)
     assert [round(g.value, 3) for g in readings] == [0.02, 0.02, -0.02] and all(g.said for g in readings)
     strut = Hypothesis("hardpoint", ("front", "strut_top", "y"), {"offset": NOMINAL_OFFSET_MM})
     (said,) = rig_or_car(scorer, base, readings, [(strut, base + 0.01 * base * [1.0, 1.0, 0.0])], base)
@@ -73,7 +73,7 @@ def test_a_transducer_error_beyond_a_calibrated_rigs_is_held_at_its_bound(sign):
     for the car's causes (the 1.5 % beyond the bound: 0.015 of the response's RMS over the noise);
     a channel 1 % off is read at its value."""
     scorer, base = campaign(["c_x", "c_y"], [1.0 + sign * 0.04, 1.0 + sign * 0.01])
-    far, near = scorer.transducers(base)
+    far, near = scorer.rig_errors(base)
     assert far.value == sign * CALIBRATION_BOUND and far.at_bound and "at its bound" in far.text
     assert near.value == pytest.approx(sign * 0.01, abs=5 * near.std) and not near.at_bound
     left = scorer.residual(base, np.ones(4000, dtype=bool))

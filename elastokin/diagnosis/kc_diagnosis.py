@@ -132,7 +132,7 @@ class KCDiagnosis(Outcome):
     #: the rig's errors (the moved rig inputs' gains, the measured channels' gains and cross-talk,
     #: the rig's own mechanics), fitted beside the final model and taken out of every comparison
     #: (:mod:`elastokin.diagnosis.kc_transducers`, :mod:`elastokin.diagnosis.kc_rig_mechanics`)
-    transducers: list[Reading] = field(default_factory=list)
+    rig_errors: list[Reading] = field(default_factory=list)
     #: the rig errors taken out that car causes would explain as well (:mod:`elastokin.diagnosis.kc_rig_or_car`)
     rig_or_car: list[RigOrCar] = field(default_factory=list)
 
@@ -195,7 +195,7 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, executor: Execut
     layout = Layout.of(data, vehicle)
     with nullcontext(executor) if executor is not None else open_executor() as pool:
         out = _diagnosis(layout, vehicle, pool, say, started)
-        at = not_proportional({g.channel: g.value for g in out.transducers if g.kind == RIG and g.said})
+        at = not_proportional({g.channel: g.value for g in out.rig_errors if g.kind == RIG and g.said})
         if at:
             say(f"the rig shows {', '.join(f'{BY_KEY[k].label} {v:.3g} {BY_KEY[k].unit}' for k, v in at.items())}, "
                 f"not proportional in its effect: every run again on a rig with it")
@@ -333,11 +333,11 @@ def _diagnosis(layout: Layout, vehicle: VehicleDefinition, pool: Executor, say: 
     out.responses = scorer.responses(out.final.simulated if out.named else base)
     out.noise_model = scorer.noise_model
     model = out.final.simulated if out.named else base
-    out.transducers = scorer.transducers(model, _effects(out, base))
-    for g in out.transducers:
+    out.rig_errors = scorer.rig_errors(model, _effects(out, base))
+    for g in out.rig_errors:
         if g.said:
             say(f"{g.label}: {g.text} (taken out)")
-    out.rig_or_car = rig_or_car(scorer, model, out.transducers, list(zip(candidates, signatures)), base,
+    out.rig_or_car = rig_or_car(scorer, model, out.rig_errors, list(zip(candidates, signatures)), base,
                                 [c.hypothesis for c in out.causes])
     for c in out.rig_or_car:
         say(f"what {c.group} took out, {' or '.join(h.label for h in c.rivals)} would explain as well "

@@ -173,9 +173,9 @@ class Scorer:
                                     float(delay - a), std))
         return out
 
-    def transducers(self, predicted: np.ndarray, effects: Sequence[np.ndarray] = ()) -> list[Reading]:
-        """Each transducer error fitted beside ``predicted`` (all rows), with its standard
-        uncertainty (fitted with the acquisition's taps and with the named causes, whose
+    def rig_errors(self, predicted: np.ndarray, effects: Sequence[np.ndarray] = ()) -> list[Reading]:
+        """Each rig error (a transducer's, an element of the rig's mechanics) fitted beside
+        ``predicted`` (all rows), with its standard uncertainty (fitted with the acquisition's taps and with the named causes, whose
         ``effects`` on the rows (N, C) in ``predicted`` are scaled with the errors: a cause that acts
         on the campaign much as an error does leaves both uncertain; the residual's correlation counted)."""
         if not self._transducers:

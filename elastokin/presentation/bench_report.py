@@ -16,7 +16,8 @@ from elastokin.diagnosis.bench_diagnosis import BenchDiagnosis, Candidate, aggre
 from elastokin.diagnosis.catalogue import PAIR_SEPARATOR, Cause, parts
 from elastokin.diagnosis.verdict import MIN_GAIN
 from elastokin.core.units import MM_PER_M
-from elastokin.presentation.diagnosis_report import Report, partly_explained, ranking_chart, separation_clause
+from elastokin.presentation.diagnosis_report import (Report, finite, partly_explained, ranking_chart,
+                                                     separation_clause)
 from elastokin.presentation.figures import save_figure
 
 #: Held-out records overlaid in the report (the largest baseline errors first).
@@ -41,16 +42,15 @@ def _parameters(d: BenchDiagnosis, cause: Cause | None = None) -> dict[str, Any]
     """The named causes' fitted values (of ``cause`` only, one of them, if given)."""
     if not d.named:
         return {}
-    # an uncertainty the tests cannot bound (a parameter they do not see) is null: JSON has no infinity
-    std = lambda name: d.best.std.get(name) if math.isfinite(d.best.std.get(name, math.nan)) else None
-    return {p.name: {"value": d.best.final[p.name], "std": std(p.name), "unit": p.unit}
+    # an uncertainty the tests cannot bound (a parameter they do not see) is null
+    return {p.name: {"value": d.best.final[p.name], "std": finite(d.best.std.get(p.name, math.nan)), "unit": p.unit}
             for p in (cause or d.best.cause).parameters}
 
 
 def _candidates(candidates: list[Candidate]) -> list[dict[str, Any]]:
     return [{"cause": c.cause.id, "heldout_error": c.heldout_error, "score": c.score,
              "n_parameters": len(c.cause.parameters), "parameters": c.values,
-             "two_fold_error": None if math.isnan(c.two_fold_error) else c.two_fold_error} for c in candidates]
+             "two_fold_error": finite(c.two_fold_error)} for c in candidates]
 
 
 def summary(d: BenchDiagnosis) -> dict[str, Any]:

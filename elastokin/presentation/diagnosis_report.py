@@ -5,6 +5,7 @@ written atomically; and the ranking's chart."""
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 from typing import Any, Iterable, Sequence
 
@@ -53,6 +54,12 @@ class Report:
                 tmp.write_text(text)
             written.append(out_dir / name)
         return written
+
+
+def finite(x: float) -> float | None:
+    """``x``, or None (JSON's null, which has no infinity) for a figure not bounded or not computed (an
+    uncertainty the tests do not bound, a training error no fit gave)."""
+    return x if math.isfinite(x) else None
 
 
 def ranking_chart(baseline: float, causes: Sequence[tuple[str, float]], floor: tuple[float, str], xlabel: str,

@@ -21,7 +21,8 @@ from elastokin.diagnosis.kc_noise import coloured_noise
 from elastokin.diagnosis.kc_rig_mechanics import BY_KEY, RIG
 from elastokin.diagnosis.kc_transducers import INPUT_GAIN
 from elastokin.diagnosis.verdict import MISFIT_CHANCE, NOISE_FACTOR, Separation
-from elastokin.presentation.diagnosis_report import Report, partly_explained, ranking_chart, separation_clause
+from elastokin.presentation.diagnosis_report import (Report, finite, partly_explained, ranking_chart,
+                                                     separation_clause)
 from elastokin.presentation.figures import save_figure
 from elastokin.vehicle.scenarios.channels import channel_quantity
 
@@ -47,16 +48,10 @@ def _candidate(c: Candidate) -> dict[str, Any]:
             "parameters": dict(c.hypothesis.values)}
 
 
-def _finite(x: float) -> float | None:
-    """``x``, or None (JSON's null, which has no infinity) for a figure not bounded or not computed (an
-    uncertainty the campaign does not bound, a training error no fit gave)."""
-    return x if math.isfinite(x) else None
-
-
 def _training_error(c: Candidate) -> float | None:
     """The linearised fit's RMS on the training tests; None for a candidate no such fit gave (a pair
     refit's halved step, :func:`elastokin.diagnosis.kc_fits.halfway`), which only its runs scored."""
-    return _finite(c.screened_error)
+    return finite(c.screened_error)
 
 
 def _run_with(d: KCDiagnosis, c: Candidate) -> list[Hypothesis]:
@@ -101,9 +96,9 @@ def summary(d: KCDiagnosis) -> dict[str, Any]:
                          "cutoff_hz": r.cutoff_hz or None, "delay_ms": 1e3 * r.delay_s, "delay_std_ms": 1e3 * r.std_s}
                         for r in d.responses],
         "transducers": [{"kind": g.kind, "channel": g.channel, "source": g.source, "value": g.value,
-                         "std": _finite(g.std), "at_bound": g.at_bound} for g in d.transducers if g.kind != RIG],
-        "rig": [{"element": g.channel, "value": g.value, "std": _finite(g.std), "unit": BY_KEY[g.channel].unit,
-                 "at_bound": g.at_bound} for g in d.transducers if g.kind == RIG],
+                         "std": finite(g.std), "at_bound": g.at_bound} for g in d.rig_errors if g.kind != RIG],
+        "rig": [{"element": g.channel, "value": g.value, "std": finite(g.std), "unit": BY_KEY[g.channel].unit,
+                 "at_bound": g.at_bound} for g in d.rig_errors if g.kind == RIG],
         "rig_or_car": [{"group": c.group, "readings": [f"{g.label} {g.text}" for g in c.readings],
                         "rivals": [{"cause": h.cause, "location": h.location_json(), "parameters": dict(h.values)}
                                    for h in c.rivals],
@@ -186,8 +181,8 @@ def _acquisition_sentence(d: KCDiagnosis) -> str:
 def _transducers_sentence(d: KCDiagnosis) -> str:
     """Which transducers the data show misreading, and what of the rig's own mechanics they show, if any
     (over the scenarios' own ``rig``, when they state one: the columns move it from there)."""
-    said = [g for g in d.transducers if g.said and g.kind != RIG]
-    mechanics = [g for g in d.transducers if g.said and g.kind == RIG]
+    said = [g for g in d.rig_errors if g.said and g.kind != RIG]
+    mechanics = [g for g in d.rig_errors if g.said and g.kind == RIG]
     out = "" if not said else (
         " The rig's transducers misread: " + ", ".join(f"{g.label} {g.text}" for g in said)
         + " (fitted with every hypothesis and taken out; a cause acting on the campaign as such an error does "
@@ -339,14 +334,14 @@ def write_report(d: KCDiagnosis, baseline: VehicleDefinition, out_dir: Path, dat
     report.table(("path", "channels", "lag at low frequency [ms]", "low-pass [Hz]", "delay [ms]"),
                  [(r.path, f"{len(r.channels)}", f"{1e3 * r.lag_s:.2f}", f"{r.cutoff_hz:.3g}" if r.cutoff_hz else "none",
                    f"{1e3 * r.delay_s:.2f} ± {1e3 * r.std_s:.2g}") for r in d.responses])
-    shown = [g for g in d.transducers if g.kind == INPUT_GAIN or (g.said and g.kind != RIG)]
+    shown = [g for g in d.rig_errors if g.kind == INPUT_GAIN or (g.said and g.kind != RIG)]
     if shown:
         report.paragraph("The transducers' errors fitted with every hypothesis (`elastokin/diagnosis/kc_transducers.py`): "
                          "each moved rig input's gain g (it reads (1 + g) × the truth; the car got the command / (1 + g)), "
                          "and each measured channel's gain or cross-talk the data show:")
         report.table(("transducer", "value [%]"), [(g.label, f"{100 * g.value:+.3f} ± {100 * g.std:.2g}"
                                                     + (" (at its bound)" if g.at_bound else "")) for g in shown])
-    mechanics = [g for g in d.transducers if g.kind == RIG]
+    mechanics = [g for g in d.rig_errors if g.kind == RIG]
     if mechanics:
         report.paragraph("The rig's own mechanics fitted with every hypothesis (`elastokin/diagnosis/kc_rig_mechanics.py`): "
                          "its floating pads' friction and its body clamp's compliance, each from none to a rig's most:")

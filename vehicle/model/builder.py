@@ -235,16 +235,14 @@ class _Builder:
 
     def clamp(self, chassis):
         """The body clamp's compliant directions (:meth:`RigMechanics.clamp`): a joint each at the
-        body's centre of mass, its spring the clamp's, critically damped on the body alone (its lag,
-        c/k, a few ms: nothing at the rig's rates)."""
+        body's centre of mass, its spring the clamp's, critically damped on the body alone."""
         body = self.v.body
         for kind, axis, compliance in self.o.rig_mechanics.clamp():
             i = "xyz".index(axis)
-            j = chassis.add_joint(name=f"clamp_{kind}_{axis}", pos=body.cg, axis=np.eye(3)[i],
-                                  type=mujoco.mjtJoint.mjJNT_SLIDE if kind == "slide" else mujoco.mjtJoint.mjJNT_HINGE)
-            k = 1.0 / compliance
-            j.stiffness = [k, 0.0, 0.0]
-            j.damping = [2.0 * math.sqrt(k * (body.mass if kind == "slide" else body.inertia[i])), 0.0, 0.0]
+            _compliant(chassis.add_joint(name=f"clamp_{kind}_{axis}", pos=body.cg, axis=np.eye(3)[i],
+                                         type=mujoco.mjtJoint.mjJNT_SLIDE if kind == "slide"
+                                         else mujoco.mjtJoint.mjJNT_HINGE),
+                       compliance, body.mass if kind == "slide" else body.inertia[i])
 
     def rack(self):
         f = self.v.front
@@ -438,11 +436,18 @@ class _Builder:
         top = f"pad_top_{corner}"
         self.body(pad, top, contact, np.eye(3), PAD_MASS, contact, [0.01] * 3, gravcomp=1.0)
         for axis, direction in (("x", [1, 0, 0]), ("y", [0, 1, 0])):
-            j = self.bodies[top].add_joint(name=f"pad_top_{axis}_{corner}", type=mujoco.mjtJoint.mjJNT_SLIDE,
-                                           axis=direction)
-            j.stiffness = [1.0 / compliance, 0.0, 0.0]
-            j.damping = [2.0 * math.sqrt(PAD_MASS / compliance), 0.0, 0.0]
+            _compliant(self.bodies[top].add_joint(name=f"pad_top_{axis}_{corner}", type=mujoco.mjtJoint.mjJNT_SLIDE,
+                                                  axis=direction), compliance, PAD_MASS)
         return top
+
+
+def _compliant(joint, compliance: float, inertia: float) -> None:
+    """Give ``joint`` (an MjSpec joint) a spring of ``compliance`` [m/N, or rad/(N·m) for a hinge],
+    critically damped on ``inertia`` alone [kg, or kg·m²]: a rig's stiff part, whose lag (c/k, a few
+    ms) is nothing at the rig's rates."""
+    k = 1.0 / compliance
+    joint.stiffness = [k, 0.0, 0.0]
+    joint.damping = [2.0 * math.sqrt(k * inertia), 0.0, 0.0]
 
 
 def build(vehicle: VehicleDefinition, options: BuildOptions = BuildOptions()) -> CarModel:
