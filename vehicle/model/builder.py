@@ -234,15 +234,12 @@ class _Builder:
                         self.cross)
 
     def clamp(self, chassis):
-        """The body clamp's compliant directions (:meth:`RigMechanics.clamp`): a joint each at the
-        body's centre of mass, its spring the clamp's, critically damped on the body alone."""
+        """The body clamp's compliant directions (:meth:`RigMechanics.clamp`): a joint each at the body's centre of mass."""
         body = self.v.body
         for kind, axis, compliance in self.o.rig_mechanics.clamp():
             i = "xyz".index(axis)
-            _compliant(chassis.add_joint(name=f"clamp_{kind}_{axis}", pos=body.cg, axis=np.eye(3)[i],
-                                         type=mujoco.mjtJoint.mjJNT_SLIDE if kind == "slide"
-                                         else mujoco.mjtJoint.mjJNT_HINGE),
-                       compliance, body.mass if kind == "slide" else body.inertia[i])
+            _compliant(chassis, compliance, body.mass if kind == "slide" else body.inertia[i], pos=body.cg,
+                       name=f"clamp_{kind}_{axis}", axis=np.eye(3)[i], type=getattr(mujoco.mjtJoint, f"mjJNT_{kind.upper()}"))
 
     def rack(self):
         f = self.v.front
@@ -427,27 +424,25 @@ class _Builder:
 
 
     def pad_float(self, pad: str, corner: str, contact) -> str:
-        """The body the pad's carriage floats on: the pad itself, or, for a compliant pad
-        (:attr:`RigMechanics.pad_compliance_m_per_n`), its top plate on x and y springs (critically
-        damped), so that the carriage's friction acts through the compliance."""
+        """The body the pad's carriage floats on: the pad itself, or, for a compliant pad (:attr:`RigMechanics.
+        pad_compliance_m_per_n`), its top plate on x and y springs, the carriage's friction acting through them."""
         compliance = self.o.rig_mechanics.pad_compliance_m_per_n
         if compliance == 0.0:
             return pad
         top = f"pad_top_{corner}"
         self.body(pad, top, contact, np.eye(3), PAD_MASS, contact, [0.01] * 3, gravcomp=1.0)
         for axis, direction in (("x", [1, 0, 0]), ("y", [0, 1, 0])):
-            _compliant(self.bodies[top].add_joint(name=f"pad_top_{axis}_{corner}", type=mujoco.mjtJoint.mjJNT_SLIDE,
-                                                  axis=direction), compliance, PAD_MASS)
+            _compliant(self.bodies[top], compliance, PAD_MASS, name=f"pad_top_{axis}_{corner}",
+                       type=mujoco.mjtJoint.mjJNT_SLIDE, axis=direction)
         return top
 
 
-def _compliant(joint, compliance: float, inertia: float) -> None:
-    """Give ``joint`` (an MjSpec joint) a spring of ``compliance`` [m/N, or rad/(N·m) for a hinge],
-    critically damped on ``inertia`` alone [kg, or kg·m²]: a rig's stiff part, whose lag (c/k, a few
-    ms) is nothing at the rig's rates."""
-    k = 1.0 / compliance
-    joint.stiffness = [k, 0.0, 0.0]
-    joint.damping = [2.0 * math.sqrt(k * inertia), 0.0, 0.0]
+def _compliant(body, compliance: float, inertia: float, **joint) -> None:
+    """A joint (its MjSpec attributes ``joint``) on ``body`` with a spring of ``compliance`` [m/N, rad/(N·m)],
+    critically damped on ``inertia`` alone [kg, kg·m²]: a rig's stiff part, its lag (c/k) a few ms."""
+    j = body.add_joint(**joint)
+    j.stiffness = [1.0 / compliance, 0.0, 0.0]
+    j.damping = [2.0 * math.sqrt(inertia / compliance), 0.0, 0.0]
 
 
 def build(vehicle: VehicleDefinition, options: BuildOptions = BuildOptions()) -> CarModel:
