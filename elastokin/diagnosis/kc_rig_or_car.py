@@ -6,15 +6,15 @@ The rig's errors are fitted with every hypothesis and take what they can explain
 car cause is named for what a rig error does. But a car cause can act on a campaign as a rig error
 does (a lower ball joint's height on camber as the camber heads' gain, a bushing's lateral stiffness
 on a lateral-force test as its load cells' gain): then the campaign cannot say which of the two it
-was, and the verdict must say so. For each family of rig errors the data show or hold at their bound
-(:func:`families`: the readings of one kind on one quantity, a camber head's gain on every wheel
-where it shows; a rig element alone), those readings are held at no error and every hypothesis of
-the screening is fitted in their stead on the training tests (its effect from its screening run, the
-acquisition's taps refitted with it, all in the nuisances' span: no run), the other rig errors held
-where the model has them: a rival explains what those readings took out, not what another wheel's or
-another kind's calibration would have to take in its stead. A hypothesis that explains what they
-explained as a cause must (:func:`elastokin.diagnosis.verdict.decide` against the model with them
-held) and that they do not beat as a cause must beat its rival, nor beats them
+was, and the verdict must say so. For each family of rig errors the data show (:func:`families`: the
+readings of one kind on one quantity, a camber head's gain on every wheel where it shows; a rig
+element alone), those readings are held at no error and every hypothesis of the screening is fitted
+in their stead on the training tests (its effect from its screening run, the acquisition's taps
+refitted with it, all in the nuisances' span: no run), the other rig errors held where the model has
+them: a rival explains what those readings took out, not what another wheel's or another kind's
+calibration would have to take in its stead. A hypothesis that explains what they explained as a
+cause must (:func:`elastokin.diagnosis.verdict.decide` against the model with them held) and that
+they do not beat as a cause must beat its rival, nor beats them
 (:func:`elastokin.diagnosis.verdict.told_apart`: one that explains more than they did is a cause
 missed, not their rival) is reported beside them with the check that separates them.
 """
@@ -67,14 +67,13 @@ class RigOrCar:
 
 
 def families(readings: Sequence[Reading]) -> list[tuple[str, str, tuple[Reading, ...]]]:
-    """The rig errors the data show (:attr:`Reading.said`, or held at their bound: the data would have
-    them beyond a calibrated rig's, as a car cause acting as one does) in families held together: the
-    readings of one kind on one quantity with one source (a camber head's gain, on every wheel where
-    it shows), a rig element alone; each as (what it is, the check that separates it from the car,
-    its readings most significant first)."""
+    """The rig errors the data show (:attr:`Reading.said`) in families held together: the readings
+    of one kind on one quantity with one source (a camber head's gain, on every wheel where it
+    shows), a rig element alone; each as (what it is, the check that separates it from the car, its
+    readings most significant first)."""
     out: dict[tuple, list[Reading]] = {}
     for g in readings:
-        if g.said or g.at_bound:
+        if g.said:
             family = (g.kind, g.channel if g.kind == RIG else channel_quantity(g.channel), g.source)
             out.setdefault(family, []).append(g)
     said = []
