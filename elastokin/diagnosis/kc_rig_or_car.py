@@ -106,7 +106,8 @@ def rig_or_car(scorer: Scorer, model: np.ndarray, readings: Sequence[Reading],
     for what, remedy, shown in families(readings):
         held = bounds.copy()
         held[rig] = fitted_at[rig, None]
-        members = np.array([k in {(g.kind, g.channel, g.source) for g in shown} for k in keys], dtype=bool)
+        shown_keys = {(g.kind, g.channel, g.source) for g in shown}
+        members = np.array([k in shown_keys for k in keys], dtype=bool)
         held[members] = none[members, None]
         error_held = error(bounded_solve(gram, seen, held), gram, seen)
         if effects is None:

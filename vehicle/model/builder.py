@@ -424,8 +424,8 @@ class _Builder:
 
 
     def pad_float(self, pad: str, corner: str, contact) -> str:
-        """The body the pad's carriage floats on: the pad itself, or, for a compliant pad (:attr:`RigMechanics.
-        pad_compliance_m_per_n`), its top plate on x and y springs, the carriage's friction acting through them."""
+        """The body the pad's carriage floats on: the pad itself, or, for a compliant pad, its top plate
+        on x and y springs (:attr:`RigMechanics.pad_compliance_m_per_n`), the friction acting through them."""
         compliance = self.o.rig_mechanics.pad_compliance_m_per_n
         if compliance == 0.0:
             return pad
