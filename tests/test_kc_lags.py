@@ -85,6 +85,23 @@ def test_the_rigs_lags_are_recovered_and_the_residual_is_the_noise(seed):
     assert scorer.heldout_error(true) == pytest.approx(1.0, abs=0.05)
 
 
+def test_a_change_of_the_prediction_lowers_the_raw_residual_by_its_delivered_self():
+    """Through a chain's filters and delays the residual is affine in the prediction: the raw residual
+    of a prediction less that of the prediction plus a change is the change as the acquisition
+    delivers it (:meth:`Scorer.seen`), to rounding; a raw residual is handed out read-only, the same
+    one again for the same prediction."""
+    wheel, pad = ChannelChain(low_pass_hz=9.0, delay_ms=13.0), ChannelChain(low_pass_hz=20.0, delay_ms=2.0)
+    layout, true = _layout({0: wheel, 1: wheel, 2: wheel, 3: pad, 4: pad}, 4)
+    scorer = Scorer(layout, true, np.array([False, True, False, True]))
+    train = ~scorer.held_rows
+    change = np.random.default_rng(4).standard_normal(true.shape) * NOISE
+    base = scorer.raw(true, train)
+    assert scorer.raw(true, train) is base and not base.flags.writeable
+    seen = scorer.seen(change, train)
+    assert np.sqrt(np.mean(seen ** 2)) > 0.3   # a change the residual sees, in noise units
+    np.testing.assert_allclose(base - scorer.raw(true + change, train), seen, rtol=0.0, atol=1e-9)
+
+
 def test_a_cars_own_error_is_left_for_the_causes():
     """The toe 3 % and the pad load 2 % off their model (a car's error, not the rig's), measured
     through the same chain: the comparison still shows them, tens of times the noise."""

@@ -20,7 +20,8 @@ def test_the_bounded_fit_is_the_bounded_least_squares_optimum(seed):
     """On random problems with correlated columns, some bounded on one or both sides and some held
     (both bounds equal): within the bounds, and its squared error the bounded-variable least squares'
     (scipy's BVLS, written apart) to 1e-10 — where holding each out-of-bounds coefficient and refitting
-    the rest once pushes another out of its bounds (columns correlated at 0.9)."""
+    the rest once pushes another out of its bounds (columns correlated at 0.9); the same from a start
+    holding a random half at one of their limits (a screening starts each fit from the last's)."""
     rng = np.random.default_rng(seed)
     for _ in range(40):
         n, k = 80, int(rng.integers(2, 14))
@@ -38,6 +39,10 @@ def test_the_bounded_fit_is_the_bounded_least_squares_optimum(seed):
         ref = lsq_linear(a[:, free], b - a[:, held] @ x[held], bounds=(lo[free], hi[free]), method="bvls").x
         sse = lambda z: float(np.sum((a[:, free] @ z - (b - a[:, held] @ x[held])) ** 2))
         assert sse(x[free]) == pytest.approx(sse(ref), rel=1e-10)
+        start = np.where(rng.random(k) < 0.5, np.where(rng.random(k) < 0.5, lo, hi), np.nan)
+        y = bounded_solve(gram, seen, np.column_stack([lo, hi]), start=start)
+        assert np.all(y >= lo) and np.all(y <= hi) and np.all(y[held] == 0.1)
+        assert sse(y[free]) == pytest.approx(sse(ref), rel=1e-10)
 
 
 def test_one_channel_columns_act_as_their_dense_forms():

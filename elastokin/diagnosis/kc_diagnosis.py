@@ -194,20 +194,22 @@ def diagnose_kc(data: KCDataset, vehicle: VehicleDefinition, *, executor: Execut
     say = progress or (lambda _: None)
     layout = Layout.of(data, vehicle)
     with nullcontext(executor) if executor is not None else open_executor() as pool:
-        out = _diagnosis(layout, vehicle, pool, say, started)
+        out, explain = _diagnosis(layout, vehicle, pool, say)
         at = not_proportional({g.channel: g.value for g in out.rig_errors if g.kind == RIG and g.said})
         if at:
             say(f"the rig shows {', '.join(f'{BY_KEY[k].label} {v:.3g} {BY_KEY[k].unit}' for k, v in at.items())}, "
                 f"not proportional in its effect: every run again on a rig with it")
-            out = replace(_diagnosis(on_rig(layout, at), vehicle, pool, say, started, at), layout=layout)
-    return out
+            out, explain = _diagnosis(on_rig(layout, at), vehicle, pool, say, at)
+        explain()
+    return replace(out, layout=layout, wall_s=time.perf_counter() - started)
 
 
 def _diagnosis(layout: Layout, vehicle: VehicleDefinition, pool: Executor, say: Callable[[str], None],
-               started: float, rig_at: dict[str, float] | None = None) -> KCDiagnosis:
-    """:func:`diagnose_kc` with its runs on ``pool``, each test on its job's rig; ``rig_at``: the
-    rig elements' values [their units] that rig adds to the scenarios' (their columns then the
-    change from them)."""
+               rig_at: dict[str, float] | None = None) -> tuple[KCDiagnosis, Callable[[], None]]:
+    """:func:`diagnose_kc`'s verdict with its runs on ``pool``, each test on its job's rig; ``rig_at``:
+    the rig elements' values [their units] that rig adds to the scenarios' (their columns then the
+    change from them). With it, what explains the verdict that only the last pass needs (its rivals
+    run on the shipped tests, the rig errors car causes would explain as well), to call on it."""
     every = range(len(layout.tests))
     heldout = split(len(layout.tests))
     training = [i for i in every if not heldout[i]]
@@ -294,20 +296,7 @@ def _diagnosis(layout: Layout, vehicle: VehicleDefinition, pool: Executor, say: 
                 single = replace(single)
                 verify([single], rows([extended_vehicle(vehicle, [single.hypothesis])], every), scorer)
             alone = single.heldout_error
-    rivals: list[Candidate] = []
-    apart: list[Separation | None] = []
-    extra: list = []
-    if second is None and decide(before, best.heldout_error, 1.0) == "named":
-        rivals = alike(best, top, before)
-    if rivals:   # the shipped scenarios read only then
-        extra = extra_scenarios({t.job.scenario.name for t in layout.tests})
-        say(f"{best.hypothesis.label} cannot be told apart on these tests from "
-            f"{', '.join(c.hypothesis.label for c in rivals)}: both run on the {len(extra)} shipped tests the "
-            f"dataset lacks")
-        apart = separations([extended_vehicle(vehicle, [c.hypothesis]) for c in (best, *rivals)], extra,
-                            layout.channels, scorer.noise,
-                            float(np.median([t.job.duration_scale for t in layout.tests])),
-                            lambda jobs: pool.map(run_unless_diverged, jobs))
+    rivals = alike(best, top, before) if second is None and decide(before, best.heldout_error, 1.0) == "named" else []
     errors = scorer.test_errors(base)
     for m in found:
         say(f"the baseline does not fit {m.test}{' (held out)' if m.heldout else ''}: {m.error:.2f} × the noise, "
@@ -324,8 +313,7 @@ def _diagnosis(layout: Layout, vehicle: VehicleDefinition, pool: Executor, say: 
     for m in left:
         say(f"  with it, {m.test} is still not fitted: {m.error:.2f} × the noise")
     out = KCDiagnosis(verdict, best, top + screened[VERIFIED:], heldout, [t.name for t in layout.tests], errors,
-                      before, layout, scorer.noise, base, None, found, left, time.perf_counter() - started, pairs,
-                      second, alone, rivals, apart, len(extra))
+                      before, layout, scorer.noise, base, None, found, left, 0.0, pairs, second, alone, rivals)
     if verdict == "named":
         named = [c.hypothesis for c in out.causes]
         out.verdict = PAIR_SEPARATOR.join(h.cause for h in named)
@@ -337,12 +325,6 @@ def _diagnosis(layout: Layout, vehicle: VehicleDefinition, pool: Executor, say: 
     for g in out.rig_errors:
         if g.said:
             say(f"{g.label}: {g.text} (taken out)")
-    out.rig_or_car = rig_or_car(scorer, model, out.rig_errors, list(zip(candidates, signatures)), base,
-                                [c.hypothesis for c in out.causes])
-    for c in out.rig_or_car:
-        say(f"what {c.group} took out, {' or '.join(h.label for h in c.rivals)} would explain as well "
-            f"({c.error_held:.3f} -> {c.error:.3f} with it, {' and '.join(f'{e:.3f}' for e in c.error_rivals)} "
-            f"with them): this campaign cannot tell them apart")
     for q, (white, coloured, tau) in coloured_noise(layout.channels, scorer.noise_model).items():
         say(f"the {q} channels' noise is coloured: {coloured / white:.2g} × their white noise, correlated over "
             f"{tau:.2g} s (counted in the noise, its uncertainties and thresholds)")
@@ -350,7 +332,25 @@ def _diagnosis(layout: Layout, vehicle: VehicleDefinition, pool: Executor, say: 
         say(f"the {r.path}' channels lag the rig inputs by {1e3 * r.lag_s:.2f} ms at low frequency: "
             f"{f'a {r.cutoff_hz:.3g} Hz low-pass, then ' if r.cutoff_hz else ''}{1e3 * r.delay_s:.2f} ± "
             f"{1e3 * r.std_s:.2g} ms (taken out)")
-    return out
+
+    def explain() -> None:
+        if rivals:   # the shipped scenarios read only then
+            extra = extra_scenarios({t.job.scenario.name for t in layout.tests})
+            say(f"{best.hypothesis.label} cannot be told apart on these tests from "
+                f"{', '.join(c.hypothesis.label for c in rivals)}: both run on the {len(extra)} shipped tests the "
+                f"dataset lacks")
+            out.separations = separations([extended_vehicle(vehicle, [c.hypothesis]) for c in (best, *rivals)],
+                                          extra, layout.channels, scorer.noise,
+                                          float(np.median([t.job.duration_scale for t in layout.tests])),
+                                          lambda jobs: pool.map(run_unless_diverged, jobs))
+            out.extra_tests = len(extra)
+        out.rig_or_car = rig_or_car(scorer, model, out.rig_errors, list(zip(candidates, signatures)), base,
+                                    [c.hypothesis for c in out.causes])
+        for c in out.rig_or_car:
+            say(f"what {c.group} took out, {' or '.join(h.label for h in c.rivals)} would explain as well "
+                f"({c.error_held:.3f} -> {c.error:.3f} with it, {' and '.join(f'{e:.3f}' for e in c.error_rivals)} "
+                f"with them): this campaign cannot tell them apart")
+    return out, explain
 
 
 def _second_stage(best: Candidate, others: list[tuple[Hypothesis, np.ndarray]], base: np.ndarray, scorer: Scorer,

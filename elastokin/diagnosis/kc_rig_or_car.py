@@ -115,7 +115,7 @@ def rig_or_car(scorer: Scorer, model: np.ndarray, readings: Sequence[Reading],
             for h, rows in screened:
                 if any((h.cause, h.location) == (n.cause, n.location) for n in named):
                     continue
-                d = m - scorer.raw(model + (rows - base), train)
+                d = scorer.seen(rows - base, train)
                 effects.append((h, columns.products(d), float(np.sum(d * d)), float(np.sum(d * m))))
         tried = {}   # the best of each place (a cause screened on both signs is fitted from each)
         for h, products, dd, dm in effects:

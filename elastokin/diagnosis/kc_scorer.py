@@ -54,8 +54,11 @@ class Scorer:
         self._at = np.array([(rig_at or {}).get(key[1], 0.0) if key[0] == RIG else 0.0 for key in self._transducers])
         #: the bounds of the transducers' coefficients (a rig input's gain, a rig's mechanics: held within them)
         self._bounds = np.array([bounds(key) for key in self._transducers]).reshape(-1, 2) - self._at[:, None]
-        #: the last residual: (the prediction, its rows and zero, the residual), read-only
+        #: the last residual and raw residual: (the prediction, its rows and zero, the residual), read-only
         self._last: tuple[np.ndarray, tuple, np.ndarray] | None = None
+        self._last_raw: tuple[np.ndarray, tuple, np.ndarray] | None = None
+        #: per selection of rows, the nuisances' coefficients in its last fit (the next one's start)
+        self._held: dict[bytes, np.ndarray] = {}
 
     def _delivered(self, rows: np.ndarray) -> np.ndarray:
         return self.response.apply(rows, self.cutoffs_hz, self.delays_s)
@@ -112,13 +115,38 @@ class Scorer:
         stack, gram, inverse = self._nuisance(rows)
         if not len(stack):
             return r, stack, np.zeros(0)
-        coef = bounded_solve(gram, stack.products(r), self._column_bounds(len(stack)), inverse)
+        coef = self._solve(rows, gram, stack.products(r), self._column_bounds(len(stack)), inverse)
         return r - stack.combine(coef).reshape(r.shape), stack, coef
+
+    def _solve(self, rows: np.ndarray, matrix: np.ndarray, products: np.ndarray, limits: np.ndarray,
+               inverse: np.ndarray | None = None) -> np.ndarray:
+        """:func:`~elastokin.diagnosis.kc_transducers.bounded_solve` of the nuisances on the selected
+        ``rows`` (``matrix``'s first columns; any after them: a fit's effects), started from those
+        the last fit on these rows held at a limit (the same optimum, in a few steps, not dozens)."""
+        key = rows.tobytes()
+        last = self._held.get(key)
+        start = None if last is None else np.r_[last, np.full(len(products) - len(last), np.nan)]
+        coef = bounded_solve(matrix, products, limits, inverse, start)
+        self._held[key] = coef[:len(self._nuisance(rows)[0])]
+        return coef
 
     def raw(self, predicted: np.ndarray, rows: np.ndarray, zero: Callable[..., np.ndarray] = np.mean) -> np.ndarray:
         """(n, C) (measured − predicted (N, C)) / noise on the ``rows`` selected (N,) as :meth:`residual`
-        has it before the nuisances are fitted out (each recording's ``zero``, their means, removed)."""
-        return self._zeroed(self.layout.measured[rows] - self._delivered(predicted)[rows], rows, zero)
+        has it before the nuisances are fitted out (each recording's ``zero``, their means, removed);
+        read-only, the last one kept for the same prediction (a screening's fits share their base)."""
+        key = (rows.tobytes(), zero)
+        last = self._last_raw
+        if last is not None and last[0] is predicted and last[1] == key:
+            return last[2]
+        r = self._zeroed(self.layout.measured[rows] - self._delivered(predicted)[rows], rows, zero)
+        r.flags.writeable = False
+        self._last_raw = (predicted, key, r)
+        return r
+
+    def seen(self, change: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        """(n, C) how much a ``change`` (N, C) of any prediction lowers its :meth:`raw` residual (zeroed
+        by the recordings' means) on the selected ``rows``: the residual is affine in the prediction."""
+        return self._zeroed(self._delivered(change)[rows], rows, np.mean)
 
     def fit_effects(self, predicted: np.ndarray, effects: Sequence[np.ndarray], rows: np.ndarray,
                     limits: np.ndarray) -> tuple[np.ndarray, np.ndarray, list[np.ndarray]]:
@@ -131,12 +159,12 @@ class Scorer:
         would take a share of the effect (a hardpoint's tilt of camber as the camber heads' gain)."""
         m = self.raw(predicted, rows)
         stack, gram, inverse = self._nuisance(rows)
-        seen = [m - self.raw(predicted + e, rows) for e in effects]   # the residual is affine in the prediction
+        seen = [self.seen(e, rows) for e in effects]
         cross = np.array([stack.products(d) for d in seen]).reshape(len(seen), len(stack))
         own = np.array([[float(np.sum(a * b)) for b in seen] for a in seen])
         matrix = np.block([[gram, cross.T], [cross, own]])
         both = np.concatenate([stack.products(m), [float(np.sum(d * m)) for d in seen]])
-        coef = bounded_solve(matrix, both, np.vstack([self._column_bounds(len(stack)), limits]))
+        coef = self._solve(rows, matrix, both, np.vstack([self._column_bounds(len(stack)), limits]))
         k = len(stack)
         left = m - stack.combine(coef[:k]).reshape(m.shape) - sum(c * d for c, d in zip(coef[k:], seen))
         projected = [d - stack.combine(inverse @ x).reshape(m.shape) for d, x in zip(seen, cross)]
@@ -183,7 +211,7 @@ class Scorer:
         every = np.ones(len(predicted), dtype=bool)
         left, stack, coef = self._fitted(self.raw(predicted, every, np.mean), every)
         first = len(stack) - len(self._transducers)
-        joint = stack.extended([self._zeroed(self._delivered(e), every, np.mean) for e in effects])
+        joint = stack.extended([self.seen(e, every) for e in effects])
         std = np.sqrt(self.variances(left, joint, every))[first:len(stack)]
         held = coef[first:] != np.clip(coef[first:], self._bounds[:, 0] + 1e-12, self._bounds[:, 1] - 1e-12)
         return [reading(key, float(at + coef[first + k]), float(s), bool(held[k] and at + coef[first + k] != 0.0))

@@ -143,17 +143,21 @@ def reading(key: Key, coef: float, std: float, at_bound: bool = False) -> Readin
     return Reading(kind, channel, source, coef, std, at_bound)
 
 
-def bounded_solve(gram: np.ndarray, seen: np.ndarray, limits: np.ndarray, inverse: np.ndarray | None = None
-                  ) -> np.ndarray:
+def bounded_solve(gram: np.ndarray, seen: np.ndarray, limits: np.ndarray, inverse: np.ndarray | None = None,
+                  start: np.ndarray | None = None) -> np.ndarray:
     """The coefficients (K,) of columns (their ``gram`` matrix (K, K), their products ``seen`` (K,) with
     what they fit) that fit it best within ``limits`` (K, 2) (:func:`bounds`; those whose limits meet
     held there): the least-squares fit (``inverse``: the Gram matrix's pseudo-inverse, used when
     nothing is held), then an active set: each coefficient beyond its limits held at the nearer and
     the others refitted, a held one whose objective's slope points inwards let go, until none is
-    beyond and none would leave its limit (the bounded least squares' optimum)."""
+    beyond and none would leave its limit (the bounded least squares' optimum, from any start).
+    ``start`` (K,): the coefficients held at a limit to begin with (their limit, NaN for the free),
+    those of a fit of nearly the same problem: a screening's next hypothesis, a few steps from it."""
     lo, hi = limits.T
     fixed = lo == hi
-    at = np.where(fixed, lo, np.nan)   # each coefficient's held value; NaN where free
+    at = np.full(len(seen), np.nan) if start is None else \
+        np.where(np.isfinite(start) & ((start == lo) | (start == hi)), start, np.nan)
+    at[fixed] = lo[fixed]   # each coefficient's held value; NaN where free
     tol = 1e-9 * float(np.abs(seen).max(initial=0.0))   # a slope that is rounding's
     for _ in range(2 * len(seen) + 1):
         free = np.isnan(at)
@@ -172,6 +176,8 @@ def bounded_solve(gram: np.ndarray, seen: np.ndarray, limits: np.ndarray, invers
         if not inwards.any():
             return coef
         at[np.argmax(np.where(inwards, np.abs(slope), -1.0))] = np.nan
+    if start is not None:   # a start too far from the optimum to reach it in as many steps as a cold one
+        return bounded_solve(gram, seen, limits, inverse)
     return np.clip(coef, lo, hi)
 
 
