@@ -54,9 +54,8 @@ class Scorer:
         self._at = np.array([(rig_at or {}).get(key[1], 0.0) if key[0] == RIG else 0.0 for key in self._transducers])
         #: the bounds of the transducers' coefficients (a rig input's gain, a rig's mechanics: held within them)
         self._bounds = np.array([bounds(key) for key in self._transducers]).reshape(-1, 2) - self._at[:, None]
-        #: the last residual and raw residual: (the prediction, its rows and zero, the residual), read-only
-        self._last: tuple[np.ndarray, tuple, np.ndarray] | None = None
-        self._last_raw: tuple[np.ndarray, tuple, np.ndarray] | None = None
+        #: the last residual and raw residual (:meth:`_kept`): (the prediction, its rows and zero, the array)
+        self._last: dict[str, tuple[np.ndarray, tuple, np.ndarray]] = {}
         #: per selection of rows, the nuisances' coefficients in its last fit (the next one's start)
         self._held: dict[bytes, np.ndarray] = {}
 
@@ -115,33 +114,38 @@ class Scorer:
         stack, gram, inverse = self._nuisance(rows)
         if not len(stack):
             return r, stack, np.zeros(0)
-        coef = self._solve(rows, gram, stack.products(r), self._column_bounds(len(stack)), inverse)
+        coef = self._solve(rows, len(stack), gram, stack.products(r), self._column_bounds(len(stack)), inverse)
         return r - stack.combine(coef).reshape(r.shape), stack, coef
 
-    def _solve(self, rows: np.ndarray, matrix: np.ndarray, products: np.ndarray, limits: np.ndarray,
+    def _solve(self, rows: np.ndarray, nuisances: int, matrix: np.ndarray, products: np.ndarray, limits: np.ndarray,
                inverse: np.ndarray | None = None) -> np.ndarray:
-        """:func:`~elastokin.diagnosis.kc_transducers.bounded_solve` of the nuisances on the selected
+        """:func:`~elastokin.diagnosis.kc_transducers.bounded_solve` of the ``nuisances`` on the selected
         ``rows`` (``matrix``'s first columns; any after them: a fit's effects), started from those
         the last fit on these rows held at a limit (the same optimum, in a few steps, not dozens)."""
         key = rows.tobytes()
         last = self._held.get(key)
-        start = None if last is None else np.r_[last, np.full(len(products) - len(last), np.nan)]
+        start = None if last is None else np.r_[last, np.full(len(products) - nuisances, np.nan)]
         coef = bounded_solve(matrix, products, limits, inverse, start)
-        self._held[key] = coef[:len(self._nuisance(rows)[0])]
+        self._held[key] = coef[:nuisances]
         return coef
+
+    def _kept(self, what: str, predicted: np.ndarray, key: tuple, compute: Callable[[], np.ndarray]) -> np.ndarray:
+        """``compute()``, read-only, or the last one of ``what`` if it was for the same ``predicted``
+        (the very array) and ``key`` (a screening's fits share their base)."""
+        last = self._last.get(what)
+        if last is not None and last[0] is predicted and last[1] == key:
+            return last[2]
+        r = compute()
+        r.flags.writeable = False
+        self._last[what] = (predicted, key, r)
+        return r
 
     def raw(self, predicted: np.ndarray, rows: np.ndarray, zero: Callable[..., np.ndarray] = np.mean) -> np.ndarray:
         """(n, C) (measured − predicted (N, C)) / noise on the ``rows`` selected (N,) as :meth:`residual`
         has it before the nuisances are fitted out (each recording's ``zero``, their means, removed);
-        read-only, the last one kept for the same prediction (a screening's fits share their base)."""
-        key = (rows.tobytes(), zero)
-        last = self._last_raw
-        if last is not None and last[0] is predicted and last[1] == key:
-            return last[2]
-        r = self._zeroed(self.layout.measured[rows] - self._delivered(predicted)[rows], rows, zero)
-        r.flags.writeable = False
-        self._last_raw = (predicted, key, r)
-        return r
+        read-only, the last one kept (:meth:`_kept`)."""
+        return self._kept("raw", predicted, (rows.tobytes(), zero),
+                          lambda: self._zeroed(self.layout.measured[rows] - self._delivered(predicted)[rows], rows, zero))
 
     def seen(self, change: np.ndarray, rows: np.ndarray) -> np.ndarray:
         """(n, C) how much a ``change`` (N, C) of any prediction lowers its :meth:`raw` residual (zeroed
@@ -164,8 +168,8 @@ class Scorer:
         own = np.array([[float(np.sum(a * b)) for b in seen] for a in seen])
         matrix = np.block([[gram, cross.T], [cross, own]])
         both = np.concatenate([stack.products(m), [float(np.sum(d * m)) for d in seen]])
-        coef = self._solve(rows, matrix, both, np.vstack([self._column_bounds(len(stack)), limits]))
         k = len(stack)
+        coef = self._solve(rows, k, matrix, both, np.vstack([self._column_bounds(k), limits]))
         left = m - stack.combine(coef[:k]).reshape(m.shape) - sum(c * d for c, d in zip(coef[k:], seen))
         projected = [d - stack.combine(inverse @ x).reshape(m.shape) for d, x in zip(seen, cross)]
         return coef[k:], left, projected
@@ -267,14 +271,8 @@ class Scorer:
         or the median, which a misfit confined to a stretch does not move for the rest of its
         recording (the misfits' search)), and what is left of each path's response to first order
         (its taps) and each transducer's error projected out: fitted with whatever the prediction is."""
-        key = (rows.tobytes(), zero)
-        last = self._last
-        if last is not None and last[0] is predicted and last[1] == key:   # the fits' mismatch: the same base
-            return last[2]
-        r, _, _ = self._fitted(self.raw(predicted, rows, zero), rows)
-        r.flags.writeable = False   # handed out again for the same prediction
-        self._last = (predicted, key, r)
-        return r
+        return self._kept("residual", predicted, (rows.tobytes(), zero),   # the fits' mismatch: the same base
+                          lambda: self._fitted(self.raw(predicted, rows, zero), rows)[0])
 
     def test_errors(self, predicted: np.ndarray) -> np.ndarray:
         """Per test, the RMS residual (1 = the noise)."""
