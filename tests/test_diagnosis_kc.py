@@ -630,7 +630,7 @@ def assert_the_chain_recovered(result: dict, rig: dict | None = None) -> None:
     """The wheel sensors' 15 ms and the pads' none within 3 standard uncertainties and
     LAG_TOLERANCE_S; every pad's lateral-force gain within 3 of its uncertainties (and 0.1 %) of
     1.5 % (on one test, its response's channels' own gains act alike: the uncertainty is wide), every
-    measured channel's gain and cross-talk of none, the rig's mechanics ``rig`` (default: ideal;
+    measured channel's gain, cross-talk and zero's drift of none, the rig's mechanics ``rig`` (default: ideal;
     every element within 3 standard uncertainties, a tenth and its floor)."""
     lags = {a["path"]: a for a in result["acquisition"]}
     for path, truth_ms in (("wheel sensors", 15.0), ("pad sensors", 0.0)):
@@ -643,6 +643,10 @@ def assert_the_chain_recovered(result: dict, rig: dict | None = None) -> None:
     for g in result["transducers"]:   # the measured channels' transducers read true
         if g["kind"] != "input gain":
             assert abs(g["value"]) <= 3.0 * g["std"] + 2e-3, g
+    # each measured channel's zero read not drifting through the recording (its input repeats), in its unit
+    drifts = [g for g in result["transducers"] if g["kind"] == "drift"]
+    assert sorted(g["channel"] for g in drifts) == sorted(g["channel"] for g in result["transducers"] if g["kind"] == "gain")
+    assert {g["source"] for g in drifts} == {"01_kc_lateral_force"} and {g["unit"] for g in drifts} <= {"deg", "mm", "N"}
     assert {g["element"] for g in result["rig"]} == set(BY_KEY)
     for g in result["rig"]:
         truth = (rig or {}).get(g["element"], 0.0)
@@ -783,11 +787,21 @@ def _chain_lags(chain: dict) -> dict[str, float]:
 
 def _chain_reading(chain: dict, reading: dict) -> float:
     """A drawn chain's value of a transducer error the diagnosis reports (a gain; a cross-talk's
-    coefficient), from the channel's own entry over its quantity's."""
+    coefficient; a drift's bound, its rate being drawn per recording within ± it), from the channel's
+    own entry over its quantity's."""
     entry = {**chain.get(reading["channel"].rsplit("_", 1)[0], {}), **chain.get(reading["channel"], {})}
     if reading["kind"] == "cross-talk":
         return entry.get("crosstalk", {}).get(reading["source"], 0.0)
-    return entry.get("gain", 0.0)
+    return entry.get("drift_per_min" if reading["kind"] == "drift" else "gain", 0.0)
+
+
+def _read_right(chain: dict, reading: dict) -> bool:
+    """Whether a transducer error the diagnosis reports is the drawn chain's within 3 of its standard
+    uncertainties and 0.1 % (a drift: within its bound and 3 of them)."""
+    truth = _chain_reading(chain, reading)
+    if reading["kind"] == "drift":
+        return abs(reading["value"]) <= truth + 3.0 * reading["std"]
+    return abs(reading["value"] - truth) <= 3.0 * reading["std"] + 1e-3
 
 
 @pytest.mark.slow
@@ -798,7 +812,8 @@ def test_success_rate_through_a_rigs_acquisition(tmp_path, record_property, caus
     too (each element alone on clean cars, all of them; all of them with each cause): a clean car
     never given a car cause, a cause named as without the chain (check), each path's lag and each
     moved input's transducer gain recovered within 3 of its standard uncertainties (and
-    LAG_TOLERANCE_S, 0.1 %), each element of the rig's mechanics within 3 and a tenth of its value (issue 53)."""
+    LAG_TOLERANCE_S, 0.1 %), each zero's drift within its bound (:func:`_read_right`), each element of
+    the rig's mechanics within 3 and a tenth of its value (issue 53)."""
     def attempt(case: Path, seed: int) -> str:
         rng = np.random.default_rng([seed, 53])
         chain = draw_chain(rng, "typical", WHITE, elements)
@@ -810,8 +825,7 @@ def test_success_rate_through_a_rigs_acquisition(tmp_path, record_property, caus
             truth = _chain_lags(chain)[a["path"]]
             assert abs(1e-3 * a["lag_ms"] - truth) <= 3e-3 * a["delay_std_ms"] + LAG_TOLERANCE_S, (a, truth)
         for g in result["transducers"]:
-            truth = _chain_reading(chain, g)
-            assert abs(g["value"] - truth) <= 3.0 * g["std"] + 1e-3, (g, truth)
+            assert _read_right(chain, g), (g, _chain_reading(chain, g))
         for g in result["rig"]:   # the diagnosis's pads have a typical compliance, not the rig's: a tenth besides
             truth = rig.get(g["element"], 0.0)
             assert abs(g["value"] - truth) <= 3.0 * g["std"] + 0.1 * truth + BY_KEY[g["element"]].floor, (g, truth)

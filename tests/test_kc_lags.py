@@ -6,6 +6,7 @@ own effect left for the causes."""
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -13,6 +14,7 @@ import pytest
 from elastokin.diagnosis.kc_scorer import Scorer
 from elastokin.diagnosis.kc_lags import Response, paths
 from elastokin.diagnosis import kc_layout
+from elastokin.diagnosis.kc_transducers import drift_columns
 
 from elastokin.diagnosis.rig_chain import ChannelChain, ar1
 
@@ -189,3 +191,57 @@ def test_a_slow_coloured_noise_is_counted_whole_and_in_the_uncertainties():
         fitted.append(coef)
         claimed.append(math.sqrt(scorer.variances(noise - coef * column, [column], every)[0]))
     assert np.median(claimed) == pytest.approx(float(np.std(fitted)), rel=0.3)
+
+
+def test_a_zero_drifting_through_each_recording_is_read_and_leaves_the_cars_effect():
+    """Each channel's zero drifting through each recording at its own rate (up to 30 × its noise per
+    minute: up to 10 × it over the longer tests), white noise on top: with the drift columns
+    (:func:`drift_columns`) each rate is read within a tenth of that range and 3 of its standard
+    uncertainty, the true model's error is the noise where without them the drift is a mismatch, and
+    a car's effect (toe 3 % and pad load 2 % off) fitted beside them keeps its size; a recording of a
+    held input (no repeat) gets no drift, the car's slow response there being the drift's twin."""
+    layout, true = _layout({}, 7)
+    rng = np.random.default_rng(8)
+    rates = rng.uniform(-1.0, 1.0, (4, len(CHANNELS))) * 30.0 * NOISE   # [unit / min]
+    effect = np.array([0.0, 0.0, 0.03, 0.02, 0.0])
+    drifted = replace(layout, units=("mm", "deg", "deg", "N", "mm"),
+                      measured=layout.measured + true * effect + rates[layout.recording] * layout.input_time[:, None] / 60.0)
+    heldout = np.array([False, True, False, True])
+    scorer = Scorer(drifted, true * (1.0 + effect), heldout, drift_columns(drifted))
+    readings = scorer.rig_errors(true * (1.0 + effect))
+    off = np.array([(g.value - rates[int(g.source.split()[-1]), CHANNELS.index(g.channel)])
+                    / NOISE[CHANNELS.index(g.channel)] for g in readings])
+    assert len(readings) == rates.size and np.abs(off).max() < 0.1 * 30.0
+    assert all(abs(g.value - rates[int(g.source.split()[-1]), CHANNELS.index(g.channel)]) < 3.0 * g.std for g in readings)
+    assert scorer.heldout_error(true * (1.0 + effect)) == pytest.approx(1.0, abs=0.05)
+    assert Scorer(drifted, true * (1.0 + effect), heldout).heldout_error(true * (1.0 + effect)) > 1.25
+    toe = next(g for g in readings if g.channel == "toe_fl" and g.source == "recording 0")
+    assert toe.label == "toe_fl's zero drifts through recording 0" and toe.text.endswith(" deg/min") and toe.unit == "deg"
+    train = ~scorer.held_rows
+    (coef,), left, (column,) = scorer.fit_effects(true, [true * effect], train, np.array([(-np.inf, np.inf)]))
+    std = math.sqrt(scorer.variances(left, [column], train)[0])
+    assert coef == pytest.approx(1.0, abs=max(3.0 * std, 0.01))
+    held = replace(drifted, tests=[replace(drifted.tests[0], period=0), *drifted.tests[1:]])
+    assert {k[2] for k in drift_columns(held)} == {"recording 1", "recording 2", "recording 3"}
+
+
+@pytest.mark.parametrize("seed", range(9, 15))
+def test_a_slow_noise_is_not_read_as_a_drift(seed):
+    """AR(1) noise correlated over 0.1 s and 1/f noise, each of twice the white noise, and no drift
+    (the virtual rig's chain), the channels four wheels of one quantity: no drift is said. The
+    noise's model (white and AR(1)) takes the short correlation and misses the 1/f noise's wander
+    over a recording, which its uncertainty alone would read as drifts in most of these draws; each
+    drift's uncertainty counts its quantity's spread (:func:`drift_spread`)."""
+    wheels = ["toe_fl", "toe_fr", "toe_rl", "toe_rr"]
+    rng = np.random.default_rng(seed)
+    t = np.arange(0.0, 20.0 + 1e-9, 1.0 / RATE_HZ)
+    chain = ChannelChain(pink_sigma=2.0 * NOISE[2], ar1_sigma=2.0 * NOISE[2], ar1_time_constant_s=0.1)
+    true = np.tile(_triangle(t, 30.0, 10.0)[:, None] * GAINS[2], (4, len(wheels)))
+    measured = true + np.vstack([np.column_stack([chain.apply(t, np.zeros(len(t)), rng) for _ in wheels])
+                                 for _ in range(4)]) + rng.normal(0.0, NOISE[2], true.shape)
+    rows = [np.arange(k * len(t), (k + 1) * len(t)) for k in range(4)]
+    tests = [kc_layout.Test(f"test {k}", None, r, np.arange(len(t)), True, int(10.0 * RATE_HZ)) for k, r in enumerate(rows)]
+    recording = np.repeat(np.arange(4), len(t))
+    layout = kc_layout.Layout(wheels, measured, np.tile(t, 4), recording, recording.copy(), tests, units=("deg",) * 4)
+    readings = Scorer(layout, true, np.array([False, True, False, True]), drift_columns(layout)).rig_errors(true)
+    assert len(readings) == 16 and not any(g.said for g in readings)

@@ -8,10 +8,10 @@
    each channel's zero error in each recording is a nuisance, removed, and so are each acquisition
    path's response (a low-pass filter and a delay behind the rig inputs, :mod:`elastokin.diagnosis.kc_lags`:
    estimated on the baseline, what is left of it fitted with every hypothesis) and the rig's
-   transducers' errors (the inputs' and the channels' gains, cross-talk,
-   :mod:`elastokin.diagnosis.kc_transducers`) and its own mechanics (its pads' friction, its body
-   clamp's compliance, :mod:`elastokin.diagnosis.kc_rig_mechanics`): fitted with every hypothesis;
-   what they take out that a car cause would explain as well is said
+   transducers' errors (the inputs' and the channels' gains, cross-talk, zeros drifting through the
+   recordings of repeated tests, :mod:`elastokin.diagnosis.kc_transducers`) and its own mechanics (its
+   pads' friction, its body clamp's compliance, :mod:`elastokin.diagnosis.kc_rig_mechanics`): fitted
+   with every hypothesis; what they take out that a car cause would explain as well is said
    (:mod:`elastokin.diagnosis.kc_rig_or_car`). When the verdict shows the pads' friction (not
    proportional in its effect, nor apart from a car cause that sticks and slips too), all of this
    runs again on a rig with it, its column then the change from it.
@@ -63,9 +63,9 @@ from elastokin.diagnosis.catalogue import PAIR_SEPARATOR
 from elastokin.diagnosis.kc_alike import alike, extra_scenarios, run_unless_diverged, separations
 from elastokin.diagnosis.kc_catalogue import (BUSHING_CAUSES, VEHICLE_CAUSES, Hypothesis, extended_vehicle, locations,
                                          parameters)
-from elastokin.diagnosis.kc_fits import (Candidate, fit, fit_pair, halfway, kept, nominal, nudged, significant,
-                                    verify)
-from elastokin.diagnosis.kc_transducers import INPUT_GAIN, STEP, Reading, input_column, moved, reading_columns, stepped
+from elastokin.diagnosis.kc_fits import Candidate, fit, fit_pair, halfway, kept, nominal, nudged, significant, verify
+from elastokin.diagnosis.kc_transducers import (INPUT_GAIN, STEP, Reading, drift_columns, input_column, moved,
+                                                reading_columns, stepped)
 from elastokin.diagnosis.kc_lags import PathResponse
 from elastokin.diagnosis.kc_rig_mechanics import (BY_KEY, ELEMENTS, RIG, element_column, element_jobs,
                                                    not_proportional, on_rig)
@@ -253,7 +253,7 @@ def _diagnosis(layout: Layout, vehicle: VehicleDefinition, pool: Executor, say: 
                                                for ch, r in zip(movers, nuisances)},
                                             **{(RIG, e.key, None): element_column(r, base, e)
                                                for e, r in zip(ELEMENTS, nuisances[len(movers):])},
-                                            **reading_columns(layout, base)}, rig_at)
+                                            **reading_columns(layout, base), **drift_columns(layout)}, rig_at)
     before = scorer.heldout_error(base)
     say(f"held-out error of the baseline: {before:.3f} (1 = the measurement noise); one run of each of "
         f"{len(candidates)} hypotheses at mid-range magnitude on the {len(training)} training tests")

@@ -74,13 +74,17 @@ class Layout:
     tests: list[Test]
     damage: tuple[str, ...] = ()  #: what the dataset's damaged recordings lack (their cases unrecorded too)
     inputs: np.ndarray | None = None   #: (N, len(INPUT_CHANNELS)) the rig's recorded commands (SI)
+    #: (N,) time since its recording started [s] (None: ``input_time``, each test its own recording)
+    recording_time_s: np.ndarray | None = None
+    recordings: tuple[str, ...] = ()   #: each recording's name, by index (default: "recording k")
+    units: tuple[str, ...] = ()        #: each channel's unit (default: none said)
 
     @classmethod
     def of(cls, data: KCDataset, vehicle: VehicleDefinition) -> "Layout":
         """The compared channels of a dataset, case by case, and the baseline ``vehicle``'s run of each case."""
         first = data.tests[0].run
         channels = [n for n in first.signals if n.rsplit("_", 1)[0] in COMPARED or n.rsplit("_", 2)[0] in COMPARED]
-        measured, commands, times, recording, tests, start, unrecorded = [], [], [], [], [], 0, []
+        measured, commands, times, clock, recording, tests, start, unrecorded = [], [], [], [], [], [], 0, []
         for k, t in enumerate(data.tests):
             run, scale = t.run, float(t.run.metadata.extra.get("duration_scale", 1.0))
             phase, number = run.signals["phase"], run.signals["case"].astype(int)
@@ -94,6 +98,7 @@ class Layout:
                 commands.append(np.column_stack([run.signals[ch][on] if ch in run.signals else np.zeros(n)
                                                  for ch in INPUT_CHANNELS]))
                 times.append(run.signals["input_time"][on])
+                clock.append(run.t_s[on] - run.t_s[0])
                 recording.append(np.full(n, k))
                 job = Job(replace(t.scenario, cases=[case]), vehicle, scale, tuple(channels))
                 samples = np.arange(n) if run.complete else _samples(times[-1], t.scenario, f"{t.file.name}, case {c}")
@@ -105,7 +110,8 @@ class Layout:
                              source=str(data.path))
         test = np.concatenate([np.full(len(t.rows), i) for i, t in enumerate(tests)])
         return cls(channels, np.vstack(measured), np.concatenate(times), np.concatenate(recording), test, tests,
-                   (*data.damage, *unrecorded), np.vstack(commands))
+                   (*data.damage, *unrecorded), np.vstack(commands), np.concatenate(clock),
+                   tuple(t.name for t in data.tests), tuple(first.units[ch] for ch in channels))
 
     def jobs(self, vehicle: VehicleDefinition, tests: Sequence[int]) -> list[Job]:
         """The runs of ``tests`` (indices) on ``vehicle``."""

@@ -31,7 +31,7 @@ from elastokin.diagnosis.kc_catalogue import Hypothesis, parameters
 from elastokin.diagnosis.kc_fits import scaled_magnitude, value_bounds
 from elastokin.diagnosis.kc_scorer import Scorer
 from elastokin.diagnosis.kc_rig_mechanics import BY_KEY, RIG
-from elastokin.diagnosis.kc_transducers import CROSS, GAIN, INPUT_GAIN, Reading, bounded_solve
+from elastokin.diagnosis.kc_transducers import CROSS, DRIFT, GAIN, INPUT_GAIN, Reading, bounded_solve
 from elastokin.diagnosis.verdict import decide, told_apart
 from elastokin.vehicle.scenarios.channels import channel_quantity
 
@@ -44,6 +44,8 @@ TRANSDUCER_FAMILIES = {
             "a static calibration of the {quantity} transducers with {source} moved alone separates them"),
     INPUT_GAIN: ("the {quantity} inputs' transducers",
                  "a calibration of the {quantity} transducers against a reference separates them"),
+    DRIFT: ("the {quantity} transducers' zeros drifting through {source}",
+            "the {quantity} channels recorded with the rig at rest before and after the test separate them"),
 }
 #: The rig's mechanics: each element's check.
 RIG_REMEDIES = {"pad_friction_n": "the pads' breakaway force measured with the car off them separates them",

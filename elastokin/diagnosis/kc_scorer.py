@@ -16,7 +16,7 @@ from elastokin.diagnosis.kc_lags import PathResponse, Response, fit_response, pa
 from elastokin.diagnosis.kc_layout import Layout
 from elastokin.diagnosis.kc_noise import estimate_noise, white_noise
 from elastokin.diagnosis.kc_rig_mechanics import RIG
-from elastokin.diagnosis.kc_transducers import Key, Reading, bounded_solve, bounds, reading
+from elastokin.diagnosis.kc_transducers import Key, Reading, bounded_solve, bounds, drift_spread, reading
 
 
 class Scorer:
@@ -218,8 +218,10 @@ class Scorer:
         joint = stack.extended([self.seen(e, every) for e in effects])
         std = np.sqrt(self.variances(left, joint, every))[first:len(stack)]
         held = coef[first:] != np.clip(coef[first:], self._bounds[:, 0] + 1e-12, self._bounds[:, 1] - 1e-12)
-        return [reading(key, float(at + coef[first + k]), float(s), bool(held[k] and at + coef[first + k] != 0.0))
-                for k, (key, at, s) in enumerate(zip(self._transducers, self._at, std))]
+        units = dict(zip(self.layout.channels, self.layout.units))
+        return drift_spread([reading(key, float(at + coef[first + k]), float(s),
+                                     bool(held[k] and at + coef[first + k] != 0.0), units.get(key[1], ""))
+                             for k, (key, at, s) in enumerate(zip(self._transducers, self._at, std))])
 
     def variances(self, residual: np.ndarray, columns: list[np.ndarray] | Columns, rows: np.ndarray,
                   channels: np.ndarray | None = None) -> np.ndarray:

@@ -8,13 +8,18 @@ from what a rig is known to do, apart from the virtual rig's chain (:mod:`elasto
   and reads as the car's lateral stiffness;
 - a measured channel's transducer reads (1 + g) × the truth (its calibration), and some see another
   quantity of their wheel (:data:`CROSSTALK`: a wheel-angle head's toe its camber, a pad's vertical
-  load cell its lateral force), before the acquisition's filter and delay.
+  load cell its lateral force), before the acquisition's filter and delay;
+- a transducer's zero drifts through a recording (its amplifier's temperature): a straight line in
+  time, its rate [the channel's unit per minute] fitted per channel in each recording whose tests
+  all repeat their input (:func:`drift_columns`), where a car's response repeats cycle after cycle
+  and a drift does not; in a recording of a held input (a rack step) the car's own slow response
+  (a relaxation) would be taken for it, and no drift is fitted there.
 
 Each is a column: the compared rows' derivative with respect to it, (N, C) in the channels' units.
 A moved input's comes from a baseline run of the tests it moves in with its command × (1 +
 :data:`STEP`) (first order, the car's own nonlinearity in it); a channel's gain is its own
 prediction; a cross-talk is the other quantity (the prediction, or the rig's command for an input)
-placed in the channel. The columns are projected out of every residual with the acquisition's
+placed in the channel; a drift is the time through its recording. The columns are projected out of every residual with the acquisition's
 (:class:`elastokin.diagnosis.kc_scorer.Scorer`), so that each cause is fitted jointly with them, each
 within its :func:`bounds` (:func:`bounded_solve`), and what the data tell of each is reported. A
 gain is common to every test of its channel while a car's cause acts on each test its own way, so
@@ -25,6 +30,7 @@ static calibration of the transducer separates them (:mod:`elastokin.diagnosis.k
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -41,7 +47,7 @@ CROSSTALK = {"toe": "camber", "pad_fz": "pad_fy"}
 #: A transducer's error is worth a word beyond this many standard uncertainties and this share (a
 #: good transducer's calibration).
 SAID_STD, SAID_SHARE = 3.0, 0.002
-INPUT_GAIN, GAIN, CROSS = "input gain", "gain", "cross-talk"
+INPUT_GAIN, GAIN, CROSS, DRIFT = "input gain", "gain", "cross-talk", "drift"
 #: What a reading held at its bound says beside its value.
 AT_BOUND = " (at its bound: the data would have it larger)"
 #: The largest transducer error fitted (a gain, or a cross-talk's coefficient, both ratios): a rig's
@@ -57,34 +63,41 @@ class Reading:
     """A rig's error as fitted beside a model: a transducer's, or an element of the rig's own
     mechanics (:mod:`elastokin.diagnosis.kc_rig_mechanics`)."""
 
-    kind: str             #: INPUT_GAIN, GAIN, CROSS or RIG
+    kind: str             #: INPUT_GAIN, GAIN, CROSS, DRIFT or RIG
     channel: str          #: the channel it reads (a rig input's for INPUT_GAIN; the rig file key for RIG)
-    source: str | None    #: the quantity of the same wheel a cross-talk sees
+    source: str | None    #: the quantity of the same wheel a cross-talk sees; the recording a drift is in
     value: float          #: a gain g (it reads (1 + g) × the truth), a cross-talk's coefficient [the
-    #: channel's unit per the source's], or a rig element's value [its unit]
+    #: channel's unit per the source's], a drift's rate [the channel's unit per minute] or a rig element's
+    #: value [its unit]
     std: float            #: its standard uncertainty
     #: held at its bound (:func:`bounds`): the data would have it larger, beyond a calibrated rig's
     #: (a transducer out of calibration, or a car cause acting as its error)
     at_bound: bool = False
+    unit: str = ""        #: a drift's channel's unit
 
     @property
     def said(self) -> bool:
         """Whether the data show it (beyond SAID_STD standard uncertainties and SAID_SHARE, a rig
-        element's floor)."""
-        floor = BY_KEY[self.channel].floor if self.kind == RIG else SAID_SHARE
+        element's floor; a drift's uncertainty alone)."""
+        floor = BY_KEY[self.channel].floor if self.kind == RIG else 0.0 if self.kind == DRIFT else SAID_SHARE
         return abs(self.value) > max(SAID_STD * self.std, floor)
 
     @property
     def label(self) -> str:
-        """``pad_fy_fl (input gain)``, ``toe_fl sees camber``, ``camber_fr (gain)``, ``the pads' friction``."""
+        """``pad_fy_fl (input gain)``, ``toe_fl sees camber``, ``camber_fr (gain)``, ``toe_fl's zero drifts
+        through 02_kc_roll``, ``the pads' friction``."""
         if self.kind == RIG:
             return BY_KEY[self.channel].label
+        if self.kind == DRIFT:
+            return f"{self.channel}'s zero drifts through {self.source}"
         return f"{self.channel} sees {self.source}" if self.kind == CROSS else f"{self.channel} ({self.kind})"
 
     @property
     def text(self) -> str:
-        """Its value for people: a gain or a cross-talk (both ratios) in %, a rig element in its unit."""
+        """Its value for people: a gain or a cross-talk (both ratios) in %, a drift in its channel's
+        unit per minute, a rig element in its unit."""
         value = (f"{self.value:.3g} ± {self.std:.2g} {BY_KEY[self.channel].unit}" if self.kind == RIG
+                 else f"{self.value:+.3g} ± {self.std:.2g} {self.unit}/min" if self.kind == DRIFT
                  else f"{100 * self.value:+.2f} ± {100 * self.std:.2g} %")
         return value + (AT_BOUND if self.at_bound else "")
 
@@ -132,15 +145,45 @@ def reading_columns(layout: Layout, baseline: np.ndarray) -> dict[Key, OneChanne
     return out
 
 
-def reading(key: Key, coef: float, std: float, at_bound: bool = False) -> Reading:
+def drift_columns(layout: Layout) -> dict[Key, OneChannel]:
+    """Each measured channel's drift in each recording whose tests all repeat their input (module
+    docstring): the time through the recording [min] on its rows, on that channel alone (its mean,
+    and so its start, goes with the recording's zero)."""
+    time = layout.input_time if layout.recording_time_s is None else layout.recording_time_s
+    out: dict[Key, OneChannel] = {}
+    for k in np.unique(layout.recording):
+        on = layout.recording == k
+        if all(layout.tests[i].period > 0 for i in np.unique(layout.test[on])):
+            name = layout.recordings[k] if layout.recordings else f"recording {k}"
+            minutes = np.where(on, time / 60.0, 0.0)
+            out.update({(DRIFT, c, name): OneChannel(i, minutes) for i, c in enumerate(layout.channels)})
+    return out
+
+
+def drift_spread(readings: list[Reading]) -> list[Reading]:
+    """``readings`` with each drift's uncertainty at least the RMS of its quantity's drifts over its
+    channels and recordings: a slow noise (1/f: a rig's temperature, its amplifiers' flicker) wanders
+    over a recording as a drift does, more than the noise's model (white and first-order
+    autoregressive) says where it fits a short correlation time (on the virtual rig's typical chain,
+    3-5 × more on three quantities); the RMS counts that wander, and a drift is said only where it
+    stands out of its quantity's (of 12, one beyond 6 × the others' spread reaches 3 of it)."""
+    rates: dict[str, list[float]] = {}
+    for g in readings:
+        if g.kind == DRIFT:
+            rates.setdefault(channel_quantity(g.channel), []).append(g.value)
+    spread = {q: math.sqrt(float(np.mean(np.square(v)))) for q, v in rates.items()}
+    return [replace(g, std=max(g.std, spread[channel_quantity(g.channel)])) if g.kind == DRIFT else g for g in readings]
+
+
+def reading(key: Key, coef: float, std: float, at_bound: bool = False, unit: str = "") -> Reading:
     """The transducer error a fitted coefficient of ``key``'s column stands for: the coefficient for a
     measured channel's gain or cross-talk and a rig element's value; for an input, the gain g whose
     servo gives the car its command × (1 + ``coef``) (1 + coef = 1 / (1 + g)), its uncertainty
-    carried to first order. ``at_bound``: the fit held it at its bound."""
+    carried to first order. ``at_bound``: the fit held it at its bound; ``unit``: a drift's channel's."""
     kind, channel, source = key
     if kind == INPUT_GAIN:
         return Reading(kind, channel, None, 1.0 / (1.0 + coef) - 1.0, std / (1.0 + coef) ** 2, at_bound)
-    return Reading(kind, channel, source, coef, std, at_bound)
+    return Reading(kind, channel, source, coef, std, at_bound, unit if kind == DRIFT else "")
 
 
 def bounded_solve(gram: np.ndarray, seen: np.ndarray, limits: np.ndarray, inverse: np.ndarray | None = None,
@@ -182,8 +225,10 @@ def bounded_solve(gram: np.ndarray, seen: np.ndarray, limits: np.ndarray, invers
 
 
 def bounds(key: Key) -> tuple[float, float]:
-    """The bounds of a transducer's or the rig's coefficient (its column's scale)."""
+    """The bounds of a transducer's or the rig's coefficient (its column's scale); a drift's none."""
     kind, name, _ = key
     if kind == RIG:
         return 0.0, BY_KEY[name].bound
+    if kind == DRIFT:
+        return -math.inf, math.inf
     return -CALIBRATION_BOUND, CALIBRATION_BOUND

@@ -96,7 +96,8 @@ def summary(d: KCDiagnosis) -> dict[str, Any]:
                          "cutoff_hz": r.cutoff_hz or None, "delay_ms": 1e3 * r.delay_s, "delay_std_ms": 1e3 * r.std_s}
                         for r in d.responses],
         "transducers": [{"kind": g.kind, "channel": g.channel, "source": g.source, "value": g.value,
-                         "std": finite(g.std), "at_bound": g.at_bound} for g in d.rig_errors if g.kind != RIG],
+                         "std": finite(g.std), "unit": g.unit or "1", "at_bound": g.at_bound}
+                        for g in d.rig_errors if g.kind != RIG],
         "rig": [{"element": g.channel, "value": g.value, "std": finite(g.std), "unit": BY_KEY[g.channel].unit,
                  "at_bound": g.at_bound} for g in d.rig_errors if g.kind == RIG],
         "rig_or_car": [{"group": c.group, "readings": [f"{g.label} {g.text}" for g in c.readings],
@@ -338,9 +339,9 @@ def write_report(d: KCDiagnosis, baseline: VehicleDefinition, out_dir: Path, dat
     if shown:
         report.paragraph("The transducers' errors fitted with every hypothesis (`elastokin/diagnosis/kc_transducers.py`): "
                          "each moved rig input's gain g (it reads (1 + g) × the truth; the car got the command / (1 + g)), "
-                         "and each measured channel's gain or cross-talk the data show:")
-        report.table(("transducer", "value [%]"), [(g.label, f"{100 * g.value:+.3f} ± {100 * g.std:.2g}"
-                                                    + (" (at its bound)" if g.at_bound else "")) for g in shown])
+                         "and each measured channel's gain, cross-talk or zero drifting through a recording of repeated "
+                         "tests the data show:")
+        report.table(("transducer", "value"), [(g.label, g.text) for g in shown])
     mechanics = [g for g in d.rig_errors if g.kind == RIG]
     if mechanics:
         report.paragraph("The rig's own mechanics fitted with every hypothesis (`elastokin/diagnosis/kc_rig_mechanics.py`): "
