@@ -59,7 +59,10 @@ class Columns:
     def gram(self) -> np.ndarray:
         """(K, K) the columns' products with each other."""
         flat, one = self._flat(), self.one
-        across = np.einsum("dnk,kn->dk", self.dense[:, :, self.channel], self.single)
+        across = np.empty((len(self.dense), len(self.single)))
+        for c in np.unique(self.channel):   # channel by channel: not the dense columns copied for each one-channel one
+            on = self.channel == c
+            across[:, on] = self.dense[:, :, c] @ self.single[on].T
         out = np.empty((len(self), len(self)))
         out[np.ix_(~one, ~one)] = flat @ flat.T
         out[np.ix_(~one, one)] = across
