@@ -165,7 +165,7 @@ def drift_spread(readings: list[Reading]) -> list[Reading]:
     channels and recordings: a slow noise (1/f: a rig's temperature, its amplifiers' flicker) wanders
     over a recording as a drift does, more than the noise's model (white and first-order
     autoregressive) says where it fits a short correlation time (on the virtual rig's typical chain,
-    3-5 × more on three quantities); the RMS counts that wander, and a drift is said only where it
+    3-4 × more on three quantities); the RMS counts that wander, and a drift is said only where it
     stands out of its quantity's (of 12, one beyond 6 × the others' spread reaches 3 of it)."""
     rates: dict[str, list[float]] = {}
     for g in readings:
