@@ -19,13 +19,14 @@ Each is a column: the compared rows' derivative with respect to it, (N, C) in th
 A moved input's comes from a baseline run of the tests it moves in with its command × (1 +
 :data:`STEP`) (first order, the car's own nonlinearity in it); a channel's gain is its own
 prediction; a cross-talk is the other quantity (the prediction, or the rig's command for an input)
-placed in the channel; a drift is the time through its recording. The columns are projected out of every residual with the acquisition's
-(:class:`elastokin.diagnosis.kc_scorer.Scorer`), so that each cause is fitted jointly with them, each
-within its :func:`bounds` (:func:`bounded_solve`), and what the data tell of each is reported. A
-gain is common to every test of its channel while a car's cause acts on each test its own way, so
-the campaign tells most causes from the gains; one that acts as a gain does (every response of a
-channel, or to an input, scaled alike) is not told from it: the fit leaves it to the gain, and a
-static calibration of the transducer separates them (:mod:`elastokin.diagnosis.kc_rig_or_car`).
+placed in the channel; a drift is the time through its recording. The columns are projected out
+of every residual with the acquisition's (:class:`elastokin.diagnosis.kc_scorer.Scorer`), so that
+each cause is fitted jointly with them, each within its :func:`bounds` (:func:`bounded_solve`), and
+what the data tell of each is reported. A gain is common to every test of its channel while a
+car's cause acts on each test its own way, so the campaign tells most causes from the gains; one
+that acts as a gain does (every response of a channel, or to an input, scaled alike) is not told
+from it: the fit leaves it to the gain, and a static calibration of the transducer separates them
+(:mod:`elastokin.diagnosis.kc_rig_or_car`).
 """
 
 from __future__ import annotations
@@ -148,7 +149,8 @@ def reading_columns(layout: Layout, baseline: np.ndarray) -> dict[Key, OneChanne
 def drift_columns(layout: Layout) -> dict[Key, OneChannel]:
     """Each measured channel's drift in each recording whose tests all repeat their input (module
     docstring): the time through the recording [min] on its rows, on that channel alone (its mean,
-    and so its start, goes with the recording's zero)."""
+    and so its start, goes with the recording's zero; through the acquisition's filter and delay, as
+    every column goes, a straight line stays one, late by a constant the zero takes too)."""
     time = layout.input_time if layout.recording_time_s is None else layout.recording_time_s
     out: dict[Key, OneChannel] = {}
     for k in np.unique(layout.recording):
@@ -172,7 +174,8 @@ def drift_spread(readings: list[Reading]) -> list[Reading]:
         if g.kind == DRIFT:
             rates.setdefault(channel_quantity(g.channel), []).append(g.value)
     spread = {q: math.sqrt(float(np.mean(np.square(v)))) for q, v in rates.items()}
-    return [replace(g, std=max(g.std, spread[channel_quantity(g.channel)])) if g.kind == DRIFT else g for g in readings]
+    return [replace(g, std=max(g.std, spread[channel_quantity(g.channel)])) if g.kind == DRIFT else g
+            for g in readings]
 
 
 def reading(key: Key, coef: float, std: float, at_bound: bool = False, unit: str = "") -> Reading:
