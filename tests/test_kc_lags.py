@@ -167,8 +167,10 @@ def test_a_slow_coloured_noise_is_counted_whole_and_in_the_uncertainties():
     """AR(1) noise of twice the white noise correlated over 4 s, longer than the shorter tests'
     period (differences a period apart tell its drift rate, not its correlation time): the noise the
     scorer counts is what a recording's zero leaves of it (√(1 + 4 × 0.59), within 20 %), so the perfect
-    model's error is the noise, no stretch of it a misfit; an effect proportional to the input fitted
-    on such noise gets an uncertainty of its scatter over 100 draws (within 30 %)."""
+    model's error is the noise, no stretch of it a misfit; an effect proportional to the input and
+    a drift through each recording, fitted on such noise, get an uncertainty of their scatter over
+    100 draws (within 30 %; 0.97 and 1.19 × it: the noise's covariance counted whole, as a column
+    centred in its recording takes it, where what the recording's zero leaves of it gave 0.76 and 0.53)."""
     from elastokin.diagnosis.kc_diagnosis import located_misfits
     tau = 4.0
     chains = {c: ChannelChain(ar1_sigma=2.0 * NOISE[c], ar1_time_constant_s=tau) for c in range(len(CHANNELS))}
@@ -178,19 +180,24 @@ def test_a_slow_coloured_noise_is_counted_whole_and_in_the_uncertainties():
     assert scorer.heldout_error(true) == pytest.approx(1.0, abs=0.15)
     assert located_misfits(layout, scorer, true) == []
     every = np.ones(len(true), dtype=bool)
-    column = true / scorer.noise
+    ramp = layout.input_time.copy()
+    for t in layout.tests:
+        ramp[t.rows] -= ramp[t.rows].mean()
+    columns = {"effect": true / scorer.noise, "drift": np.where(np.arange(len(CHANNELS)) == 2, ramp[:, None], 0.0)}
     rng = np.random.default_rng(6)
-    fitted, claimed = [], []
+    fitted, claimed = {k: [] for k in columns}, {k: [] for k in columns}
     for _ in range(100):
         noise = np.vstack([np.column_stack([ChannelChain(ar1_sigma=2.0 * NOISE[c], ar1_time_constant_s=tau).apply(
             layout.input_time[t.rows], np.zeros(len(t.rows)), rng) + rng.normal(0.0, NOISE[c], len(t.rows))
             for c in range(len(CHANNELS))]) for t in layout.tests]) / scorer.noise
         for t in layout.tests:   # each recording's zero out, as the scorer's residuals have it
             noise[t.rows] -= noise[t.rows].mean(axis=0)
-        coef = float(np.sum(column * noise) / np.sum(column * column))
-        fitted.append(coef)
-        claimed.append(math.sqrt(scorer.variances(noise - coef * column, [column], every)[0]))
-    assert np.median(claimed) == pytest.approx(float(np.std(fitted)), rel=0.3)
+        for k, column in columns.items():
+            coef = float(np.sum(column * noise) / np.sum(column * column))
+            fitted[k].append(coef)
+            claimed[k].append(math.sqrt(scorer.variances(noise - coef * column, [column], every)[0]))
+    for k in columns:
+        assert np.median(claimed[k]) == pytest.approx(float(np.std(fitted[k])), rel=0.3), k
 
 
 def test_a_zero_drifting_through_each_recording_is_read_and_leaves_the_cars_effect():

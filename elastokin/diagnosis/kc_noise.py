@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Sequence
 
 import numpy as np
 from scipy import signal as sps
@@ -47,12 +48,25 @@ FIT_TOLERANCE = 0.1
 
 
 @dataclass(frozen=True)
+class Segment:
+    """A test's rows in :meth:`NoiseModel.covariance_product`: evenly sampled, its noise running on
+    from its recording's previous segment."""
+
+    first: int        #: its first row
+    end: int          #: past its last row
+    dt_s: float       #: its sampling interval [s]
+    start_s: float    #: its first row's time through its recording [s]
+    recording: int    #: its recording's index
+
+
+@dataclass(frozen=True)
 class NoiseModel:
     """Each compared channel's noise: white plus first-order autoregressive (module docstring)."""
 
     white: np.ndarray              #: (C,) the white noise's standard deviation [channel unit]
     coloured: np.ndarray           #: (C,) the coloured noise's, what each recording's zero leaves of it [channel unit]
     correlation_time_s: np.ndarray  #: (C,) the coloured noise's correlation time τ [s] (0: none)
+    coloured_left: np.ndarray      #: (C,) the share of the coloured noise's variance each recording's zero leaves
     #: the repeated tests' period differences, noise alone: (their sampling interval [s], the channels'
     #: indices, the differences (n, channels) clipped)
     differences: tuple[tuple[float, np.ndarray, np.ndarray], ...] = ()
@@ -62,22 +76,20 @@ class NoiseModel:
         """(C,) the whole noise's standard deviation [channel unit]."""
         return np.sqrt(self.white ** 2 + self.coloured ** 2)
 
-    def covariance_product(self, columns: np.ndarray, channel: int, segments: list[tuple[int, int, float]]
-                           ) -> np.ndarray:
+    def covariance_product(self, columns: np.ndarray, channel: int, segments: Sequence[Segment]) -> np.ndarray:
         """JᵀΣJ (K, K) for ``columns`` (K, n) on ``channel`` in units of its noise (:attr:`sigma`), Σ
-        its noise's covariance: white, plus the coloured noise's first-order autoregression within
-        each of ``segments`` (first, end, sampling interval [s]: a test's rows, uncorrelated with
-        the next test's)."""
+        its noise's covariance: white, plus the coloured noise's exp(−|tᵢ − tⱼ| / τ) over each
+        recording's ``segments`` (its tests' rows in time order: the noise runs on between them),
+        whole: the columns are centred in each recording as its zero leaves the noise, and a
+        centred column takes the whole noise's covariance, a slow noise's as well (over a recording
+        its zero takes most of that noise, not its wander)."""
         sigma = max(float(self.sigma[channel]), 1e-300)
         weighted = (self.white[channel] / sigma) ** 2 * columns
-        share, tau = (self.coloured[channel] / sigma) ** 2, float(self.correlation_time_s[channel])
-        if share > 0.0 and tau > 0.0:
-            for first, end, dt in segments:
-                seg = columns[:, first:end]
-                phi = math.exp(-dt / tau)
-                ahead = sps.lfilter([1.0], [1.0, -phi], seg, axis=1)
-                behind = sps.lfilter([1.0], [1.0, -phi], seg[:, ::-1], axis=1)[:, ::-1]
-                weighted[:, first:end] += share * (ahead + behind - seg)   # Σ_j φ^|i−j| c_j
+        tau = float(self.correlation_time_s[channel])
+        share = (self.coloured[channel] / sigma) ** 2 / max(float(self.coloured_left[channel]), 1e-3)
+        if share > 0.0 and tau > 0.0:   # Σ_j exp(−|tᵢ − tⱼ| / τ) c_j
+            weighted += share * (_relaxed(columns, segments, tau, False) + _relaxed(columns, segments, tau, True)
+                                 - columns)
         return columns @ weighted.T
 
     def window_dof(self, width: int, dt_s: float) -> np.ndarray:
@@ -103,6 +115,29 @@ class NoiseModel:
             if m.var() > 0.0:
                 out[idx] = np.minimum(out[idx], 2.0 * m.mean() ** 2 / m.var())
         return out
+
+
+def _relaxed(columns: np.ndarray, segments: Sequence[Segment], tau_s: float, backward: bool) -> np.ndarray:
+    """Σ_{j ≤ i} exp(−(tᵢ − tⱼ) / ``tau_s``) c_j for each row i of ``columns`` (K, n) over each
+    recording's ``segments`` (or Σ_{j ≥ i} if ``backward``): each segment filtered alone, then what
+    the recording's earlier segments carry into it decayed over the gap."""
+    out = np.zeros_like(columns)
+    order = sorted(segments, key=lambda g: (g.recording, g.start_s), reverse=backward)
+    carry, recording, edge_s = None, None, 0.0
+    for g in order:
+        n = g.end - g.first
+        if n <= 0:
+            continue
+        phi = math.exp(-g.dt_s / tau_s) if g.dt_s > 0.0 else 0.0
+        seg = columns[:, g.first:g.end]
+        filtered = sps.lfilter([1.0], [1.0, -phi], seg[:, ::-1] if backward else seg, axis=1)
+        near_s = g.start_s + (n - 1) * g.dt_s if backward else g.start_s   # the edge facing the carry
+        if carry is not None and g.recording == recording:
+            filtered += carry[:, None] * (math.exp(-abs(near_s - edge_s) / tau_s) * phi ** np.arange(n))[None, :]
+        carry, recording = filtered[:, -1].copy(), g.recording
+        edge_s = g.start_s if backward else g.start_s + (n - 1) * g.dt_s
+        out[:, g.first:g.end] = filtered[:, ::-1] if backward else filtered
+    return out
 
 
 def coloured_noise(channels: list[str], noise: NoiseModel) -> dict[str, tuple[float, float, float]]:
@@ -152,7 +187,7 @@ def estimate_noise(layout: Layout, residual: np.ndarray) -> NoiseModel:
     width = residual.shape[1]
     white = white_noise(layout, residual)
     family = np.array([channel_quantity(c) for c in layout.channels])
-    coloured, tau = np.zeros(width), np.zeros(width)
+    coloured, tau, left = np.zeros(width), np.zeros(width), np.ones(width)
     spans: dict[int, float] = {}   # each recording's length [s]
     for t in layout.tests:
         k = int(layout.recording[t.rows[0]])
@@ -162,9 +197,10 @@ def estimate_noise(layout: Layout, residual: np.ndarray) -> NoiseModel:
     for f in dict.fromkeys(family):
         idx = np.flatnonzero(family == f)
         share, t, kept = _coloured(layout, residual[:, idx] / white[idx], span)
-        coloured[idx], tau[idx] = white[idx] * math.sqrt(share * _left_by_the_zero(t, span)), t
+        left[idx] = _left_by_the_zero(t, span)
+        coloured[idx], tau[idx] = white[idx] * np.sqrt(share * left[idx]), t
         differences += [(dt, idx, d) for dt, d in kept]
-    return NoiseModel(white, coloured, tau, tuple(differences))
+    return NoiseModel(white, coloured, tau, left, tuple(differences))
 
 
 def _left_by_the_zero(tau_s: float, span_s: float) -> float:

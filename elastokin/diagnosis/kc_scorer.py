@@ -14,7 +14,7 @@ from elastokin.diagnosis.fit_uncertainty import clustered_errors, standard_error
 from elastokin.diagnosis.kc_columns import Columns, OneChannel
 from elastokin.diagnosis.kc_lags import PathResponse, Response, fit_response, paths
 from elastokin.diagnosis.kc_layout import Layout
-from elastokin.diagnosis.kc_noise import estimate_noise, white_noise
+from elastokin.diagnosis.kc_noise import Segment, estimate_noise, white_noise
 from elastokin.diagnosis.kc_rig_mechanics import RIG
 from elastokin.diagnosis.kc_transducers import Key, Reading, bounded_solve, bounds, drift_spread, reading
 
@@ -252,7 +252,12 @@ class Scorer:
         tests = self.layout.test[rows]
         firsts = np.flatnonzero(np.r_[True, tests[1:] != tests[:-1]])
         ends = np.r_[firsts[1:], len(tests)]
-        segments = [(int(a), int(b), self.response.steps[tests[a]]) for a, b in zip(firsts, ends)]
+        layout = self.layout
+        clock, recording = ((layout.input_time, layout.test) if layout.recording_time_s is None
+                            else (layout.recording_time_s, layout.recording))
+        at = np.flatnonzero(rows)
+        segments = [Segment(int(a), int(b), self.response.steps[tests[a]], float(clock[at[a]]), int(recording[at[a]]))
+                    for a, b in zip(firsts, ends)]
         out = np.zeros((len(columns), len(columns)))
         for k, c in enumerate(channels):
             if isinstance(columns, Columns):
