@@ -34,7 +34,7 @@ from elastokin.core.documents import Document, dump_yaml
 from elastokin.core.errors import InputError
 from elastokin.core.shipped import BENCH_DIR, DATASET_DIR, DEFAULT_VEHICLE, SCENARIO_DIR
 from elastokin.recordings.csv_import import import_csv
-from elastokin.diagnosis.kc_layout import Layout
+from elastokin.diagnosis.kc_layout import Layout, RunRows
 from elastokin.recordings.kc_dataset import read_kc_dataset
 from elastokin.recordings.run_format import Run
 from elastokin.recordings.run_reader import DamagedRecording, load_run
@@ -479,5 +479,7 @@ def test_a_kc_dataset_with_a_damaged_recording_is_refused_unless_asked(tmp_path:
         np.testing.assert_array_equal(part.measured[t.rows], whole.measured[whole_by_name[t.name].rows][t.samples])
     # a simulation's input phase goes to the samples recorded
     simulated = {t.name: {ch: whole.measured[t.rows, j] for j, ch in enumerate(whole.channels)} for t in whole.tests}
-    stacked = part.stack([simulated[t.name] for t in part.tests], range(len(part.tests)))
-    np.testing.assert_array_equal(stacked, part.measured)
+    stacked = RunRows(part, [range(len(part.tests))])
+    for i, t in enumerate(part.tests):
+        stacked.place(0, simulated[t.name], i)
+    np.testing.assert_array_equal(stacked[0], part.measured)

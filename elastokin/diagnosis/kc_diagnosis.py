@@ -72,7 +72,7 @@ from elastokin.diagnosis.kc_rig_mechanics import (BY_KEY, ELEMENTS, RIG, element
 from elastokin.diagnosis.kc_rig_or_car import RigOrCar, rig_or_car
 from elastokin.diagnosis.kc_noise import NoiseModel, coloured_noise
 from elastokin.diagnosis.kc_scorer import Scorer
-from elastokin.diagnosis.kc_layout import Job, Layout, run_job
+from elastokin.diagnosis.kc_layout import Job, Layout, RunRows, run_job
 from elastokin.diagnosis.verdict import (Outcome, Separation, decide, explained, misfit, misfit_stretch, pair_named,
                                     pair_shares, second_cause_wanted, single_verdict, split)
 from elastokin.recordings.kc_dataset import KCDataset
@@ -215,27 +215,23 @@ def _diagnosis(layout: Layout, vehicle: VehicleDefinition, pool: Executor, say: 
     training = [i for i in every if not heldout[i]]
     candidates = hypotheses(vehicle)
 
-    def runs(sets: list[tuple[str, list[Job], Sequence[int]]]) -> list[np.ndarray]:
+    def runs(sets: list[tuple[str, list[Job], Sequence[int]]]) -> RunRows:
         """The compared rows of each set of runs (what it is, its jobs, the tests they run: NaN
-        elsewhere), all in parallel."""
-        jobs = [(label, t, j) for label, js, tests in sets for t, j in zip(tests, js)]
-        flat: list[dict[str, np.ndarray]] = [{}] * len(jobs)
+        elsewhere), all in parallel, each run's placed as it comes."""
+        jobs = [(label, k, t, j) for k, (label, js, tests) in enumerate(sets) for t, j in zip(tests, js)]
+        out = RunRows(layout, [tests for _, _, tests in sets])
         each = max(1, len(jobs) // max(len(sets), 1))   # no set at all: a campaign whose inputs never move
-        with closing(pool.each(run_job, [j for _, _, j in jobs])) as outcomes:   # a failure cancels the others at once
+        with closing(pool.each(run_job, [j for *_, j in jobs])) as outcomes:   # a failure cancels the others at once
             for done, o in enumerate(outcomes, 1):
+                label, k, test, _ = jobs[o.index]
                 if o.error:
-                    label, test, _ = jobs[o.index]
                     raise TaskFailed(f"{label} on {layout.tests[test].name}: {o.error}")
-                flat[o.index] = o.result
+                out.place(k, o.result, test)
                 if len(sets) > 1 and done % each == 0:
-                    say(f"  {done}/{len(flat)} runs done on {pool.description}")
-        out, start = [], 0
-        for _, js, tests in sets:
-            out.append(layout.stack(flat[start:start + len(js)], tests))
-            start += len(js)
+                    say(f"  {done}/{len(jobs)} runs done on {pool.description}")
         return out
 
-    def rows(vehicles: list[VehicleDefinition], tests: Sequence[int]) -> list[np.ndarray]:
+    def rows(vehicles: list[VehicleDefinition], tests: Sequence[int]) -> RunRows:
         """The compared rows of each vehicle on ``tests`` (NaN elsewhere), the runs in parallel."""
         return runs([(f"vehicle {k + 1} of {len(vehicles)}", layout.jobs(v, tests), tests)
                      for k, v in enumerate(vehicles)])
@@ -254,6 +250,7 @@ def _diagnosis(layout: Layout, vehicle: VehicleDefinition, pool: Executor, say: 
                                             **{(RIG, e.key, None): element_column(r, base, e)
                                                for e, r in zip(ELEMENTS, nuisances[len(movers):])},
                                             **reading_columns(layout, base), **drift_columns(layout)}, rig_at)
+    del nuisances   # the scorer holds their columns
     before = scorer.heldout_error(base)
     say(f"held-out error of the baseline: {before:.3f} (1 = the measurement noise); one run of each of "
         f"{len(candidates)} hypotheses at mid-range magnitude on the {len(training)} training tests")
@@ -280,8 +277,8 @@ def _diagnosis(layout: Layout, vehicle: VehicleDefinition, pool: Executor, say: 
     if second_cause_wanted(before, best.heldout_error, 1.0, bool(unfitted)):
         say(f"{best.hypothesis.label} leaves {best.heldout_error:.3f} × the noise"
             f"{' and tests it does not fit' if left else ''}: every other hypothesis beside it")
-        others = [(h, sig) for h, sig in zip(candidates, signatures)
-                  if (h.cause, h.location) != (best.hypothesis.cause, best.hypothesis.location)]
+        others = ((h, sig) for h, sig in zip(candidates, signatures)   # each read as it is fitted
+                  if (h.cause, h.location) != (best.hypothesis.cause, best.hypothesis.location))
         pairs = _second_stage(best, others, base, scorer,
                               lambda hs, tests: rows([extended_vehicle(vehicle, h) for h in hs], tests), every,
                               training)
@@ -344,7 +341,7 @@ def _diagnosis(layout: Layout, vehicle: VehicleDefinition, pool: Executor, say: 
                                           float(np.median([t.job.duration_scale for t in layout.tests])),
                                           lambda jobs: pool.map(run_unless_diverged, jobs))
             out.extra_tests = len(extra)
-        out.rig_or_car = rig_or_car(scorer, model, out.rig_errors, list(zip(candidates, signatures)), base,
+        out.rig_or_car = rig_or_car(scorer, model, out.rig_errors, zip(candidates, signatures), base,
                                     [c.hypothesis for c in out.causes])
         for c in out.rig_or_car:
             say(f"what {c.group} took out, {' or '.join(h.label for h in c.rivals)} would explain as well "
@@ -353,8 +350,8 @@ def _diagnosis(layout: Layout, vehicle: VehicleDefinition, pool: Executor, say: 
     return out, explain
 
 
-def _second_stage(best: Candidate, others: list[tuple[Hypothesis, np.ndarray]], base: np.ndarray, scorer: Scorer,
-                  rows: Callable[[list[list[Hypothesis]], Sequence[int]], list[np.ndarray]],
+def _second_stage(best: Candidate, others: Iterable[tuple[Hypothesis, np.ndarray]], base: np.ndarray, scorer: Scorer,
+                  rows: Callable[[list[list[Hypothesis]], Sequence[int]], Sequence[np.ndarray]],
                   every: Sequence[int], training: Sequence[int]) -> list[Candidate]:
     """Every other hypothesis beside ``best``: its magnitude fitted on what ``best``'s run leaves, its
     effect taken from its own screening run (``others``: hypothesis, rows); the best VERIFIED run
@@ -369,7 +366,7 @@ def _second_stage(best: Candidate, others: list[tuple[Hypothesis, np.ndarray]], 
     refits = [(c, fit_pair(best, c, base, scorer, s)) for c, s in zip(top, slopes)]
     moved = [(c, r) for c, r in refits if r is not None]
 
-    def run(pairs: list[Candidate]) -> list[np.ndarray]:
+    def run(pairs: list[Candidate]) -> Sequence[np.ndarray]:
         return rows([[r.beside.hypothesis, r.hypothesis] for r in pairs], every)
 
     # two magnitudes and a shape moved at once along their linearised effects can overshoot (a Mullins
@@ -383,7 +380,7 @@ def _second_stage(best: Candidate, others: list[tuple[Hypothesis, np.ndarray]], 
     return sorted(better + [c for c, r in refits if r is None], key=lambda c: c.score)
 
 
-def _slopes(top: list[Candidate], run_moved: Callable[[list[Hypothesis]], list[np.ndarray]]
+def _slopes(top: list[Candidate], run_moved: Callable[[list[Hypothesis]], Sequence[np.ndarray]]
             ) -> list[np.ndarray | None]:
     """Per candidate, its rows' slope along its cause's second parameter, from one more run on the
     training tests with that parameter moved (:func:`elastokin.diagnosis.kc_fits.nudged`; ``run_moved``

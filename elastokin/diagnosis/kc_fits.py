@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
+from typing import Sequence
 
 import numpy as np
 
@@ -232,7 +233,7 @@ def nudged(h: Hypothesis) -> tuple[Hypothesis, float]:
     return replace(h, values={**h.values, second.name: value + step}), step
 
 
-def kept(first: list[Candidate], refit: list[Candidate], simulated: list[np.ndarray], scorer: Scorer
+def kept(first: list[Candidate], refit: list[Candidate], simulated: Sequence[np.ndarray], scorer: Scorer
          ) -> list[Candidate]:
     """Of each candidate and its refit (whose runs are ``simulated``), the better, best first; a
     refit's uncertainty at least its shift (the linearised one ignores the model's nonlinearity)."""
@@ -242,7 +243,7 @@ def kept(first: list[Candidate], refit: list[Candidate], simulated: list[np.ndar
     return sorted((min(a, b, key=lambda c: c.score) for a, b in zip(first, refit)), key=lambda c: c.score)
 
 
-def verify(candidates: list[Candidate], simulated: list[np.ndarray], scorer: Scorer) -> None:
+def verify(candidates: list[Candidate], simulated: Sequence[np.ndarray], scorer: Scorer) -> None:
     """Give each candidate its full vehicle run's rows (``simulated``) and their errors."""
     for c, rows in zip(candidates, simulated):
         c.simulated = rows

@@ -117,15 +117,37 @@ class Layout:
         """The runs of ``tests`` (indices) on ``vehicle``."""
         return [replace(self.tests[i].job, vehicle=vehicle) for i in tests]
 
-    def stack(self, results: Sequence[dict[str, np.ndarray]], tests: Sequence[int]) -> np.ndarray:
-        """(N, C) rows of simulated runs of ``tests``; NaN in the rows of the others."""
-        out = np.full(self.measured.shape, np.nan)
-        for result, i in zip(results, tests):
-            t, n = self.tests[i], len(result[self.channels[0]])
-            if (n != len(t.rows)) if t.whole else (t.samples[-1] >= n):
-                raise RuntimeError(f"{t.name}: the simulation gave {n} samples of the input phase, the recording "
-                                   f"{len(t.rows)}{'' if t.whole else f' up to sample {t.samples[-1] + 1}'}")
-            out[t.rows] = np.column_stack([result[ch][t.samples] for ch in self.channels])
+
+
+class RunRows(Sequence[np.ndarray]):
+    """The compared rows of sets of simulated runs, each set's held on its tests' rows alone and read
+    as (N, C) rows, NaN in the other tests' (a screening's hundred-odd runs on the training tests
+    without the held-out tests' NaN: 119 × (N, C) float64 were 255 MiB of the shipped dataset's
+    diagnosis)."""
+
+    def __init__(self, layout: Layout, tests: Sequence[Sequence[int]]):
+        """``tests``: each set's tests (indices)."""
+        self.layout = layout
+        self.on = [np.isin(layout.test, list(t)) for t in tests]   #: each set's rows (N,)
+        self.held = [np.full((int(on.sum()), len(layout.channels)), np.nan) for on in self.on]
+
+    def place(self, k: int, result: dict[str, np.ndarray], i: int) -> None:
+        """A simulated run of test ``i`` (its compared channels over its input phase) into set ``k``."""
+        t, n = self.layout.tests[i], len(result[self.layout.channels[0]])
+        if (n != len(t.rows)) if t.whole else (t.samples[-1] >= n):
+            raise RuntimeError(f"{t.name}: the simulation gave {n} samples of the input phase, the recording "
+                               f"{len(t.rows)}{'' if t.whole else f' up to sample {t.samples[-1] + 1}'}")
+        at = np.cumsum(self.on[k]) - 1   # each row's place among the set's
+        self.held[k][at[t.rows]] = np.column_stack([result[ch][t.samples] for ch in self.layout.channels])
+
+    def __len__(self) -> int:
+        return len(self.held)
+
+    def __getitem__(self, k):
+        if isinstance(k, slice):
+            return [self[j] for j in range(len(self))[k]]
+        out = np.full(self.layout.measured.shape, np.nan)
+        out[self.on[k]] = self.held[k]
         return out
 
 

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Sequence
+from typing import Iterable, Sequence
 
 import numpy as np
 
@@ -88,7 +88,7 @@ def families(readings: Sequence[Reading]) -> list[tuple[str, str, tuple[Reading,
 
 
 def rig_or_car(scorer: Scorer, model: np.ndarray, readings: Sequence[Reading],
-               screened: Sequence[tuple[Hypothesis, np.ndarray]], base: np.ndarray,
+               screened: Iterable[tuple[Hypothesis, np.ndarray]], base: np.ndarray,
                named: Sequence[Hypothesis] = ()) -> list[RigOrCar]:
     """For each family of rig errors ``readings`` (fitted beside ``model``'s rows) shows
     (:func:`families`), the hypotheses of the screening (``screened``: each with its run's rows on the

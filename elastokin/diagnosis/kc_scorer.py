@@ -68,7 +68,7 @@ class Scorer:
             return self._delivered(column)
         rows = np.zeros(self.layout.measured.shape)
         rows[:, column.channel] = column.values
-        return OneChannel(column.channel, self._delivered(rows)[:, column.channel])
+        return OneChannel(column.channel, self._delivered(rows)[:, column.channel].copy())   # not a view holding all channels
 
     def _zeroed(self, r: np.ndarray, rows: np.ndarray, zero: Callable[..., np.ndarray],
                 channel: int | None = None) -> np.ndarray:
