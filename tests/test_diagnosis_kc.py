@@ -821,6 +821,7 @@ def test_success_rate_through_a_rigs_acquisition(tmp_path, record_property, caus
         rig = draw_rig(rng, "typical", elements)
         result = diagnose_fresh(measure_truth(case, [h] if h else [], seed, duration_scale=0.25, chain=chain,
                                               rig=rig))
+        note = check(result, h)   # the car's verdict first: a wrong one is the failure to report
         for a in result["acquisition"]:
             truth = _chain_lags(chain)[a["path"]]
             assert abs(1e-3 * a["lag_ms"] - truth) <= 3e-3 * a["delay_std_ms"] + LAG_TOLERANCE_S, (a, truth)
@@ -829,7 +830,7 @@ def test_success_rate_through_a_rigs_acquisition(tmp_path, record_property, caus
         for g in result["rig"]:   # the diagnosis's pads have a typical compliance, not the rig's: a tenth besides
             truth = rig.get(g["element"], 0.0)
             assert abs(g["value"] - truth) <= 3.0 * g["std"] + 0.1 * truth + BY_KEY[g["element"]].floor, (g, truth)
-        return check(result, h)
+        return note
 
     assert_success_rate(f"{cause} through {'+'.join(elements)}", SLOW_SEEDS, tmp_path, attempt, record_property,
                         OWN_FORM_SUCCESS_RATE)

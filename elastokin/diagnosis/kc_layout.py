@@ -118,7 +118,6 @@ class Layout:
         return [replace(self.tests[i].job, vehicle=vehicle) for i in tests]
 
 
-
 class RunRows(Sequence[np.ndarray]):
     """The compared rows of sets of simulated runs, each set's held on its tests' rows alone and read
     as (N, C) rows, NaN in the other tests' (a screening's hundred-odd runs on the training tests
@@ -143,7 +142,7 @@ class RunRows(Sequence[np.ndarray]):
     def __len__(self) -> int:
         return len(self.held)
 
-    def __getitem__(self, k):
+    def __getitem__(self, k: int | slice) -> np.ndarray | list[np.ndarray]:
         if isinstance(k, slice):
             return [self[j] for j in range(len(self))[k]]
         out = np.full(self.layout.measured.shape, np.nan)
