@@ -131,11 +131,11 @@ def _relaxed(columns: np.ndarray, segments: Sequence[Segment], tau_s: float, bac
         phi = math.exp(-g.dt_s / tau_s) if g.dt_s > 0.0 else 0.0
         seg = columns[:, g.first:g.end]
         filtered = sps.lfilter([1.0], [1.0, -phi], seg[:, ::-1] if backward else seg, axis=1)
-        near_s = g.start_s + (n - 1) * g.dt_s if backward else g.start_s   # the edge facing the carry
+        edges_s = (g.start_s, g.start_s + (n - 1) * g.dt_s)   # its first and last rows' times
+        near_s, far_s = edges_s[::-1] if backward else edges_s   # the one facing the carry first
         if carry is not None and g.recording == recording:
             filtered += carry[:, None] * (math.exp(-abs(near_s - edge_s) / tau_s) * phi ** np.arange(n))[None, :]
-        carry, recording = filtered[:, -1].copy(), g.recording
-        edge_s = g.start_s if backward else g.start_s + (n - 1) * g.dt_s
+        carry, recording, edge_s = filtered[:, -1].copy(), g.recording, far_s
         out[:, g.first:g.end] = filtered[:, ::-1] if backward else filtered
     return out
 
