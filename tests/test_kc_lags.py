@@ -232,6 +232,27 @@ def test_a_zero_drifting_through_each_recording_is_read_and_leaves_the_cars_effe
     assert {k[2] for k in drift_columns(held)} == {"recording 1", "recording 2", "recording 3"}
 
 
+def test_a_drift_runs_through_its_recording_by_the_recordings_clock():
+    """Two repeated tests in one recording, the second starting 30 s after the first: with the
+    recording's clock a channel's one drift runs through both (its column the minutes since the
+    recording started, across the gap); without the clock each test is its own recording, as the
+    noise's covariance takes it (:meth:`kc_layout.Layout.clock`), with its own drift on its input
+    time."""
+    t = np.arange(0.0, 10.0, 0.1)
+    tests = [kc_layout.Test(f"test {k}", None, np.arange(k * len(t), (k + 1) * len(t)), np.arange(len(t)), True, 20)
+             for k in range(2)]
+    one = np.zeros(2 * len(t), dtype=int)
+    bare = kc_layout.Layout(["toe_fl"], np.zeros((2 * len(t), 1)), np.tile(t, 2), one, np.repeat([0, 1], len(t)), tests)
+    timed = replace(bare, recording_time_s=np.r_[t, t + 30.0], recordings=("session",))
+    (column,) = drift_columns(timed).values()
+    assert list(drift_columns(timed)) == [("drift", "toe_fl", "session")]
+    np.testing.assert_allclose(column.values, np.r_[t, t + 30.0] / 60.0)
+    own = drift_columns(bare)
+    assert [k[2] for k in own] == ["recording 0", "recording 1"]
+    np.testing.assert_allclose(sum(c.values for c in own.values()), np.tile(t, 2) / 60.0)
+    np.testing.assert_allclose(own[("drift", "toe_fl", "recording 1")].values, np.r_[0.0 * t, t] / 60.0)
+
+
 @pytest.mark.parametrize("seed", range(9, 15))
 def test_a_slow_noise_is_not_read_as_a_drift(seed):
     """AR(1) noise correlated over 0.1 s and 1/f noise, each of twice the white noise, and no drift

@@ -5,7 +5,7 @@ a recorded case's input phase, one column per compared channel, and the vehicle 
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from typing import Sequence
+from typing import NamedTuple, Sequence
 
 import numpy as np
 
@@ -61,6 +61,15 @@ class Test:
     period: int = 0           #: samples in a period of its input, repeated (0: not repeated)
 
 
+class Clock(NamedTuple):
+    """Where each compared row lies in its recording (a rig session, its transducers' zeros drifting
+    and its noise running on through it)."""
+
+    time_s: np.ndarray          #: (N,) time since the recording started [s]
+    recording: np.ndarray       #: (N,) the recording's index
+    names: tuple[str, ...]      #: each recording's name, by index
+
+
 @dataclass
 class Layout:
     """The compared samples of the dataset: one row per sample of an input phase, one column per
@@ -112,6 +121,16 @@ class Layout:
         return cls(channels, np.vstack(measured), np.concatenate(times), np.concatenate(recording), test, tests,
                    (*data.damage, *unrecorded), np.vstack(commands), np.concatenate(clock),
                    tuple(t.name for t in data.tests), tuple(first.units[ch] for ch in channels))
+
+    @property
+    def clock(self) -> Clock:
+        """The rows' recordings by their clock (``recording_time_s``, ``recording``, ``recordings``); a
+        layout without the recordings' clock takes each test as its own recording (its ``input_time``
+        restarts with each)."""
+        if self.recording_time_s is None:
+            return Clock(self.input_time, self.test, tuple(f"recording {k}" for k in range(len(self.tests))))
+        return Clock(self.recording_time_s, self.recording, self.recordings
+                     or tuple(f"recording {k}" for k in range(int(self.recording.max()) + 1)))
 
     def jobs(self, vehicle: VehicleDefinition, tests: Sequence[int]) -> list[Job]:
         """The runs of ``tests`` (indices) on ``vehicle``."""

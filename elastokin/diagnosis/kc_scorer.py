@@ -252,12 +252,9 @@ class Scorer:
         tests = self.layout.test[rows]
         firsts = np.flatnonzero(np.r_[True, tests[1:] != tests[:-1]])
         ends = np.r_[firsts[1:], len(tests)]
-        layout = self.layout
-        clock, recording = ((layout.input_time, layout.test) if layout.recording_time_s is None
-                            else (layout.recording_time_s, layout.recording))
-        at = np.flatnonzero(rows)
-        segments = [Segment(int(a), int(b), self.response.steps[tests[a]], float(clock[at[a]]), int(recording[at[a]]))
-                    for a, b in zip(firsts, ends)]
+        clock, at = self.layout.clock, np.flatnonzero(rows)
+        segments = [Segment(int(a), int(b), self.response.steps[tests[a]], float(clock.time_s[at[a]]),
+                            int(clock.recording[at[a]])) for a, b in zip(firsts, ends)]
         out = np.zeros((len(columns), len(columns)))
         for k, c in enumerate(channels):
             if isinstance(columns, Columns):

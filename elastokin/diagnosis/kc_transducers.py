@@ -151,14 +151,13 @@ def drift_columns(layout: Layout) -> dict[Key, OneChannel]:
     docstring): the time through the recording [min] on its rows, on that channel alone (its mean,
     and so its start, goes with the recording's zero; through the acquisition's filter and delay, as
     every column goes, a straight line stays one, late by a constant the zero takes too)."""
-    time = layout.input_time if layout.recording_time_s is None else layout.recording_time_s
+    clock = layout.clock
     out: dict[Key, OneChannel] = {}
-    for k in np.unique(layout.recording):
-        on = layout.recording == k
+    for k in np.unique(clock.recording):
+        on = clock.recording == k
         if all(layout.tests[i].period > 0 for i in np.unique(layout.test[on])):
-            name = layout.recordings[k] if layout.recordings else f"recording {k}"
-            minutes = np.where(on, time / 60.0, 0.0)
-            out.update({(DRIFT, c, name): OneChannel(i, minutes) for i, c in enumerate(layout.channels)})
+            minutes = np.where(on, clock.time_s / 60.0, 0.0)
+            out.update({(DRIFT, c, clock.names[k]): OneChannel(i, minutes) for i, c in enumerate(layout.channels)})
     return out
 
 
