@@ -10,7 +10,7 @@ from elastokin.diagnosis.kc_columns import Columns, OneChannel
 from elastokin.diagnosis import kc_layout
 from elastokin.diagnosis.kc_rig_mechanics import BY_KEY, RIG, with_element
 from elastokin.diagnosis.kc_scorer import Scorer
-from elastokin.diagnosis.kc_transducers import bounded_solve
+from elastokin.diagnosis.kc_transducers import bounded_solve, reading_columns
 from elastokin.diagnosis.verdict import split
 from elastokin.vehicle.model.elements import RigMechanics
 
@@ -115,3 +115,36 @@ def test_a_rig_element_linearised_at_a_value_reads_and_is_bounded_from_it():
     assert scorer(-10.0, at).rig_errors(base)[0].value == 0.0
     assert scorer(12.0, None).rig_errors(base)[0].value == 0.0
     assert scorer(12.0, at).nuisances(np.ones(2000, dtype=bool))[3][-1] == -20.0
+
+
+def test_a_predictions_change_is_read_through_the_transducers_errors():
+    """A cause's toe change (a progressive bump steer, as large as the baseline's at full travel)
+    measured through a toe head reading 2 % high and seeing 1.5 % of its camber, white noise on top:
+    fitted beside the cause's prediction, the head's gain and cross-talk are read within 3 of their
+    uncertainties (1.43 ± 0.08 % for 1.5). Their columns are the baseline's rows; the cause's change
+    is read through the same gain (:func:`~elastokin.diagnosis.kc_transducers.as_read`), not left to
+    the cross-talk, whose camber the change partly follows (so left: 0.78 ± 0.19 %)."""
+    rng = np.random.default_rng(3)
+    rate_hz, tests, base, times = 50.0, [], [], []
+    for k, (amplitude, period_s) in enumerate([(30.0, 10.0), (60.0, 10.0), (30.0, 4.0), (60.0, 4.0)]):
+        t = np.arange(0.0, 2.0 * period_s, 1.0 / rate_hz)
+        travel = amplitude * (2.0 / np.pi) * np.arcsin(np.sin(2.0 * np.pi * t / period_s))
+        # camber follows the travel; toe too, with a part of its own (another test's content)
+        base.append(np.column_stack([-0.02 * travel, 0.01 * travel + 0.2 * np.sin(2.0 * np.pi * t / period_s) ** 2]))
+        start = sum(len(x) for x in times)
+        tests.append(kc_layout.Test(f"test {k}", None, np.arange(start, start + len(t)), np.arange(len(t)), True,
+                                    int(period_s * rate_hz)))
+        times.append(t)
+    base = np.vstack(base)
+    travel = base[:, 0] / -0.02
+    change = np.column_stack([np.zeros(len(base)), 0.01 * travel * np.abs(travel) / 60.0])   # progressive
+    gain, crosstalk, truth = 0.02, 0.015, base + change
+    measured = truth + 0.003 * rng.standard_normal(truth.shape)
+    measured[:, 1] += gain * truth[:, 1] + crosstalk * truth[:, 0]
+    recording = np.repeat(np.arange(4), [len(t) for t in times])
+    layout = kc_layout.Layout(["camber_fl", "toe_fl"], measured, np.concatenate(times), recording, recording.copy(),
+                              tests)
+    scorer = Scorer(layout, base, np.array([False, True, False, True]), reading_columns(layout, base))
+    read = {(g.kind, g.channel): g for g in scorer.rig_errors(truth, [change])}
+    for key, value in ((("gain", "toe_fl"), gain), (("cross-talk", "toe_fl"), crosstalk), (("gain", "camber_fl"), 0.0)):
+        assert abs(read[key].value - value) < 3.0 * read[key].std and read[key].std < 0.002, (key, read[key])

@@ -16,7 +16,7 @@ from elastokin.diagnosis.kc_lags import PathResponse, Response, fit_response, pa
 from elastokin.diagnosis.kc_layout import Layout
 from elastokin.diagnosis.kc_noise import Segment, estimate_noise, white_noise
 from elastokin.diagnosis.kc_rig_mechanics import RIG
-from elastokin.diagnosis.kc_transducers import Key, Reading, bounded_solve, bounds, drift_spread, reading
+from elastokin.diagnosis.kc_transducers import Key, Reading, as_read, bounded_solve, bounds, drift_spread, reading
 
 
 class Scorer:
@@ -29,13 +29,15 @@ class Scorer:
     def __init__(self, layout: Layout, baseline: np.ndarray, heldout: np.ndarray,
                  transducers: Mapping[Key, np.ndarray | OneChannel] | None = None,
                  rig_at: Mapping[str, float] | None = None):
-        """``transducers``: the rows' derivative (N, C) with respect to each transducer error fitted
+        """``baseline`` (N, C): the baseline's rows, the gains' and cross-talks' columns its own
+        (:func:`~elastokin.diagnosis.kc_transducers.reading_columns`). ``transducers``: the rows'
+        derivative (N, C) with respect to each transducer error fitted
         with every prediction (:mod:`elastokin.diagnosis.kc_transducers`; one channel's alone for a
         :class:`~elastokin.diagnosis.kc_columns.OneChannel`), as the rig's acquisition delivers it (here).
         ``rig_at``: each rig element's value [its unit] the runs were made at beyond the scenarios'
         rigs (default none): its column's coefficient is the change from it, held so that the element
         stays within its bounds, and its reading the value."""
-        self.layout, self.heldout = layout, heldout
+        self.layout, self.heldout, self.baseline = layout, heldout, baseline
         self.held_rows = heldout[layout.test]
         self.paths = paths(layout.channels)
         self.response = Response(layout, self.paths)
@@ -129,6 +131,14 @@ class Scorer:
         self._held[key] = coef[:nuisances]
         return coef
 
+    def _read(self, coef: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
+        """A change (N, C) of the baseline's rows as the transducers read it with the nuisances'
+        coefficients ``coef`` (the taps' then the transducers'): the gains' and cross-talks' columns
+        are the baseline's rows, so a prediction away from it (a cause's toe change) is read through
+        the same errors (:func:`~elastokin.diagnosis.kc_transducers.as_read`)."""
+        errors = coef[len(coef) - len(self._transducers):]
+        return lambda change: as_read(change, list(self._transducers), errors, self.layout.channels)
+
     def _kept(self, what: str, predicted: np.ndarray, key: tuple, compute: Callable[[], np.ndarray]) -> np.ndarray:
         """``compute()``, read-only, or the last one of ``what`` if it was for the same ``predicted``
         (the very array) and ``key`` (a screening's fits share their base)."""
@@ -161,18 +171,31 @@ class Scorer:
         nuisances' span projected out (n, C) (its uncertainty's column). Fitted jointly, not each
         effect's residual apart: a transducer's error at its bound in one and within it in the other
         would take a share of the effect (a hardpoint's tilt of camber as the camber heads' gain)."""
-        m = self.raw(predicted, rows)
-        stack, gram, inverse = self._nuisance(rows)
-        seen = [self.seen(e, rows) for e in effects]
-        cross = np.array([stack.products(d) for d in seen]).reshape(len(seen), len(stack))
-        own = np.array([[float(np.sum(a * b)) for b in seen] for a in seen])
-        matrix = np.block([[gram, cross.T], [cross, own]])
-        both = np.concatenate([stack.products(m), [float(np.sum(d * m)) for d in seen]])
-        k = len(stack)
-        coef = self._solve(rows, k, matrix, both, np.vstack([self._column_bounds(k), limits]))
+        stack, _, inverse = self._nuisance(rows)
+        coef, left, seen, cross = self._joint(predicted, effects, rows, limits)
+        projected = [d - stack.combine(inverse @ x).reshape(left.shape) for d, x in zip(seen, cross)]
+        return coef[len(stack):], left, projected
+
+    def _joint(self, predicted: np.ndarray, effects: Sequence[np.ndarray], rows: np.ndarray, limits: np.ndarray
+               ) -> tuple[np.ndarray, np.ndarray, list[np.ndarray], np.ndarray]:
+        """:meth:`fit_effects`'s fit: the nuisances' and the effects' coefficients (K + E,), what they
+        leave (n, C), the effects as the raw residual sees them (each (n, C)) and their products with
+        the nuisance columns (E, K). Fitted twice, the second time with the prediction's change from
+        the baseline and the effects read through the transducers' errors the first found (:meth:`_read`)."""
+        stack, gram, _ = self._nuisance(rows)
+        k, m, seen, coef = len(stack), self.raw(predicted, rows), [self.seen(e, rows) for e in effects], None
+        for _ in range(2):
+            if coef is not None:
+                read, change = self._read(coef[:k]), predicted - self.baseline
+                m = self.raw(self.baseline + read(change), rows) if change.any() else m   # the screening's: none
+                seen = [self.seen(read(e), rows) for e in effects]
+            cross = np.array([stack.products(d) for d in seen]).reshape(len(seen), k)
+            own = np.array([[float(np.sum(a * b)) for b in seen] for a in seen]).reshape(len(seen), len(seen))
+            matrix = np.block([[gram, cross.T], [cross, own]])
+            both = np.concatenate([stack.products(m), [float(np.sum(d * m)) for d in seen]])
+            coef = self._solve(rows, k, matrix, both, np.vstack([self._column_bounds(k), limits]))
         left = m - stack.combine(coef[:k]).reshape(m.shape) - sum(c * d for c, d in zip(coef[k:], seen))
-        projected = [d - stack.combine(inverse @ x).reshape(m.shape) for d, x in zip(seen, cross)]
-        return coef[k:], left, projected
+        return coef, left, seen, cross
 
     def nuisances(self, rows: np.ndarray) -> tuple[Columns, np.ndarray, np.ndarray, np.ndarray, list[Key | None]]:
         """The nuisance columns on the selected rows as :meth:`residual` fits them out; their Gram
@@ -207,21 +230,23 @@ class Scorer:
 
     def rig_errors(self, predicted: np.ndarray, effects: Sequence[np.ndarray] = ()) -> list[Reading]:
         """Each rig error (a transducer's, an element of the rig's mechanics) fitted beside
-        ``predicted`` (all rows), with its standard uncertainty (fitted with the acquisition's taps and with the named causes, whose
-        ``effects`` on the rows (N, C) in ``predicted`` are scaled with the errors: a cause that acts
-        on the campaign much as an error does leaves both uncertain; the residual's correlation counted)."""
+        ``predicted`` (all rows) with the named causes, whose ``effects`` on the rows (N, C) in
+        ``predicted`` are refitted with the errors (:meth:`fit_effects`'s fit: a cause that acts on the
+        campaign much as an error does leaves both uncertain, and a cause's run a little off its
+        value does not leave its change to the errors); with its standard uncertainty (the
+        acquisition's taps and the causes fitted with it, the residual's correlation counted)."""
         if not self._transducers:
             return []
         every = np.ones(len(predicted), dtype=bool)
-        left, stack, coef = self._fitted(self.raw(predicted, every, np.mean), every)
-        first = len(stack) - len(self._transducers)
-        joint = stack.extended([self.seen(e, every) for e in effects])
-        std = np.sqrt(self.variances(left, joint, every))[first:len(stack)]
-        held = coef[first:] != np.clip(coef[first:], self._bounds[:, 0] + 1e-12, self._bounds[:, 1] - 1e-12)
+        coef, left, seen, _ = self._joint(predicted, effects, every, np.tile([-np.inf, np.inf], (len(effects), 1)))
+        stack = self._nuisance(every)[0]
+        first, end = len(stack) - len(self._transducers), len(stack)
+        std = np.sqrt(self.variances(left, stack.extended(seen), every))[first:end]
+        coef = coef[first:end]
+        held = coef != np.clip(coef, self._bounds[:, 0] + 1e-12, self._bounds[:, 1] - 1e-12)
         units = dict(zip(self.layout.channels, self.layout.units))
-        return drift_spread([reading(key, float(at + coef[first + k]), float(s),
-                                     bool(held[k] and at + coef[first + k] != 0.0), units.get(key[1], ""))
-                             for k, (key, at, s) in enumerate(zip(self._transducers, self._at, std))])
+        return drift_spread([reading(key, float(at + c), float(s), bool(h and at + c != 0.0), units.get(key[1], ""))
+                             for key, at, c, s, h in zip(self._transducers, self._at, coef, std, held)])
 
     def variances(self, residual: np.ndarray, columns: list[np.ndarray] | Columns, rows: np.ndarray,
                   channels: np.ndarray | None = None) -> np.ndarray:

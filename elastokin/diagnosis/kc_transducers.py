@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from typing import Sequence
 
 import numpy as np
 
@@ -138,11 +139,34 @@ def reading_columns(layout: Layout, baseline: np.ndarray) -> dict[Key, OneChanne
     out: dict[Key, OneChannel] = {}
     for i, c in enumerate(layout.channels):
         out[(GAIN, c, None)] = OneChannel(i, baseline[:, i].copy())
-        source = CROSSTALK.get(channel_quantity(c))
-        seen = f"{source}_{channel_wheel(c)}" if source else None
+        seen = seen_channel(c)
         if seen in index or (seen in INPUT_CHANNELS and layout.inputs is not None):
-            out[(CROSS, c, source)] = OneChannel(i, baseline[:, index[seen]].copy() if seen in index
-                                                 else layout.inputs[:, INPUT_CHANNELS.index(seen)].copy())
+            source = baseline[:, index[seen]] if seen in index else layout.inputs[:, INPUT_CHANNELS.index(seen)]
+            out[(CROSS, c, CROSSTALK[channel_quantity(c)])] = OneChannel(i, source.copy())
+    return out
+
+
+def seen_channel(channel: str) -> str | None:
+    """The channel of the quantity ``channel``'s transducer sees of its wheel besides its own
+    (:data:`CROSSTALK`), if any."""
+    source = CROSSTALK.get(channel_quantity(channel))
+    return f"{source}_{channel_wheel(channel)}" if source else None
+
+
+def as_read(change: np.ndarray, keys: Sequence[Key], coef: np.ndarray, channels: Sequence[str]) -> np.ndarray:
+    """A ``change`` (N, C) of the rows the gains' and cross-talks' columns were taken at (the
+    baseline's, :func:`reading_columns`) as the transducers read it with the errors ``coef`` (one per
+    key of ``keys``, the others' ignored): each channel's change × (1 + its gain) plus its cross-talk's
+    share of its source's change (a rig command's: none). Those columns are the baseline's rows: a
+    prediction away from it (a cause's toe change) is read through the same gains."""
+    index = {c: i for i, c in enumerate(channels)}
+    out = change.copy()
+    for (kind, channel, _), a in zip(keys, coef):
+        i, seen = index.get(channel), index.get(seen_channel(channel) or "")
+        if kind == GAIN:
+            out[:, i] += a * change[:, i]
+        elif kind == CROSS and seen is not None:
+            out[:, i] += a * change[:, seen]
     return out
 
 
