@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from elastokin.vehicle.scenarios.scenario import Scenario
-from elastokin.diagnosis.kc_diagnosis import located_misfits
+from elastokin.diagnosis.kc_misfits import located_misfits
 from elastokin.diagnosis.kc_layout import Job, Layout, Test
 from elastokin.diagnosis.kc_scorer import Scorer
 from scipy.special import gammaincc

@@ -171,7 +171,7 @@ def test_a_slow_coloured_noise_is_counted_whole_and_in_the_uncertainties():
     a drift through each recording, fitted on such noise, get an uncertainty of their scatter over
     100 draws (within 30 %; 0.97 and 1.19 × it: the noise's covariance counted whole, as a column
     centred in its recording takes it, where what the recording's zero leaves of it gave 0.76 and 0.53)."""
-    from elastokin.diagnosis.kc_diagnosis import located_misfits
+    from elastokin.diagnosis.kc_misfits import located_misfits
     tau = 4.0
     chains = {c: ChannelChain(ar1_sigma=2.0 * NOISE[c], ar1_time_constant_s=tau) for c in range(len(CHANNELS))}
     layout, true = _layout(chains, 5)

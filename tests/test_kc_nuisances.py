@@ -10,7 +10,7 @@ from elastokin.diagnosis.kc_columns import Columns, OneChannel
 from elastokin.diagnosis import kc_layout
 from elastokin.diagnosis.kc_rig_mechanics import BY_KEY, RIG, with_element
 from elastokin.diagnosis.kc_scorer import Scorer
-from elastokin.diagnosis.kc_transducers import bounded_solve, reading_columns
+from elastokin.diagnosis.kc_transducers import INPUT_GAIN, bounded_solve, reading_columns
 from elastokin.diagnosis.verdict import split
 from elastokin.vehicle.model.elements import RigMechanics
 
@@ -117,19 +117,15 @@ def test_a_rig_element_linearised_at_a_value_reads_and_is_bounded_from_it():
     assert scorer(12.0, at).nuisances(np.ones(2000, dtype=bool))[3][-1] == -20.0
 
 
-def test_a_predictions_change_is_read_through_the_transducers_errors():
-    """A cause's toe change (a progressive bump steer, as large as the baseline's at full travel)
-    measured through a toe head reading 2 % high and seeing 1.5 % of its camber, white noise on top:
-    fitted beside the cause's prediction, the head's gain and cross-talk are read within 3 of their
-    uncertainties (1.51 ± 0.08 % for 1.5). Their columns are the baseline's rows; the cause's change
-    is read through the same gain (:func:`~elastokin.diagnosis.kc_transducers.as_read`), not left to
-    the cross-talk, whose camber the change partly follows (so left: 0.78 ± 0.19 %)."""
-    rng = np.random.default_rng(3)
+def _bump_steer_campaign() -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, list[kc_layout.Test]]:
+    """Four pumping-like tests (30 and 60 mm triangles of 10 and 4 s, 50 Hz): the times, each row's
+    recording, the baseline's camber and toe rows (camber follows the travel; toe too, with a part
+    of its own) and a cause's change of them (a progressive bump steer, as large as the baseline's
+    at full travel), the tests."""
     rate_hz, tests, base, times = 50.0, [], [], []
     for k, (amplitude, period_s) in enumerate([(30.0, 10.0), (60.0, 10.0), (30.0, 4.0), (60.0, 4.0)]):
         t = np.arange(0.0, 2.0 * period_s, 1.0 / rate_hz)
         travel = amplitude * (2.0 / np.pi) * np.arcsin(np.sin(2.0 * np.pi * t / period_s))
-        # camber follows the travel; toe too, with a part of its own (another test's content)
         base.append(np.column_stack([-0.02 * travel, 0.01 * travel + 0.2 * np.sin(2.0 * np.pi * t / period_s) ** 2]))
         start = sum(len(x) for x in times)
         tests.append(kc_layout.Test(f"test {k}", None, np.arange(start, start + len(t)), np.arange(len(t)), True,
@@ -137,14 +133,59 @@ def test_a_predictions_change_is_read_through_the_transducers_errors():
         times.append(t)
     base = np.vstack(base)
     travel = base[:, 0] / -0.02
-    change = np.column_stack([np.zeros(len(base)), 0.01 * travel * np.abs(travel) / 60.0])   # progressive
+    change = np.column_stack([np.zeros(len(base)), 0.01 * travel * np.abs(travel) / 60.0])
+    return np.concatenate(times), np.repeat(np.arange(4), [len(t) for t in times]), base, change, tests
+
+
+def test_a_predictions_change_is_read_through_the_transducers_errors():
+    """A cause's toe change (:func:`_bump_steer_campaign`) measured through a toe head reading 2 %
+    high and seeing 1.5 % of its camber, white noise on top: fitted beside the cause's prediction,
+    the head's gain and cross-talk are read within 3 of their uncertainties (1.51 ± 0.08 % for 1.5).
+    Their columns are the baseline's rows; the cause's change is read through the same gain
+    (:func:`~elastokin.diagnosis.kc_transducers.as_read`), not left to the cross-talk, whose camber
+    the change partly follows (so left: 0.78 ± 0.19 %)."""
+    rng = np.random.default_rng(3)
+    times, recording, base, change = _bump_steer_campaign()[:4]
     gain, crosstalk, truth = 0.02, 0.015, base + change
     measured = truth + 0.003 * rng.standard_normal(truth.shape)
     measured[:, 1] += gain * truth[:, 1] + crosstalk * truth[:, 0]
-    recording = np.repeat(np.arange(4), [len(t) for t in times])
-    layout = kc_layout.Layout(["camber_fl", "toe_fl"], measured, np.concatenate(times), recording, recording.copy(),
-                              tests)
+    layout = kc_layout.Layout(["camber_fl", "toe_fl"], measured, times, recording, recording.copy(),
+                              _bump_steer_campaign()[4])
     scorer = Scorer(layout, base, np.array([False, True, False, True]), reading_columns(layout, base))
     read = {(g.kind, g.channel): g for g in scorer.rig_errors(truth, [change])}
     for key, value in ((("gain", "toe_fl"), gain), (("cross-talk", "toe_fl"), crosstalk), (("gain", "camber_fl"), 0.0)):
         assert abs(read[key].value - value) < 3.0 * read[key].std and read[key].std < 0.002, (key, read[key])
+
+
+def test_a_rig_inputs_gain_acts_on_a_causes_change_too():
+    """The same cause, its slow tests played by a wheel pad whose travel transducer reads 2 % high
+    (the car gets the command / 1.02; the toy car's rows are proportional to the travel), its fast
+    ones by an exact one, measured through exact heads in white noise: the input-gain column is the
+    baseline's, so read beside the cause's run the rest of its change, 2 % of it in the slow tests,
+    goes to the gain (2.27 ± 0.04 % for 2); with the baseline and the cause run again under the gain
+    read (:meth:`~elastokin.diagnosis.kc_scorer.Scorer.rig_errors_under_inputs`), every reading is
+    within 3 of its uncertainties of the truth (the gain 1.98 ± 0.04 %)."""
+    rng = np.random.default_rng(5)
+    times, recording, base, change, tests = _bump_steer_campaign()
+    slow = (recording < 2)[:, None]
+    servo, truth = 1.0 / 1.02, base + change
+    measured = np.where(slow, servo, 1.0) * truth + 0.003 * rng.standard_normal(truth.shape)
+    layout = kc_layout.Layout(["camber_fl", "toe_fl"], measured, times, recording, recording.copy(), tests)
+    columns = {(INPUT_GAIN, "pad_z_fl", None): slow * base, **reading_columns(layout, base)}   # d rows / d its scale
+    scorer = Scorer(layout, base, np.array([False, True, False, True]), columns)
+    runs = []
+
+    def rerun(factors: dict[str, float]) -> list[np.ndarray]:
+        runs.append(factors)
+        scale = np.where(slow, factors["pad_z_fl"], 1.0)
+        return [scale * base, scale * truth]
+
+    plain = scorer.rig_errors(truth, [change])
+    read, model = scorer.rig_errors_under_inputs(truth, [change], rerun)
+    assert len(runs) == 1 and runs[0]["pad_z_fl"] == pytest.approx(servo, abs=0.005)   # the first reading's
+    truths = {("input gain", "pad_z_fl"): 0.02}
+    assert abs(plain[0].value - 0.02) > 3.0 * plain[0].std and plain[0].channel == "pad_z_fl"
+    for g in read:
+        assert abs(g.value - truths.get((g.kind, g.channel), 0.0)) < 3.0 * g.std and g.std < 0.002, g
+    assert np.abs(model - base - np.where(slow, runs[0]["pad_z_fl"], 1.0) * change).max() < 1e-12
+    assert scorer.rig_errors_under_inputs(truth, [], rerun)[1] is truth and len(runs) == 1   # no cause: no runs

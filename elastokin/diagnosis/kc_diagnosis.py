@@ -12,7 +12,8 @@
    recordings of repeated tests, :mod:`elastokin.diagnosis.kc_transducers`) and its own mechanics (its
    pads' friction, its body clamp's compliance, :mod:`elastokin.diagnosis.kc_rig_mechanics`): fitted
    with every hypothesis; what they take out that a car cause would explain as well is said
-   (:mod:`elastokin.diagnosis.kc_rig_or_car`). When the verdict shows the pads' friction (not
+   (:mod:`elastokin.diagnosis.kc_rig_or_car`); the rig inputs' gains the verdict shows act on the
+   named causes' change too, read from the baseline and the causes run again under them. When the verdict shows the pads' friction (not
    proportional in its effect, nor apart from a car cause that sticks and slips too), all of this
    runs again on a rig with it, its column then the change from it.
 2. Screening: every catalogue cause at every place it can sit (:mod:`elastokin.diagnosis.kc_catalogue`)
@@ -65,33 +66,21 @@ from elastokin.diagnosis.kc_catalogue import (BUSHING_CAUSES, VEHICLE_CAUSES, Hy
                                          parameters)
 from elastokin.diagnosis.kc_fits import Candidate, fit, fit_pair, halfway, kept, nominal, nudged, significant, verify
 from elastokin.diagnosis.kc_transducers import (INPUT_GAIN, STEP, Reading, drift_columns, input_column, moved,
-                                                reading_columns, stepped)
+                                                reading_columns, stepped, inputs_scaled)
 from elastokin.diagnosis.kc_lags import PathResponse
+from elastokin.diagnosis.kc_misfits import Misfit, located_misfits
 from elastokin.diagnosis.kc_rig_mechanics import (BY_KEY, ELEMENTS, RIG, element_column, element_jobs,
                                                    not_proportional, on_rig)
 from elastokin.diagnosis.kc_rig_or_car import RigOrCar, rig_or_car
 from elastokin.diagnosis.kc_noise import NoiseModel, coloured_noise
 from elastokin.diagnosis.kc_scorer import Scorer
 from elastokin.diagnosis.kc_layout import Job, Layout, RunRows, run_job
-from elastokin.diagnosis.verdict import (Outcome, Separation, decide, explained, misfit, misfit_stretch, pair_named,
-                                    pair_shares, second_cause_wanted, single_verdict, split)
+from elastokin.diagnosis.verdict import (Outcome, Separation, decide, explained, pair_named, pair_shares,
+                                    second_cause_wanted, single_verdict, split)
 from elastokin.recordings.kc_dataset import KCDataset
 
 #: Hypotheses re-run on the full vehicle after the screening.
 VERIFIED = 3
-
-
-@dataclass(frozen=True)
-class Misfit:
-    """A test a model does not fit, and where in it (:func:`elastokin.diagnosis.verdict.misfit_stretch`)."""
-
-    test: str
-    heldout: bool
-    error: float          #: the model's RMS error on it (1 = the noise), each recording's zeros its medians
-    chance: float         #: the chance that the noise alone shows a stretch as unlikely in the test
-    start_s: float        #: the stretch of the test holding the excess: from, to [s of its input]
-    end_s: float
-    channel: str          #: the channel with the most excess there
 
 
 @dataclass
@@ -318,7 +307,13 @@ def _diagnosis(layout: Layout, vehicle: VehicleDefinition, pool: Executor, say: 
     out.responses = scorer.responses(out.final.simulated if out.named else base)
     out.noise_model = scorer.noise_model
     model = out.final.simulated if out.named else base
-    out.rig_errors = scorer.rig_errors(model, _effects(out, base))
+
+    def under_inputs(factors: dict[str, float]) -> RunRows:
+        say("the baseline and the named causes again with the commands the car got through the rig inputs' gains")
+        return runs([(f"{label} under the inputs' gains", inputs_scaled(layout.jobs(v, every), factors), every)
+                     for label, v in (("the baseline", vehicle), ("the named causes", out.extended))])
+
+    out.rig_errors, model = scorer.rig_errors_under_inputs(model, _effects(out, base), under_inputs)
     for g in out.rig_errors:
         if g.said:
             say(f"{g.label}: {g.text} (taken out)")
@@ -420,25 +415,6 @@ def _best_per_place(candidates: Iterable[Candidate]) -> list[Candidate]:
         if _place(c.hypothesis) not in seen:
             seen.add(_place(c.hypothesis))
             out.append(c)
-    return out
-
-
-def located_misfits(layout: Layout, scorer: Scorer, predicted: np.ndarray) -> list[Misfit]:
-    """The tests ``predicted`` does not fit (:func:`elastokin.diagnosis.verdict.misfit`: the RMS error
-    over a test or a stretch of it beyond the noise, its correlation counted; every test, training
-    or held out), each with
-    where; each recording's zeros taken as its medians, so that one misfit does not shift the tests
-    beside it."""
-    residual = scorer.residual(predicted, np.ones(len(predicted), dtype=bool), np.median)
-    out = []
-    for i, t in enumerate(layout.tests):
-        error = float(np.sqrt(np.mean(residual[t.rows] ** 2)))
-        dt = float(np.median(np.diff(layout.input_time[t.rows]))) if len(t.rows) > 1 else 0.0
-        chance, first, last, channel = misfit_stretch(residual[t.rows],
-                                                      lambda width: scorer.noise_model.window_dof(width, dt))
-        if misfit(error, chance):
-            out.append(Misfit(t.name, bool(scorer.heldout[i]), error, chance, float(layout.input_time[t.rows[first]]),
-                              float(layout.input_time[t.rows[last]]), layout.channels[channel]))
     return out
 
 

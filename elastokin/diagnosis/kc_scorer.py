@@ -16,7 +16,8 @@ from elastokin.diagnosis.kc_lags import PathResponse, Response, fit_response, pa
 from elastokin.diagnosis.kc_layout import Layout
 from elastokin.diagnosis.kc_noise import Segment, estimate_noise, white_noise
 from elastokin.diagnosis.kc_rig_mechanics import RIG
-from elastokin.diagnosis.kc_transducers import Key, Reading, as_read, bounded_solve, bounds, drift_spread, reading
+from elastokin.diagnosis.kc_transducers import (INPUT_GAIN, Key, Reading, as_read, bounded_solve, bounds, drift_spread,
+                                                reading)
 
 
 class Scorer:
@@ -247,6 +248,24 @@ class Scorer:
         units = dict(zip(self.layout.channels, self.layout.units))
         return drift_spread([reading(key, float(at + c), float(s), bool(h and at + c != 0.0), units.get(key[1], ""))
                              for key, at, c, s, h in zip(self._transducers, self._at, coef, std, held)])
+
+    def rig_errors_under_inputs(self, predicted: np.ndarray, effects: Sequence[np.ndarray],
+                                rerun: Callable[[dict[str, float]], Sequence[np.ndarray]]
+                                ) -> tuple[list[Reading], np.ndarray]:
+        """:meth:`rig_errors`, the rig inputs' gains acting on the named causes' change too: their
+        columns are the baseline's, so with causes (``effects`` not empty) and inputs' gains the data
+        show (:attr:`~elastokin.diagnosis.kc_transducers.Reading.said`: the others' effect on the change
+        is below their uncertainty's on the baseline), ``rerun(factors)`` gives the baseline's and the
+        causes' rows (each (N, C)) with each input's command × its factor (the car's through a servo
+        reading g high: 1 / (1 + g)), and the errors are read again with the change between them in
+        the causes' stead; with the model read (N, C)."""
+        readings = self.rig_errors(predicted, effects)
+        factors = {g.channel: 1.0 / (1.0 + g.value) for g in readings if g.kind == INPUT_GAIN and g.said}
+        if not (effects and factors):
+            return readings, predicted
+        base, named = rerun(factors)
+        predicted = self.baseline + named - base
+        return self.rig_errors(predicted, effects), predicted
 
     def variances(self, residual: np.ndarray, columns: list[np.ndarray] | Columns, rows: np.ndarray,
                   channels: np.ndarray | None = None) -> np.ndarray:

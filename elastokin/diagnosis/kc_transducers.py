@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from typing import Sequence
+from typing import Mapping, Sequence
 
 import numpy as np
 
@@ -121,9 +121,14 @@ def moved(layout: Layout) -> dict[str, list[int]]:
 
 def stepped(layout: Layout, channel: str, tests: list[int]) -> list[Job]:
     """The baseline runs of ``tests`` with ``channel``'s command × (1 + :data:`STEP`)."""
-    scale = np.where(np.array(INPUT_CHANNELS) == channel, 1.0 + STEP, 1.0)
-    return [replace(layout.tests[i].job, scenario=layout.tests[i].job.scenario.with_inputs_scaled(scale))
-            for i in tests]
+    return inputs_scaled([layout.tests[i].job for i in tests], {channel: 1.0 + STEP})
+
+
+def inputs_scaled(jobs: Sequence[Job], factors: Mapping[str, float]) -> list[Job]:
+    """``jobs`` with each rig input's command × its factor in ``factors`` (rig input channel ->
+    factor; the others × 1): what the car gets from servos whose own transducers misread."""
+    scale = np.array([factors.get(ch, 1.0) for ch in INPUT_CHANNELS])
+    return [replace(j, scenario=j.scenario.with_inputs_scaled(scale)) for j in jobs]
 
 
 def input_column(stepped_rows: np.ndarray, baseline: np.ndarray) -> np.ndarray:

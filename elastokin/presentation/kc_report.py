@@ -15,7 +15,8 @@ from elastokin.vehicle.model.definition import VehicleDefinition
 from elastokin.core.files import atomic_output
 from elastokin.diagnosis.catalogue import PAIR_SEPARATOR
 from elastokin.diagnosis.kc_catalogue import Hypothesis, extended_vehicle_yaml, parameters
-from elastokin.diagnosis.kc_diagnosis import KCDiagnosis, Misfit
+from elastokin.diagnosis.kc_diagnosis import KCDiagnosis
+from elastokin.diagnosis.kc_misfits import Misfit
 from elastokin.diagnosis.kc_fits import Candidate
 from elastokin.diagnosis.kc_noise import coloured_noise
 from elastokin.diagnosis.kc_rig_mechanics import BY_KEY, RIG
