@@ -13,9 +13,9 @@
    pads' friction, its body clamp's compliance, :mod:`elastokin.diagnosis.kc_rig_mechanics`): fitted
    with every hypothesis; what they take out that a car cause would explain as well is said
    (:mod:`elastokin.diagnosis.kc_rig_or_car`); the rig inputs' gains the verdict shows act on the
-   named causes' change too, read from the baseline and the causes run again under them. When the verdict shows the pads' friction (not
-   proportional in its effect, nor apart from a car cause that sticks and slips too), all of this
-   runs again on a rig with it, its column then the change from it.
+   named causes' change too, read from the baseline and the causes run again under them. When the
+   verdict shows the pads' friction (not proportional in its effect, nor apart from a car cause that
+   sticks and slips too), all of this runs again on a rig with it, its column then the change from it.
 2. Screening: every catalogue cause at every place it can sit (:mod:`elastokin.diagnosis.kc_catalogue`)
    is run once on the training tests (every other one) at mid-range magnitude (a sided cause, whose
    sign picks another effect, or one whose effect is not odd in its magnitude, such as a cross
@@ -65,8 +65,8 @@ from elastokin.diagnosis.kc_alike import alike, extra_scenarios, run_unless_dive
 from elastokin.diagnosis.kc_catalogue import (BUSHING_CAUSES, VEHICLE_CAUSES, Hypothesis, extended_vehicle, locations,
                                          parameters)
 from elastokin.diagnosis.kc_fits import Candidate, fit, fit_pair, halfway, kept, nominal, nudged, significant, verify
-from elastokin.diagnosis.kc_transducers import (INPUT_GAIN, STEP, Reading, drift_columns, input_column, moved,
-                                                reading_columns, stepped, inputs_scaled)
+from elastokin.diagnosis.kc_transducers import (INPUT_GAIN, STEP, Reading, drift_columns, input_column, inputs_scaled,
+                                                moved, reading_columns, stepped)
 from elastokin.diagnosis.kc_lags import PathResponse
 from elastokin.diagnosis.kc_misfits import Misfit, located_misfits
 from elastokin.diagnosis.kc_rig_mechanics import (BY_KEY, ELEMENTS, RIG, element_column, element_jobs,
