@@ -145,12 +145,11 @@ def test_a_predictions_change_is_read_through_the_transducers_errors():
     (:func:`~elastokin.diagnosis.kc_transducers.as_read`), not left to the cross-talk, whose camber
     the change partly follows (so left: 0.78 ± 0.19 %)."""
     rng = np.random.default_rng(3)
-    times, recording, base, change = _bump_steer_campaign()[:4]
+    times, recording, base, change, tests = _bump_steer_campaign()
     gain, crosstalk, truth = 0.02, 0.015, base + change
     measured = truth + 0.003 * rng.standard_normal(truth.shape)
     measured[:, 1] += gain * truth[:, 1] + crosstalk * truth[:, 0]
-    layout = kc_layout.Layout(["camber_fl", "toe_fl"], measured, times, recording, recording.copy(),
-                              _bump_steer_campaign()[4])
+    layout = kc_layout.Layout(["camber_fl", "toe_fl"], measured, times, recording, recording.copy(), tests)
     scorer = Scorer(layout, base, np.array([False, True, False, True]), reading_columns(layout, base))
     read = {(g.kind, g.channel): g for g in scorer.rig_errors(truth, [change])}
     for key, value in ((("gain", "toe_fl"), gain), (("cross-talk", "toe_fl"), crosstalk), (("gain", "camber_fl"), 0.0)):
