@@ -304,9 +304,9 @@ def _diagnosis(layout: Layout, vehicle: VehicleDefinition, pool: Executor, say: 
         named = [c.hypothesis for c in out.causes]
         out.verdict = PAIR_SEPARATOR.join(h.cause for h in named)
         out.extended = extended_vehicle(vehicle, named)
-    out.responses = scorer.responses(out.final.simulated if out.named else base)
-    out.noise_model = scorer.noise_model
     model = out.final.simulated if out.named else base
+    out.responses = scorer.responses(model)
+    out.noise_model = scorer.noise_model
 
     def under_inputs(factors: dict[str, float]) -> RunRows:
         say("the baseline and the named causes again with the commands the car got through the rig inputs' gains")
