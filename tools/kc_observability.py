@@ -8,9 +8,19 @@ error), in units of the channel's noise (the virtual rig's defaults). A baseline
 ``elastokin.diagnosis.kc_catalogue.OBSERVABLE`` lists the places whose excess is at least
 ``kc_catalogue.MIN_EXCESS`` at the test campaign's speed (``--duration-scale 0.25``).
 
-    python tools/kc_observability.py [--vehicle V.yaml] [--duration-scale S] [--cause C ...] [--json]
+With ``--through-rig``, at each place of ``OBSERVABLE`` and at magnitudes spread over the draw's
+range (:data:`THROUGH_RIG_STEPS`, every sign and side it is drawn on), what the change leaves once
+a calibrated rig's errors have taken what they can: every rig error the diagnosis fits beside the
+causes (its inputs' and measuring transducers' gains and cross-talks, each within its bound; the
+zeros' drifts; the acquisition's lags; the rig's mechanics), fitted to the change alone on the
+car measured on the virtual rig without a chain. A cause below MIN_EXCESS there is one a rig's
+calibration errors can take whole; ``kc_catalogue.THROUGH_A_RIG`` lists each place's floor, the
+magnitude from which its weakest way stays above it.
 
-About 2 min on 2 cores at ``--duration-scale 0.25`` (its runs on a local Dask cluster, or where ``VSIM_SCHEDULER`` says).
+    python tools/kc_observability.py [--vehicle V.yaml] [--duration-scale S] [--cause C ...] [--through-rig] [--json]
+
+About 2 min on 2 cores at ``--duration-scale 0.25``, 29 with ``--through-rig`` beside a slow test
+run (its runs on a local Dask cluster, or where ``VSIM_SCHEDULER`` says).
 """
 
 from __future__ import annotations
@@ -19,7 +29,9 @@ import argparse
 import json
 import math
 import sys
+import tempfile
 from contextlib import closing
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -29,12 +41,22 @@ from elastokin.vehicle.model.vehicle_file import load_vehicle
 from elastokin.vehicle.scenarios.scenario_file import load_scenario
 from elastokin.cluster.executor import TaskFailed, executor
 from elastokin.core.shipped import DEFAULT_VEHICLE
-from elastokin.diagnosis.kc_catalogue import (BUSHING_CAUSES, MIN_EXCESS, VEHICLE_CAUSES, Hypothesis, extended_vehicle,
-                                         locations, parameters)
-from elastokin.diagnosis.kc_layout import COMPARED
+from elastokin.diagnosis.kc_catalogue import (BUSHING_CAUSES, MIN_EXCESS, OBSERVABLE, VEHICLE_CAUSES, Hypothesis,
+                                              drawn_ways, extended_vehicle, locations, parameters)
+from elastokin.diagnosis.kc_diagnosis import rig_scorer
+from elastokin.diagnosis.kc_layout import COMPARED, Layout, run_sets
 from elastokin.diagnosis.kc_fits import nominal
-from elastokin.diagnosis.virtual_kc_rig import DEFAULT_SCENARIOS, MEASUREMENT_DEFAULTS, sensor
+from elastokin.diagnosis.kc_scorer import Scorer
+from elastokin.diagnosis.kc_transducers import bounded_solve
+from elastokin.diagnosis.verdict import split
+from elastokin.diagnosis.virtual_kc_rig import (DEFAULT_SCENARIOS, MEASUREMENT_DEFAULTS, KCTruth, measure_kc,
+                                                sensor)
+from elastokin.recordings.kc_dataset import read_kc_dataset
 from elastokin.recordings.recorder import simulate
+
+#: Magnitudes tried at each place with ``--through-rig``: the draw's range's ends and evenly between,
+#: in the coordinate its effect grows with.
+THROUGH_RIG_STEPS = 4
 
 
 def weak(cause: str) -> list[dict[str, float]]:
@@ -75,17 +97,93 @@ def excess(base: list[dict[str, np.ndarray]], run: list[dict[str, np.ndarray]]) 
     return math.sqrt(float(np.mean(squares)))
 
 
+def left_by_the_rig(scorer: Scorer, change: np.ndarray) -> float:
+    """RMS over every compared channel and sample of what a ``change`` (N, C) of the baseline's rows
+    leaves once every rig error ``scorer`` fits has taken what it can of it, each within its bounds
+    (each channel's mean per recording removed) [noise]."""
+    rows = np.ones(len(change), dtype=bool)
+    columns, gram, limits, _, _ = scorer.nuisances(rows)
+    d = scorer.seen(change, rows)
+    coef = bounded_solve(gram, columns.products(d), limits)
+    return math.sqrt(float(np.mean((d - columns.combine(coef).reshape(d.shape)) ** 2)))
+
+
+def magnitudes(cause: str) -> list[float]:
+    """:data:`THROUGH_RIG_STEPS` magnitudes of ``cause``'s first parameter over its draw's range."""
+    first = parameters(cause)[0]
+    lo, hi = (first.effect(x) for x in first.draw)
+    return [first.from_effect(lo + k * (hi - lo) / (THROUGH_RIG_STEPS - 1)) for k in range(THROUGH_RIG_STEPS)]
+
+
+def rig_floor(cause: str, excess_by_magnitude: list[tuple[float, float]]) -> float:
+    """The first parameter's magnitude from which the excess left by the rig's errors stays at least
+    MIN_EXCESS (interpolated between the magnitudes tried, in their effect's coordinate; proportional
+    below the first; infinite if the last is below)."""
+    first = parameters(cause)[0]
+    if excess_by_magnitude[-1][1] < MIN_EXCESS:
+        return math.inf
+    k = max(i for i, (_, x) in enumerate(excess_by_magnitude) if i == 0 or excess_by_magnitude[i - 1][1] < MIN_EXCESS)
+    if k == 0:
+        return floor(cause, excess_by_magnitude[0][1])
+    (m0, x0), (m1, x1) = excess_by_magnitude[k - 1], excess_by_magnitude[k]
+    e0, e1 = first.effect(m0), first.effect(m1)
+    return first.from_effect(e0 + (MIN_EXCESS - x0) / (x1 - x0) * (e1 - e0))
+
+
+def through_rig(vehicle: VehicleDefinition, duration_scale: float, causes: list[str], show: bool
+                ) -> dict[str, dict[str, object]]:
+    """Per place of OBSERVABLE of ``causes``: the excess left by the rig's errors at each magnitude
+    (its weakest way) and the floor (module docstring); printed as they come if ``show``."""
+    places = [(c, where) for c in causes if c in OBSERVABLE for where in OBSERVABLE[c]]
+    tried = [(c, where, m, Hypothesis(c, where, {**nominal(c), parameters(c)[0].name: v}))
+             for c, where in places for m in magnitudes(c) for v in drawn_ways(c, m)]
+    scenarios = tuple(load_scenario(p) for p in DEFAULT_SCENARIOS)
+    clean = KCTruth("<a clean car>", vehicle, scenarios, (), MEASUREMENT_DEFAULTS, 1, duration_scale)
+    with tempfile.TemporaryDirectory() as folder, executor() as pool:
+        layout = Layout.of(read_kc_dataset(measure_kc(clean, Path(folder) / "measured")), vehicle)
+        every = range(len(layout.tests))
+        runs = partial(run_sets, layout, pool)
+        (base,) = runs([("the baseline", layout.jobs(vehicle, every), every)])
+        scorer = rig_scorer(layout, base, split(len(layout.tests)), runs)
+        rows = runs([(h.label, layout.jobs(extended_vehicle(vehicle, [h]), every), every) for *_, h in tried])
+        weakest: dict[tuple, dict[float, float]] = {}
+        for (c, where, m, h), r in zip(tried, rows):
+            x = left_by_the_rig(scorer, r - base)
+            if show:
+                print(f"{h.label:40s} {parameters(c)[0].name} = {h.values[parameters(c)[0].name]:<8.4g} "
+                      f"left by the rig's errors {x:7.2f}", flush=True)
+            at = weakest.setdefault((c, where), {})
+            at[m] = min(x, at.get(m, math.inf))
+    out = {}
+    for (c, where), at in weakest.items():
+        pairs = sorted(at.items())
+        out[Hypothesis(c, where).label] = {"excess": [x for _, x in pairs], "magnitudes": [m for m, _ in pairs],
+                                           "floor": rig_floor(c, pairs)}
+    return out
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--vehicle", type=Path, default=DEFAULT_VEHICLE)
     parser.add_argument("--duration-scale", type=float, default=1.0, help="the campaign's speed-up (0.25: the tests')")
     parser.add_argument("--cause", action="append", choices=[*BUSHING_CAUSES, *VEHICLE_CAUSES, "backlash"],
                         help="only this cause (repeat for more; default: every cause)")
+    parser.add_argument("--through-rig", action="store_true",
+                        help="what a calibrated rig's errors leave of each cause, at the places it is drawn")
     parser.add_argument("--json", action="store_true")
     args = parser.parse_args()
     vehicle = load_vehicle(args.vehicle)
-    base = campaign(vehicle, args.duration_scale)
     causes = args.cause or (*BUSHING_CAUSES, *VEHICLE_CAUSES, "backlash")
+    if args.through_rig:
+        floors = through_rig(vehicle, args.duration_scale, list(causes), not args.json)
+        if args.json:
+            print(json.dumps(floors))
+        else:
+            print("\nthe floor through a rig's errors (inf: below MIN_EXCESS over the whole draw range):")
+            for label, r in floors.items():
+                print(f"  {label:40s} floor {r['floor']:.4g}")
+        return 0
+    base = campaign(vehicle, args.duration_scale)
     places = [Hypothesis(c, where, values) for c in causes for where in locations(vehicle, c) for values in weak(c)]
     out: dict[str, dict[str, float]] = {}
     with executor() as ex, closing(ex.each(_campaign, [(extended_vehicle(vehicle, [h]), args.duration_scale)

@@ -52,14 +52,15 @@ from __future__ import annotations
 
 import math
 import time
-from contextlib import closing, nullcontext
+from contextlib import nullcontext
 from dataclasses import dataclass, field, replace
+from functools import partial
 from typing import Callable, Iterable, Sequence
 
 import numpy as np
 
 from elastokin.vehicle.model.definition import VehicleDefinition
-from elastokin.cluster.executor import Executor, TaskFailed, executor as open_executor
+from elastokin.cluster.executor import Executor, executor as open_executor
 from elastokin.diagnosis.catalogue import PAIR_SEPARATOR
 from elastokin.diagnosis.kc_alike import alike, extra_scenarios, run_unless_diverged, separations
 from elastokin.diagnosis.kc_catalogue import (BUSHING_CAUSES, VEHICLE_CAUSES, Hypothesis, extended_vehicle, locations,
@@ -74,7 +75,7 @@ from elastokin.diagnosis.kc_rig_mechanics import (BY_KEY, ELEMENTS, RIG, element
 from elastokin.diagnosis.kc_rig_or_car import RigOrCar, rig_or_car
 from elastokin.diagnosis.kc_noise import NoiseModel, coloured_noise
 from elastokin.diagnosis.kc_scorer import Scorer
-from elastokin.diagnosis.kc_layout import Job, Layout, RunRows, run_job
+from elastokin.diagnosis.kc_layout import Job, Layout, RunRows, run_sets
 from elastokin.diagnosis.verdict import (Outcome, Separation, decide, explained, pair_named, pair_shares,
                                     second_cause_wanted, single_verdict, split)
 from elastokin.recordings.kc_dataset import KCDataset
@@ -204,21 +205,7 @@ def _diagnosis(layout: Layout, vehicle: VehicleDefinition, pool: Executor, say: 
     training = [i for i in every if not heldout[i]]
     candidates = hypotheses(vehicle)
 
-    def runs(sets: list[tuple[str, list[Job], Sequence[int]]]) -> RunRows:
-        """The compared rows of each set of runs (what it is, its jobs, the tests they run: NaN
-        elsewhere), all in parallel, each run's placed as it comes."""
-        jobs = [(label, k, t, j) for k, (label, js, tests) in enumerate(sets) for t, j in zip(tests, js)]
-        out = RunRows(layout, [tests for _, _, tests in sets])
-        each = max(1, len(jobs) // max(len(sets), 1))   # no set at all: a campaign whose inputs never move
-        with closing(pool.each(run_job, [j for *_, j in jobs])) as outcomes:   # a failure cancels the others at once
-            for done, o in enumerate(outcomes, 1):
-                label, k, test, _ = jobs[o.index]
-                if o.error:
-                    raise TaskFailed(f"{label} on {layout.tests[test].name}: {o.error}")
-                out.place(k, o.result, test)
-                if len(sets) > 1 and done % each == 0:
-                    say(f"  {done}/{len(jobs)} runs done on {pool.description}")
-        return out
+    runs = partial(run_sets, layout, pool, say=say)
 
     def rows(vehicles: list[VehicleDefinition], tests: Sequence[int]) -> RunRows:
         """The compared rows of each vehicle on ``tests`` (NaN elsewhere), the runs in parallel."""
@@ -228,18 +215,7 @@ def _diagnosis(layout: Layout, vehicle: VehicleDefinition, pool: Executor, say: 
     say(f"baseline {vehicle.name} on {len(np.unique(layout.recording))} recordings, {len(layout.tests)} tests "
         f"({int(heldout.sum())} held out)")
     (base,) = rows([vehicle], every)
-    movers = moved(layout)
-    say(f"the baseline with each of the {len(movers)} rig inputs moved × {1 + STEP:g} (its transducer's gain), "
-        f"and on a rig with each of {len(ELEMENTS)} elements of its mechanics moved (the pads' friction, the "
-        f"body clamp's compliance)")
-    nuisances = runs([(f"{ch} × {1 + STEP:g}", stepped(layout, ch, tests), tests) for ch, tests in movers.items()]
-                     + [(e.label, element_jobs(layout, e), every) for e in ELEMENTS])
-    scorer = Scorer(layout, base, heldout, {**{(INPUT_GAIN, ch, None): input_column(r, base)
-                                               for ch, r in zip(movers, nuisances)},
-                                            **{(RIG, e.key, None): element_column(r, base, e)
-                                               for e, r in zip(ELEMENTS, nuisances[len(movers):])},
-                                            **reading_columns(layout, base), **drift_columns(layout)}, rig_at)
-    del nuisances   # the scorer holds their columns
+    scorer = rig_scorer(layout, base, heldout, runs, say, rig_at)
     before = scorer.heldout_error(base)
     say(f"held-out error of the baseline: {before:.3f} (1 = the measurement noise); one run of each of "
         f"{len(candidates)} hypotheses at mid-range magnitude on the {len(training)} training tests")
@@ -343,6 +319,29 @@ def _diagnosis(layout: Layout, vehicle: VehicleDefinition, pool: Executor, say: 
                 f"({c.error_held:.3f} -> {c.error:.3f} with it, {' and '.join(f'{e:.3f}' for e in c.error_rivals)} "
                 f"with them): this campaign cannot tell them apart")
     return out, explain
+
+
+def rig_scorer(layout: Layout, base: np.ndarray, heldout: np.ndarray,
+               runs: Callable[[list[tuple[str, list[Job], Sequence[int]]]], RunRows],
+               say: Callable[[str], None] = lambda _: None, rig_at: dict[str, float] | None = None) -> Scorer:
+    """The scorer of a campaign's ``layout`` with every rig error the diagnosis fits beside the causes
+    (its inputs' transducers, its mechanics, its measuring transducers' gains, cross-talks and drifts):
+    ``base`` (N, C) the baseline's rows, ``heldout`` (tests,) the held-out tests; ``runs`` runs sets of
+    jobs (:func:`~elastokin.diagnosis.kc_layout.run_sets`): here the baseline's with each moved rig
+    input's command stepped and on a rig with each element of its mechanics moved; ``rig_at`` as
+    :class:`~elastokin.diagnosis.kc_scorer.Scorer`'s."""
+    every = range(len(layout.tests))
+    movers = moved(layout)
+    say(f"the baseline with each of the {len(movers)} rig inputs moved × {1 + STEP:g} (its transducer's gain), "
+        f"and on a rig with each of {len(ELEMENTS)} elements of its mechanics moved (the pads' friction, the "
+        f"body clamp's compliance)")
+    nuisances = runs([(f"{ch} × {1 + STEP:g}", stepped(layout, ch, tests), tests) for ch, tests in movers.items()]
+                     + [(e.label, element_jobs(layout, e), every) for e in ELEMENTS])
+    return Scorer(layout, base, heldout, {**{(INPUT_GAIN, ch, None): input_column(r, base)
+                                             for ch, r in zip(movers, nuisances)},
+                                          **{(RIG, e.key, None): element_column(r, base, e)
+                                             for e, r in zip(ELEMENTS, nuisances[len(movers):])},
+                                          **reading_columns(layout, base), **drift_columns(layout)}, rig_at)
 
 
 def _second_stage(best: Candidate, others: Iterable[tuple[Hypothesis, np.ndarray]], base: np.ndarray, scorer: Scorer,

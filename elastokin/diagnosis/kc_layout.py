@@ -4,11 +4,13 @@ a recorded case's input phase, one column per compared channel, and the vehicle 
 
 from __future__ import annotations
 
+from contextlib import closing
 from dataclasses import dataclass, replace
-from typing import NamedTuple, Sequence
+from typing import Callable, NamedTuple, Sequence
 
 import numpy as np
 
+from elastokin.cluster.executor import Executor, TaskFailed
 from elastokin.core.errors import InputError
 from elastokin.vehicle.model.definition import VehicleDefinition
 from elastokin.vehicle.scenarios.channels import INPUT_CHANNELS
@@ -167,6 +169,28 @@ class RunRows(Sequence[np.ndarray]):
         out = np.full(self.layout.measured.shape, np.nan)
         out[self.on[k]] = self.held[k]
         return out
+
+
+def run_sets(layout: Layout, pool: Executor, sets: Sequence[tuple[str, Sequence[Job], Sequence[int]]],
+             say: Callable[[str], None] = lambda _: None) -> RunRows:
+    """The compared rows of each set of runs (what it is, its jobs, the tests they run: NaN
+    elsewhere), all in parallel on ``pool``, each run's placed as it comes; progress to ``say``.
+
+    Raises:
+        TaskFailed: a run failed (naming its set and test); the others are cancelled at once.
+    """
+    jobs = [(label, k, t, j) for k, (label, js, tests) in enumerate(sets) for t, j in zip(tests, js)]
+    out = RunRows(layout, [tests for _, _, tests in sets])
+    each = max(1, len(jobs) // max(len(sets), 1))   # no set at all: a campaign whose inputs never move
+    with closing(pool.each(run_job, [j for *_, j in jobs])) as outcomes:
+        for done, o in enumerate(outcomes, 1):
+            label, k, test, _ = jobs[o.index]
+            if o.error:
+                raise TaskFailed(f"{label} on {layout.tests[test].name}: {o.error}")
+            out.place(k, o.result, test)
+            if len(sets) > 1 and done % each == 0:
+                say(f"  {done}/{len(jobs)} runs done on {pool.description}")
+    return out
 
 
 def _period(case: Case, duration_scale: float, rate_hz: float) -> int:
