@@ -11,16 +11,17 @@ error), in units of the channel's noise (the virtual rig's defaults). A baseline
 With ``--through-rig``, at each place of ``OBSERVABLE`` and at magnitudes spread over the draw's
 range (:data:`THROUGH_RIG_STEPS`, every sign and side it is drawn on), what the change leaves once
 a calibrated rig's errors have taken what they can: every rig error the diagnosis fits beside the
-causes (its inputs' and measuring transducers' gains and cross-talks, each within its bound; the
-zeros' drifts; the acquisition's lags; the rig's mechanics), fitted to the change alone on the
-car measured on the virtual rig without a chain. A cause below MIN_EXCESS there is one a rig's
-calibration errors can take whole; ``kc_catalogue.THROUGH_A_RIG`` lists each place's floor, the
-magnitude from which its weakest way stays above it.
+causes (its measuring transducers' gains and cross-talks and its inputs' gains, each within its
+bound; the zeros' drifts; the acquisition's lags; the rig's mechanics), fitted to the change alone
+on the car measured on the virtual rig without a chain. A cause below MIN_EXCESS there is one the
+rig's errors leave too little of to name; ``kc_catalogue.THROUGH_A_RIG`` lists each place's floor,
+the magnitude from which its weakest way stays above it (the larger of it and ``OBSERVABLE``'s,
+kept where it leaves the top fifth of the range).
 
     python tools/kc_observability.py [--vehicle V.yaml] [--duration-scale S] [--cause C ...] [--through-rig] [--json]
 
-About 2 min on 2 cores at ``--duration-scale 0.25``, 29 with ``--through-rig`` beside a slow test
-run (its runs on a local Dask cluster, or where ``VSIM_SCHEDULER`` says).
+About 2 min on 2 cores at ``--duration-scale 0.25``, 29 min with ``--through-rig`` beside a slow
+test run (its runs on a local Dask cluster, or where ``VSIM_SCHEDULER`` says).
 """
 
 from __future__ import annotations
@@ -117,24 +118,27 @@ def magnitudes(cause: str) -> list[float]:
 
 def rig_floor(cause: str, excess_by_magnitude: list[tuple[float, float]]) -> float:
     """The first parameter's magnitude from which the excess left by the rig's errors stays at least
-    MIN_EXCESS (interpolated between the magnitudes tried, in their effect's coordinate; proportional
-    below the first; infinite if the last is below)."""
+    MIN_EXCESS: interpolated between the magnitudes tried in their effect's coordinate (a little low
+    where the excess grows faster than in proportion, as one left by bounded errors does), in
+    proportion below the first; infinite if the last is below."""
     first = parameters(cause)[0]
     if excess_by_magnitude[-1][1] < MIN_EXCESS:
         return math.inf
     k = max(i for i, (_, x) in enumerate(excess_by_magnitude) if i == 0 or excess_by_magnitude[i - 1][1] < MIN_EXCESS)
+    (m1, x1) = excess_by_magnitude[k]
     if k == 0:
-        return floor(cause, excess_by_magnitude[0][1])
-    (m0, x0), (m1, x1) = excess_by_magnitude[k - 1], excess_by_magnitude[k]
+        return first.from_effect(first.effect(m1) * MIN_EXCESS / x1)
+    m0, x0 = excess_by_magnitude[k - 1]
     e0, e1 = first.effect(m0), first.effect(m1)
     return first.from_effect(e0 + (MIN_EXCESS - x0) / (x1 - x0) * (e1 - e0))
 
 
 def through_rig(vehicle: VehicleDefinition, duration_scale: float, causes: list[str], show: bool
                 ) -> dict[str, dict[str, object]]:
-    """Per place of OBSERVABLE of ``causes``: the excess left by the rig's errors at each magnitude
+    """Per place of OBSERVABLE of ``causes`` (the catalogue's: backlash is drawn through no rig's
+    chain): the excess left by the rig's errors at each magnitude
     (its weakest way) and the floor (module docstring); printed as they come if ``show``."""
-    places = [(c, where) for c in causes if c in OBSERVABLE for where in OBSERVABLE[c]]
+    places = [(c, where) for c in causes if c in OBSERVABLE and c != "backlash" for where in OBSERVABLE[c]]
     tried = [(c, where, m, Hypothesis(c, where, {**nominal(c), parameters(c)[0].name: v}))
              for c, where in places for m in magnitudes(c) for v in drawn_ways(c, m)]
     scenarios = tuple(load_scenario(p) for p in DEFAULT_SCENARIOS)

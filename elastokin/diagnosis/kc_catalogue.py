@@ -137,12 +137,12 @@ OBSERVABLE: dict[str, dict[tuple[str, ...], float]] = {
 #: zeros' drifts; the acquisition's lags; the rig's mechanics) reaches MIN_EXCESS from the magnitude
 #: given, the larger of that and OBSERVABLE's (measured with ``python tools/kc_observability.py
 #: --duration-scale 0.25 --through-rig``, a cause's weakest way; kept as OBSERVABLE's are). The draws
-#: of data measured through a rig's chain take these. Missing, a calibrated rig's errors taking them
-#: whole over their range: missing viscoelasticity and a broad relaxation (at the top of their ranges
-#: 0.65 and 0.77 × the noise left of 1.49 and 1.74: the front pads' lateral load cells' gains take the
-#: rest), the rear pivot's Mullins softening (floor 0.216 of 0.08-0.25), the tie rod's outer end and
-#: the lower ball joint moved in x (0.37 and 0.71 left at 4 mm), the strut's points in y and the beam's
-#: centre in z (floors 3.2-3.8 mm of 1-4).
+#: of data measured through a rig's chain take these. Missing: below MIN_EXCESS over their whole
+#: range, missing viscoelasticity and a broad relaxation (0.65 and 0.77 × the noise left at the top
+#: of 1.49 and 1.74: the front pads' lateral load cells' gains take the rest), the tie rod's outer
+#: end and the lower ball joint moved in x (0.37 and 0.71 left at 4 mm); above it only in the top
+#: fifth of their range, the rear pivot's Mullins softening (from 0.216 of 0.08-0.25), the strut's
+#: points in y and the beam's centre in z (from 3.2-3.8 mm of 1-4).
 THROUGH_A_RIG: dict[str, dict[tuple[str, ...], float]] = {
     "asymmetry": {("e1_rear", "x"): 0.0763},
     "mullins": {("e1_front", "y"): 0.1795},

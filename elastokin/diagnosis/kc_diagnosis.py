@@ -325,7 +325,8 @@ def rig_scorer(layout: Layout, base: np.ndarray, heldout: np.ndarray,
                runs: Callable[[list[tuple[str, list[Job], Sequence[int]]]], RunRows],
                say: Callable[[str], None] = lambda _: None, rig_at: dict[str, float] | None = None) -> Scorer:
     """The scorer of a campaign's ``layout`` with every rig error the diagnosis fits beside the causes
-    (its inputs' transducers, its mechanics, its measuring transducers' gains, cross-talks and drifts):
+    (the acquisition's lags, estimated on the baseline; the rig inputs' transducers; its mechanics;
+    its measuring transducers' gains, cross-talks and drifts):
     ``base`` (N, C) the baseline's rows, ``heldout`` (tests,) the held-out tests; ``runs`` runs sets of
     jobs (:func:`~elastokin.diagnosis.kc_layout.run_sets`): here the baseline's with each moved rig
     input's command stepped and on a rig with each element of its mechanics moved; ``rig_at`` as

@@ -181,7 +181,7 @@ def run_sets(layout: Layout, pool: Executor, sets: Sequence[tuple[str, Sequence[
     """
     jobs = [(label, k, t, j) for k, (label, js, tests) in enumerate(sets) for t, j in zip(tests, js)]
     out = RunRows(layout, [tests for _, _, tests in sets])
-    each = max(1, len(jobs) // max(len(sets), 1))   # no set at all: a campaign whose inputs never move
+    each = max(1, len(jobs) // max(len(sets), 1))   # progress once a set's worth is done (none: no set)
     with closing(pool.each(run_job, [j for *_, j in jobs])) as outcomes:
         for done, o in enumerate(outcomes, 1):
             label, k, test, _ = jobs[o.index]

@@ -97,10 +97,10 @@ def summary(d: KCDiagnosis) -> dict[str, Any]:
                          "cutoff_hz": r.cutoff_hz or None, "delay_ms": 1e3 * r.delay_s, "delay_std_ms": 1e3 * r.std_s}
                         for r in d.responses],
         "transducers": [{"kind": g.kind, "channel": g.channel, "source": g.source, "value": g.value,
-                         "std": finite(g.std), "unit": g.unit or "1", "at_bound": g.at_bound}
+                         "std": finite(g.std), "unit": g.unit or "1", "at_bound": g.at_bound, "shown": g.said}
                         for g in d.rig_errors if g.kind != RIG],
         "rig": [{"element": g.channel, "value": g.value, "std": finite(g.std), "unit": BY_KEY[g.channel].unit,
-                 "at_bound": g.at_bound} for g in d.rig_errors if g.kind == RIG],
+                 "at_bound": g.at_bound, "shown": g.said} for g in d.rig_errors if g.kind == RIG],
         "rig_or_car": [{"group": c.group, "readings": [f"{g.label} {g.text}" for g in c.readings],
                         "rivals": [{"cause": h.cause, "location": h.location_json(), "parameters": dict(h.values)}
                                    for h in c.rivals],
