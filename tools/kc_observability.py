@@ -125,7 +125,7 @@ def rig_floor(cause: str, excess_by_magnitude: list[tuple[float, float]]) -> flo
     if excess_by_magnitude[-1][1] < MIN_EXCESS:
         return math.inf
     k = max(i for i, (_, x) in enumerate(excess_by_magnitude) if i == 0 or excess_by_magnitude[i - 1][1] < MIN_EXCESS)
-    (m1, x1) = excess_by_magnitude[k]
+    m1, x1 = excess_by_magnitude[k]
     if k == 0:
         return first.from_effect(first.effect(m1) * MIN_EXCESS / x1)
     m0, x0 = excess_by_magnitude[k - 1]
@@ -136,8 +136,8 @@ def rig_floor(cause: str, excess_by_magnitude: list[tuple[float, float]]) -> flo
 def through_rig(vehicle: VehicleDefinition, duration_scale: float, causes: list[str], show: bool
                 ) -> dict[str, dict[str, object]]:
     """Per place of OBSERVABLE of ``causes`` (the catalogue's: backlash is drawn through no rig's
-    chain): the excess left by the rig's errors at each magnitude
-    (its weakest way) and the floor (module docstring); printed as they come if ``show``."""
+    chain), the excess left by the rig's errors at each magnitude (its weakest way) and the floor
+    (module docstring); each excess printed as it comes if ``show``."""
     places = [(c, where) for c in causes if c in OBSERVABLE and c != "backlash" for where in OBSERVABLE[c]]
     tried = [(c, where, m, Hypothesis(c, where, {**nominal(c), parameters(c)[0].name: v}))
              for c, where in places for m in magnitudes(c) for v in drawn_ways(c, m)]
