@@ -48,7 +48,6 @@ from elastokin.diagnosis.kc_diagnosis import rig_scorer
 from elastokin.diagnosis.kc_layout import COMPARED, Layout, run_sets
 from elastokin.diagnosis.kc_fits import nominal
 from elastokin.diagnosis.kc_scorer import Scorer
-from elastokin.diagnosis.kc_transducers import bounded_solve
 from elastokin.diagnosis.verdict import split
 from elastokin.diagnosis.virtual_kc_rig import (DEFAULT_SCENARIOS, MEASUREMENT_DEFAULTS, KCTruth, measure_kc,
                                                 sensor)
@@ -68,13 +67,14 @@ def weak(cause: str) -> list[dict[str, float]]:
     return [{**nominal(cause), first.name: sign * first.draw[0]} for sign in first.signs]
 
 
-def floor(cause: str, excess_at_weak_end: float) -> float:
-    """The first parameter's magnitude at which the cause's excess reaches MIN_EXCESS, taking the
-    effect proportional to it as the diagnosis's fit does (:meth:`Parameter.effect`)."""
-    if excess_at_weak_end <= 1e-3 * MIN_EXCESS:
+def floor(cause: str, excess: float, magnitude: float | None = None) -> float:
+    """The first parameter's magnitude at which the cause's excess reaches MIN_EXCESS, from its
+    ``excess`` at ``magnitude`` (default: the weak end of its draw), taking the effect proportional
+    to it as the diagnosis's fit does (:meth:`Parameter.effect`)."""
+    if excess <= 1e-3 * MIN_EXCESS:
         return math.inf
     first = parameters(cause)[0]
-    return first.from_effect(first.effect(first.draw[0]) * MIN_EXCESS / excess_at_weak_end)
+    return first.from_effect(first.effect(first.draw[0] if magnitude is None else magnitude) * MIN_EXCESS / excess)
 
 
 def campaign(vehicle: VehicleDefinition, duration_scale: float) -> list[dict[str, np.ndarray]]:
@@ -101,12 +101,8 @@ def excess(base: list[dict[str, np.ndarray]], run: list[dict[str, np.ndarray]]) 
 def left_by_the_rig(scorer: Scorer, change: np.ndarray) -> float:
     """RMS over every compared channel and sample of what a ``change`` (N, C) of the baseline's rows
     leaves once every rig error ``scorer`` fits has taken what it can of it, each within its bounds
-    (each channel's mean per recording removed) [noise]."""
-    rows = np.ones(len(change), dtype=bool)
-    columns, gram, limits, _, _ = scorer.nuisances(rows)
-    d = scorer.seen(change, rows)
-    coef = bounded_solve(gram, columns.products(d), limits)
-    return math.sqrt(float(np.mean((d - columns.combine(coef).reshape(d.shape)) ** 2)))
+    (:meth:`~elastokin.diagnosis.kc_scorer.Scorer.seen_left`) [noise]."""
+    return math.sqrt(float(np.mean(scorer.seen_left(change, np.ones(len(change), dtype=bool)) ** 2)))
 
 
 def magnitudes(cause: str) -> list[float]:
@@ -127,7 +123,7 @@ def rig_floor(cause: str, excess_by_magnitude: list[tuple[float, float]]) -> flo
     k = max(i for i, (_, x) in enumerate(excess_by_magnitude) if i == 0 or excess_by_magnitude[i - 1][1] < MIN_EXCESS)
     m1, x1 = excess_by_magnitude[k]
     if k == 0:
-        return first.from_effect(first.effect(m1) * MIN_EXCESS / x1)
+        return floor(cause, x1, m1)
     m0, x0 = excess_by_magnitude[k - 1]
     e0, e1 = first.effect(m0), first.effect(m1)
     return first.from_effect(e0 + (MIN_EXCESS - x0) / (x1 - x0) * (e1 - e0))

@@ -163,6 +163,12 @@ class Scorer:
         by the recordings' means) on the selected ``rows``: the residual is affine in the prediction."""
         return self._zeroed(self._delivered(change)[rows], rows, np.mean)
 
+    def seen_left(self, change: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        """(n, C) what :meth:`seen` of a ``change`` (N, C) leaves once the nuisances, each within its
+        bounds, have taken what they can of it, as :meth:`residual` fits them out (what a rig's
+        errors leave of a cause's change)."""
+        return self._fitted(self.seen(change, rows), rows)[0]
+
     def fit_effects(self, predicted: np.ndarray, effects: Sequence[np.ndarray], rows: np.ndarray,
                     limits: np.ndarray) -> tuple[np.ndarray, np.ndarray, list[np.ndarray]]:
         """The coefficients (E,) of ``effects`` (each (N, C): a change of ``predicted``) fitted on the
