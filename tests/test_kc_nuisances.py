@@ -188,3 +188,29 @@ def test_a_rig_inputs_gain_acts_on_a_causes_change_too():
         assert abs(g.value - truths.get((g.kind, g.channel), 0.0)) < 3.0 * g.std and g.std < 0.002, g
     assert np.abs(model - base - np.where(slow, runs[0]["pad_z_fl"], 1.0) * change).max() < 1e-12
     assert scorer.rig_errors_under_inputs(truth, [], rerun)[1] is truth and len(runs) == 1   # no cause: no runs
+
+
+def test_what_a_rigs_errors_leave_of_a_change_is_what_lies_beyond_their_bounds():
+    """:meth:`~elastokin.diagnosis.kc_scorer.Scorer.seen_left` of a change that a wheel pad's travel
+    gain in the slow tests would make (its column, ``f`` × the slow rows): within the gain's bound
+    (±2.5 %) the gain takes all of it; beyond, the gain stops at its bound and what is left is what a
+    scorer without that gain leaves of the change beyond the bound (the lags' taps refitted either
+    way), in both signs."""
+    rng = np.random.default_rng(7)
+    times, recording, base, _, tests = _bump_steer_campaign()
+    slow = (recording < 2)[:, None]
+    measured = base + 0.003 * rng.standard_normal(base.shape)
+    layout = kc_layout.Layout(["camber_fl", "toe_fl"], measured, times, recording, recording.copy(), tests)
+    held = np.array([False, True, False, True])
+    gain = Scorer(layout, base, held, {(INPUT_GAIN, "pad_z_fl", None): slow * base})
+    plain = Scorer(layout, base, held)
+    rows = np.ones(len(base), dtype=bool)
+    size = np.abs(gain.seen(0.01 * slow * base, rows)).max()
+    assert size > 1.0   # the change is seen: above the noise
+    for f in (0.01, -0.02):
+        assert np.abs(gain.seen_left(f * slow * base, rows)).max() < 1e-9 * size
+    for f in (0.04, -0.06):
+        beyond = (f - np.sign(f) * 0.025) * slow * base
+        left = gain.seen_left(f * slow * base, rows)
+        assert np.abs(left - plain.seen_left(beyond, rows)).max() < 1e-6 * size
+        assert np.abs(left).max() > 0.5 * np.abs(plain.seen(beyond, rows)).max()
