@@ -48,7 +48,7 @@ def test_the_bounded_fit_is_the_bounded_least_squares_optimum(seed):
 def test_one_channel_columns_act_as_their_dense_forms():
     """Products with a residual, the Gram matrix and a weighted sum of dense and one-channel columns
     (two on one channel, so that their product is kept) equal the dense arrays' to 1e-12, extended by
-    dense columns too."""
+    dense columns too (a block of their own); the dense columns on a channel, in order."""
     rng = np.random.default_rng(7)
     n, c = 50, 4
     ones = [OneChannel(2, rng.standard_normal(n)), OneChannel(0, rng.standard_normal(n)),
@@ -71,6 +71,7 @@ def test_one_channel_columns_act_as_their_dense_forms():
     assert stack.products(r) == pytest.approx(flat @ r.ravel(), rel=1e-12, abs=1e-12)
     assert stack.gram() == pytest.approx(flat @ flat.T, rel=1e-12, abs=1e-12)
     assert stack.combine(coef).ravel() == pytest.approx(coef @ flat, rel=1e-12, abs=1e-12)
+    assert np.array_equal(stack.on_channel(2), np.array([d[:, 2] for d in dense + [extra]]))
 
 
 def test_the_pads_friction_column_runs_on_pads_with_a_compliance_in_series():

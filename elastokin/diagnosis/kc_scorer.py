@@ -310,7 +310,7 @@ class Scorer:
             if isinstance(columns, Columns):
                 # the columns span every channel: channel c's own, at c
                 idx = np.r_[np.flatnonzero(~columns.one), np.flatnonzero(columns.one)[columns.channel == c]]
-                on = np.vstack([columns.dense[:, :, c], columns.single[columns.channel == c]])
+                on = np.vstack([columns.on_channel(c), columns.single[columns.channel == c]])
             else:
                 idx = np.arange(len(columns))
                 on = np.array([np.reshape(x, (len(tests), len(channels)))[:, k] for x in columns])
