@@ -10,7 +10,7 @@ from elastokin.diagnosis.kc_columns import Columns, OneChannel
 from elastokin.diagnosis import kc_layout
 from elastokin.diagnosis.kc_rig_mechanics import BY_KEY, RIG, with_element
 from elastokin.diagnosis.kc_scorer import Scorer
-from elastokin.diagnosis.kc_transducers import INPUT_GAIN, bounded_solve, reading_columns
+from elastokin.diagnosis.kc_transducers import CALIBRATION_BOUND, INPUT_GAIN, bounded_solve, reading_columns
 from elastokin.diagnosis.verdict import split
 from elastokin.vehicle.model.elements import RigMechanics
 
@@ -211,7 +211,7 @@ def test_what_a_rigs_errors_leave_of_a_change_is_what_lies_beyond_their_bounds()
     for f in (0.01, -0.02):
         assert np.abs(gain.seen_left(f * slow * base, rows)).max() < 1e-9 * size
     for f in (0.04, -0.06):
-        beyond = (f - np.sign(f) * 0.025) * slow * base
+        beyond = (f - np.sign(f) * CALIBRATION_BOUND) * slow * base
         left = gain.seen_left(f * slow * base, rows)
         assert np.abs(left - plain.seen_left(beyond, rows)).max() < 1e-6 * size
         assert np.abs(left).max() > 0.5 * np.abs(plain.seen(beyond, rows)).max()
