@@ -39,7 +39,7 @@ class Columns:
 
     def extended(self, dense: Sequence[np.ndarray]) -> "Columns":
         """These columns and the ``dense`` ones (each (n, C)) after them, sharing these columns' arrays
-        (copied, the campaign's dense columns were 58 MB of the shipped dataset's diagnosis's peak)."""
+        (copied, the campaign's dense columns were 57 MiB of the shipped dataset's diagnosis's peak)."""
         out = Columns([], self.shape)
         out.one = np.concatenate([self.one, np.zeros(len(dense), dtype=bool)])
         out.blocks = (*self.blocks, np.reshape(dense, (-1, *self.shape)))
