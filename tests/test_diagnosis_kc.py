@@ -19,6 +19,7 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from scipy.stats import norm
 
 from elastokin.bushings.parameter_sets import load_parameter_set
 from tests.damage_helpers import damaged_kc_dataset
@@ -813,14 +814,41 @@ def _chain_reading(chain: dict, reading: dict) -> float:
     return entry.get("drift_per_min" if reading["kind"] == "drift" else "gain", 0.0)
 
 
-def _read_right(chain: dict, reading: dict) -> bool:
-    """Whether a transducer error the diagnosis reports is the drawn chain's within 3 of its standard
-    uncertainties and 0.1 % (a drift: within its bound and 3 of them)."""
+#: How often a draw whose readings all have honest uncertainties may fail on one of them by chance:
+#: a draw judges ~180 readings (lags, every transducer's errors, the rig's mechanics), and at 3 of
+#: their uncertainties each, one or more would fail two draws in five; each is judged instead at
+#: the two-sided normal quantile of this over their number (Bonferroni), chance then taking at most a
+#: fifth of the draws OWN_FORM_SUCCESS_RATE lets fail. Decided before seeds 106 on (issue 53).
+FAMILY_ALPHA = 0.01
+
+
+def family_sigmas(n: int) -> float:
+    """How many standard uncertainties each of ``n`` readings of one draw may be off [1]: the
+    two-sided normal quantile of FAMILY_ALPHA / n, never fewer than 3."""
+    return max(3.0, float(norm.isf(FAMILY_ALPHA / (2 * max(n, 1)))))
+
+
+def _read_right(chain: dict, reading: dict, sigmas: float) -> bool:
+    """Whether a transducer error the diagnosis reports is the drawn chain's within ``sigmas`` of its
+    standard uncertainties and 0.1 % (a drift: within its bound and ``sigmas`` of them)."""
     truth = _chain_reading(chain, reading)
     if reading["kind"] == "drift":
-        return abs(reading["value"]) <= truth + 3.0 * reading["std"]
-    return abs(reading["value"] - truth) <= 3.0 * reading["std"] + 1e-3
+        return abs(reading["value"]) <= truth + sigmas * reading["std"]
+    return abs(reading["value"] - truth) <= sigmas * reading["std"] + 1e-3
 
+
+
+def test_a_draws_readings_with_honest_uncertainties_fail_together_as_often_as_family_alpha():
+    """Of 40 000 draws of 184 readings, each off by its standard uncertainty times a normal deviate,
+    those with a reading beyond family_sigmas fail at FAMILY_ALPHA (within 4 binomial standard
+    deviations); at 3 each, two in five would."""
+    rng = np.random.default_rng(53)
+    n, draws = 184, 40_000
+    worst = np.abs(rng.standard_normal((draws, n))).max(axis=1)
+    rate = np.mean(worst > family_sigmas(n))
+    assert abs(rate - FAMILY_ALPHA) <= 4.0 * math.sqrt(FAMILY_ALPHA * (1 - FAMILY_ALPHA) / draws), rate
+    assert np.mean(worst > 3.0) == pytest.approx(1 - (1 - 2 * norm.sf(3.0)) ** n, abs=0.01)
+    assert family_sigmas(1) == 3.0
 
 @pytest.mark.slow
 @pytest.mark.parametrize("cause, elements", [("none", (e,)) for e in DRAWN] + [("none", DRAWN)]
@@ -831,9 +859,10 @@ def test_success_rate_through_a_rigs_acquisition(tmp_path, record_property, caus
     never given a car cause; a cause of THROUGH_A_RIG, drawn there, named as without the chain
     (check); one it lacks, drawn where OBSERVABLE has it, named so or "none" found (the rig's errors
     may take it, never another cause); each path's lag and each moved input's transducer gain
-    recovered within 3 of its standard uncertainties (and LAG_TOLERANCE_S, 0.1 %), each zero's drift
-    within its bound (:func:`_read_right`), each element of the rig's mechanics within 3 and a tenth
-    of its value (issue 53); of a cause found "none", the rig errors the report shows alone."""
+    recovered within :func:`family_sigmas` of its standard uncertainties (and LAG_TOLERANCE_S, 0.1 %),
+    each zero's drift within its bound (:func:`_read_right`), each element of the rig's mechanics
+    within them and a tenth of its value (issue 53); of a cause found "none", the rig errors the
+    report shows alone."""
     def attempt(case: Path, seed: int) -> str:
         rng = np.random.default_rng([seed, 53])
         chain = draw_chain(rng, "typical", WHITE, elements)
@@ -849,15 +878,18 @@ def test_success_rate_through_a_rigs_acquisition(tmp_path, record_property, caus
             note = "not seen through the rig's errors"
         else:
             note = check(result, h)
+        transducers = [g for g in result["transducers"] if g["shown"] or not missed]
+        mechanics = [g for g in result["rig"] if g["shown"] or not missed]
+        sigmas = family_sigmas(len(result["acquisition"]) + len(transducers) + len(mechanics))
         for a in result["acquisition"]:
             truth = _chain_lags(chain)[a["path"]]
-            assert abs(1e-3 * a["lag_ms"] - truth) <= 3e-3 * a["delay_std_ms"] + LAG_TOLERANCE_S, (a, truth)
-        for g in (g for g in result["transducers"] if g["shown"] or not missed):
-            assert _read_right(chain, g), (g, _chain_reading(chain, g))
-        for g in (g for g in result["rig"] if g["shown"] or not missed):
+            assert abs(1e-3 * a["lag_ms"] - truth) <= 1e-3 * sigmas * a["delay_std_ms"] + LAG_TOLERANCE_S, (a, truth)
+        for g in transducers:
+            assert _read_right(chain, g, sigmas), (g, _chain_reading(chain, g), sigmas)
+        for g in mechanics:
             # the diagnosis's pads have a typical compliance, not the rig's: a tenth besides
             truth = rig.get(g["element"], 0.0)
-            assert abs(g["value"] - truth) <= 3.0 * g["std"] + 0.1 * truth + BY_KEY[g["element"]].floor, (g, truth)
+            assert abs(g["value"] - truth) <= sigmas * g["std"] + 0.1 * truth + BY_KEY[g["element"]].floor, (g, truth)
         return note
 
     assert_success_rate(f"{cause} through {'+'.join(elements)}", SLOW_SEEDS, tmp_path, attempt, record_property,
