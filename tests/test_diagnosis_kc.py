@@ -837,7 +837,6 @@ def _read_right(chain: dict, reading: dict, sigmas: float) -> bool:
     return abs(reading["value"] - truth) <= sigmas * reading["std"] + 1e-3
 
 
-
 def test_a_draws_readings_with_honest_uncertainties_fail_together_as_often_as_family_alpha():
     """Of 40 000 draws of 184 readings, each off by its standard uncertainty times a normal deviate,
     those with a reading beyond family_sigmas fail at FAMILY_ALPHA (within 4 binomial standard
@@ -849,6 +848,7 @@ def test_a_draws_readings_with_honest_uncertainties_fail_together_as_often_as_fa
     assert abs(rate - FAMILY_ALPHA) <= 4.0 * math.sqrt(FAMILY_ALPHA * (1 - FAMILY_ALPHA) / draws), rate
     assert np.mean(worst > 3.0) == pytest.approx(1 - (1 - 2 * norm.sf(3.0)) ** n, abs=0.01)
     assert family_sigmas(1) == 3.0
+
 
 @pytest.mark.slow
 @pytest.mark.parametrize("cause, elements", [("none", (e,)) for e in DRAWN] + [("none", DRAWN)]
