@@ -40,7 +40,7 @@ from elastokin.diagnosis.kc_fits import (Candidate, fit, fit_pair, halfway, nomi
                                     verify)
 from elastokin.diagnosis.kc_scorer import Scorer
 from elastokin.diagnosis.kc_layout import Layout, Test
-from elastokin.diagnosis.kc_rig_mechanics import BY_KEY
+from elastokin.diagnosis.kc_rig_mechanics import BY_KEY, RIG
 from elastokin.diagnosis.verdict import Separation, pair_named, split, told_apart
 from elastokin.diagnosis.rig_chain import DRAWN, GROUPS, draw_chain, draw_rig
 from elastokin.diagnosis.virtual_kc_rig import DEFAULT_SCENARIOS, measure_kc, parse_kc_truth
@@ -649,7 +649,8 @@ def assert_the_chain_recovered(result: dict, rig: dict | None = None) -> None:
     LAG_TOLERANCE_S; every pad's lateral-force gain within 3 of its uncertainties (and 0.1 %) of
     1.5 % (on one test, its response's channels' own gains act alike: the uncertainty is wide), every
     measured channel's gain, cross-talk and zero's drift of none, the rig's mechanics ``rig`` (default: ideal;
-    every element within 3 standard uncertainties, a tenth and its floor)."""
+    every element within 3 standard uncertainties, a tenth and its floor); no car cause said to
+    explain a rig error as well, nor one the rig's errors may hide."""
     lags = {a["path"]: a for a in result["acquisition"]}
     for path, truth_ms in (("wheel sensors", 15.0), ("pad sensors", 0.0)):
         lag = lags[path]
@@ -669,7 +670,7 @@ def assert_the_chain_recovered(result: dict, rig: dict | None = None) -> None:
     for g in result["rig"]:
         truth = (rig or {}).get(g["element"], 0.0)
         assert abs(g["value"] - truth) <= 3.0 * g["std"] + 0.1 * truth + BY_KEY[g["element"]].floor, g
-    assert result["rig_or_car"] == []
+    assert result["rig_or_car"] == [] and result["hidden_cause"] is None
 
 
 def test_a_spring_on_a_rig_whose_pads_have_friction_is_named_and_the_friction_taken_out(tmp_path):
@@ -850,6 +851,18 @@ def test_a_draws_readings_with_honest_uncertainties_fail_together_as_often_as_fa
     assert family_sigmas(1) == 3.0
 
 
+def _with_hidden_truth(result: dict, h: Hypothesis | None) -> dict[tuple, dict]:
+    """The shown rig errors as the report reads them with the car cause it says the rig's errors may
+    hide (``result["hidden_cause"]``), by (kind, channel, source), if that cause is ``h``'s at its
+    place (each with the channel and kind of its reading, its value and standard uncertainty then);
+    else none."""
+    hidden = result.get("hidden_cause")
+    if h is None or hidden is None or (hidden["cause"], hidden["location"]) != (h.cause, h.location_json()):
+        return {}
+    return {(r["kind"], r["channel"], r["source"]): {**r, "value": r["value_with"], "std": r["std_with"]}
+            for r in hidden["readings"]}
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("cause, elements", [("none", (e,)) for e in DRAWN] + [("none", DRAWN)]
                          + [(c, DRAWN) for c in KC_CAUSES])
@@ -862,7 +875,9 @@ def test_success_rate_through_a_rigs_acquisition(tmp_path, record_property, caus
     recovered within :func:`family_sigmas` of its standard uncertainties (and LAG_TOLERANCE_S, 0.1 %),
     each zero's drift within its bound (:func:`_read_right`), each element of the rig's mechanics
     within them and a tenth of its value (issue 53); of a cause found "none", the rig errors the
-    report shows alone."""
+    report shows alone; a reading off is right too where the report reads it right with the car cause it
+    says the rig's errors may hide, that cause being the truth's at its place (:func:`_with_hidden_truth`;
+    decided before seeds 108 on)."""
     def attempt(case: Path, seed: int) -> str:
         rng = np.random.default_rng([seed, 53])
         chain = draw_chain(rng, "typical", WHITE, elements)
@@ -873,9 +888,10 @@ def test_success_rate_through_a_rigs_acquisition(tmp_path, record_property, caus
                                               rig=rig))
         # the car's verdict first: a wrong one is the failure to report
         missed = h is not None and cause not in THROUGH_A_RIG and result["cause"] == "none"
+        with_truth = _with_hidden_truth(result, h)
         if missed:   # the rig's errors took it: what they read is the chain's and the cause's
             check(result, None)
-            note = "not seen through the rig's errors"
+            note = "said as one the rig's errors may hide" if with_truth else "not seen through the rig's errors"
         else:
             note = check(result, h)
         transducers = [g for g in result["transducers"] if g["shown"] or not missed]
@@ -885,11 +901,15 @@ def test_success_rate_through_a_rigs_acquisition(tmp_path, record_property, caus
             truth = _chain_lags(chain)[a["path"]]
             assert abs(1e-3 * a["lag_ms"] - truth) <= 1e-3 * sigmas * a["delay_std_ms"] + LAG_TOLERANCE_S, (a, truth)
         for g in transducers:
-            assert _read_right(chain, g, sigmas), (g, _chain_reading(chain, g), sigmas)
+            with_it = with_truth.get((g["kind"], g["channel"], g["source"]))
+            assert _read_right(chain, g, sigmas) or (with_it is not None and _read_right(chain, with_it, sigmas)), \
+                (g, with_it, _chain_reading(chain, g), sigmas)
         for g in mechanics:
             # the diagnosis's pads have a typical compliance, not the rig's: a tenth besides
             truth = rig.get(g["element"], 0.0)
-            assert abs(g["value"] - truth) <= sigmas * g["std"] + 0.1 * truth + BY_KEY[g["element"]].floor, (g, truth)
+            with_it = with_truth.get((RIG, g["element"], None))
+            assert any(abs(r["value"] - truth) <= sigmas * r["std"] + 0.1 * truth + BY_KEY[g["element"]].floor
+                       for r in (g, with_it) if r is not None), (g, with_it, truth)
         return note
 
     assert_success_rate(f"{cause} through {'+'.join(elements)}", SLOW_SEEDS, tmp_path, attempt, record_property,

@@ -9,6 +9,7 @@ from elastokin.diagnosis.kc_catalogue import Hypothesis
 from elastokin.diagnosis import kc_layout
 from elastokin.diagnosis.kc_rig_or_car import rig_or_car
 from elastokin.diagnosis.kc_scorer import Scorer
+from elastokin.diagnosis.kc_training_fit import training_fit
 from elastokin.diagnosis.kc_transducers import CALIBRATION_BOUND
 from elastokin.diagnosis.verdict import split
 
@@ -16,13 +17,15 @@ NOISE = 0.002
 NOMINAL_OFFSET_MM = 2.0
 
 
-def campaign(channels: list[str], scales: list[float], seed: int = 5) -> tuple[Scorer, np.ndarray]:
-    """Four tests of one smooth response per channel, measured as ``scales`` × it plus white noise
-    of NOISE, each channel's gain a nuisance: the scorer and the baseline's rows (N, C)."""
+def campaign(channels: list[str], scales: list[float], seed: int = 5, extra: np.ndarray | float = 0.0
+             ) -> tuple[Scorer, np.ndarray]:
+    """Four tests of one smooth response per channel, measured as ``scales`` × it, plus ``extra``
+    (N, C) and white noise of NOISE, each channel's gain a nuisance: the scorer and the baseline's
+    rows (N, C)."""
     rng = np.random.default_rng(seed)
     t = np.linspace(0.0, 1.0, 4000)
     base = np.column_stack([np.sin((2 + k) * np.pi * t + k) for k in range(len(channels))])
-    measured = base * scales + NOISE * rng.standard_normal(base.shape)
+    measured = base * scales + extra + NOISE * rng.standard_normal(base.shape)
     tests = [kc_layout.Test(name, None, rows, np.arange(1000), True)
              for name, rows in zip("abcd", np.split(np.arange(4000), 4))]
     layout = kc_layout.Layout(channels, measured, np.zeros(4000), np.zeros(4000, dtype=int),
@@ -44,11 +47,11 @@ def test_a_rig_error_a_car_cause_would_explain_as_well_is_said_with_it():
     apart = Hypothesis("hardpoint", ("front", "tie_rod_inner", "z"), {"offset": NOMINAL_OFFSET_MM})
     effect = 0.01 * base * [1.0, 0.0]   # the nominal offset scales c_x by 1 %
     screened = [(alike_h, base + effect), (apart, base + effect + 0.01 * base * [0.0, 1.0])]
-    (said,) = rig_or_car(scorer, base, readings, screened, base)
+    (said,) = rig_or_car(training_fit(scorer, base, screened, base), readings)
     assert [h.location for h in said.rivals] == [alike_h.location]
     assert said.rivals[0].values["offset"] == pytest.approx(2.0 * NOMINAL_OFFSET_MM, rel=0.05)
     assert said.readings == (readings[0],) and said.error_held > 1.5 > said.error_rivals[0]
-    assert rig_or_car(scorer, base, readings, screened[1:], base) == []
+    assert rig_or_car(training_fit(scorer, base, screened[1:], base), readings) == []
 
 
 def test_each_family_of_rig_errors_is_held_apart_from_the_others():
@@ -59,7 +62,8 @@ def test_each_family_of_rig_errors_is_held_apart_from_the_others():
     readings = scorer.rig_errors(base)
     assert [round(g.value, 3) for g in readings] == [0.02, 0.02, -0.02] and all(g.said for g in readings)
     strut = Hypothesis("hardpoint", ("front", "strut_top", "y"), {"offset": NOMINAL_OFFSET_MM})
-    (said,) = rig_or_car(scorer, base, readings, [(strut, base + 0.01 * base * [1.0, 1.0, 0.0])], base)
+    screened = [(strut, base + 0.01 * base * [1.0, 1.0, 0.0])]
+    (said,) = rig_or_car(training_fit(scorer, base, screened, base), readings)
     assert said.group == "the camber transducers' calibration" and "camber transducers" in said.remedy
     assert {g.channel for g in said.readings} == {"camber_fl", "camber_fr"}
     assert said.rivals[0].values["offset"] == pytest.approx(2.0 * NOMINAL_OFFSET_MM, rel=0.05)

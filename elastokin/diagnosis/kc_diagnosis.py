@@ -12,7 +12,9 @@
    recordings of repeated tests, :mod:`elastokin.diagnosis.kc_transducers`) and its own mechanics (its
    pads' friction, its body clamp's compliance, :mod:`elastokin.diagnosis.kc_rig_mechanics`): fitted
    with every hypothesis; what they take out that a car cause would explain as well is said
-   (:mod:`elastokin.diagnosis.kc_rig_or_car`); the rig inputs' gains the verdict shows act on the
+   (:mod:`elastokin.diagnosis.kc_rig_or_car`), and so is a car cause they may hide, which the data
+   prefer beside them below the naming threshold, with what it makes of the readings shown
+   (:mod:`elastokin.diagnosis.kc_hidden_cause`); the rig inputs' gains the verdict shows act on the
    named causes' change too, read from the baseline and the causes run again under them. When the
    verdict shows the pads' friction (not proportional in its effect, nor apart from a car cause that
    sticks and slips too), all of this runs again on a rig with it, its column then the change from it.
@@ -72,7 +74,9 @@ from elastokin.diagnosis.kc_lags import PathResponse
 from elastokin.diagnosis.kc_misfits import Misfit, located_misfits
 from elastokin.diagnosis.kc_rig_mechanics import (BY_KEY, ELEMENTS, RIG, element_column, element_jobs,
                                                    not_proportional, on_rig)
+from elastokin.diagnosis.kc_hidden_cause import HiddenCause, hidden_cause
 from elastokin.diagnosis.kc_rig_or_car import RigOrCar, rig_or_car
+from elastokin.diagnosis.kc_training_fit import training_fit
 from elastokin.diagnosis.kc_noise import NoiseModel, coloured_noise
 from elastokin.diagnosis.kc_scorer import Scorer
 from elastokin.diagnosis.kc_layout import Job, Layout, RunRows, run_sets
@@ -125,6 +129,9 @@ class KCDiagnosis(Outcome):
     rig_errors: list[Reading] = field(default_factory=list)
     #: the rig errors taken out that car causes would explain as well (:mod:`elastokin.diagnosis.kc_rig_or_car`)
     rig_or_car: list[RigOrCar] = field(default_factory=list)
+    #: the car cause the data prefer beside the rig's errors, below the naming threshold, and the shown
+    #: rig errors it moves (:mod:`elastokin.diagnosis.kc_hidden_cause`); None when none is found
+    hidden: HiddenCause | None = None
 
     @property
     def final(self) -> Candidate:
@@ -312,12 +319,18 @@ def _diagnosis(layout: Layout, vehicle: VehicleDefinition, pool: Executor, say: 
                                           float(np.median([t.job.duration_scale for t in layout.tests])),
                                           lambda jobs: pool.map(run_unless_diverged, jobs))
             out.extra_tests = len(extra)
-        out.rig_or_car = rig_or_car(scorer, model, out.rig_errors, zip(candidates, signatures), base,
-                                    [c.hypothesis for c in out.causes])
+        fit = training_fit(scorer, model, zip(candidates, signatures), base, [c.hypothesis for c in out.causes])
+        out.rig_or_car = rig_or_car(fit, out.rig_errors)
         for c in out.rig_or_car:
             say(f"what {c.group} took out, {' or '.join(h.label for h in c.rivals)} would explain as well "
                 f"({c.error_held:.3f} -> {c.error:.3f} with it, {' and '.join(f'{e:.3f}' for e in c.error_rivals)} "
                 f"with them): this campaign cannot tell them apart")
+        out.hidden = hidden_cause(fit, out.rig_errors)
+        if out.hidden is not None:
+            h = out.hidden
+            say(f"beside the rig's errors the data prefer {h.hypothesis.label} ({_fmt(h.hypothesis.values)}, "
+                f"{h.z:.1f} standard uncertainties off none; training error {h.error_without:.4f} -> {h.error:.4f}): "
+                f"with it, {', '.join(f'{g.label} {g.text} -> {w.text}' for g, w in h.moved)}")
     return out, explain
 
 

@@ -23,13 +23,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Iterable, Sequence
+from typing import Sequence
 
 import numpy as np
 
-from elastokin.diagnosis.kc_catalogue import Hypothesis, parameters
-from elastokin.diagnosis.kc_fits import scaled_magnitude, value_bounds
-from elastokin.diagnosis.kc_scorer import Scorer
+from elastokin.diagnosis.kc_catalogue import Hypothesis
+from elastokin.diagnosis.kc_training_fit import TrainingFit, scaled
 from elastokin.diagnosis.kc_rig_mechanics import BY_KEY, RIG
 from elastokin.diagnosis.kc_transducers import CROSS, DRIFT, GAIN, INPUT_GAIN, Reading, bounded_solve
 from elastokin.diagnosis.verdict import decide, told_apart
@@ -87,67 +86,33 @@ def families(readings: Sequence[Reading]) -> list[tuple[str, str, tuple[Reading,
     return said
 
 
-def rig_or_car(scorer: Scorer, model: np.ndarray, readings: Sequence[Reading],
-               screened: Iterable[tuple[Hypothesis, np.ndarray]], base: np.ndarray,
-               named: Sequence[Hypothesis] = ()) -> list[RigOrCar]:
-    """For each family of rig errors ``readings`` (fitted beside ``model``'s rows) shows
-    (:func:`families`), the hypotheses of the screening (``screened``: each with its run's rows on the
-    training tests; ``base``: the baseline's) that explain what they explain as well, but ``named``
-    (the model's own causes); the families that have any (module docstring)."""
-    train = ~scorer.held_rows
-    m = scorer.raw(model, train)
-    columns, gram, bounds, none, keys = scorer.nuisances(train)
-    seen, mm, size = columns.products(m), float(np.sum(m * m)), m.size
-    error = lambda coef, matrix, products: math.sqrt(max(mm - 2.0 * coef @ products + coef @ matrix @ coef, 0.0)
-                                                     / size)
-    fitted_at = bounded_solve(gram, seen, bounds)
-    fitted = error(fitted_at, gram, seen)
-    rig = np.array([k is not None for k in keys], dtype=bool)   # the rig's errors, not the acquisition's taps
+def rig_or_car(fit: TrainingFit, readings: Sequence[Reading]) -> list[RigOrCar]:
+    """For each family of rig errors ``readings`` (fitted beside the model of ``fit``) shows
+    (:func:`families`), the screened hypotheses of ``fit`` that explain what they explain as well;
+    the families that have any (module docstring)."""
+    fitted = fit.error(fit.fitted, fit.gram, fit.seen)
+    rig = np.array([k is not None for k in fit.keys], dtype=bool)   # the rig's errors, not the acquisition's taps
     out = []
-    effects = None   # each hypothesis's effect and its products with the columns, computed once
     for what, remedy, shown in families(readings):
-        held = bounds.copy()
-        held[rig] = fitted_at[rig, None]
-        shown_keys = {(g.kind, g.channel, g.source) for g in shown}
-        members = np.array([k in shown_keys for k in keys], dtype=bool)
-        held[members] = none[members, None]
-        error_held = error(bounded_solve(gram, seen, held), gram, seen)
-        if effects is None:
-            effects = []
-            for h, rows in screened:
-                if any((h.cause, h.location) == (n.cause, n.location) for n in named):
-                    continue
-                d = scorer.seen(rows - base, train)
-                effects.append((h, columns.products(d), float(np.sum(d * d)), float(np.sum(d * m))))
+        held = fit.bounds.copy()
+        held[rig] = fit.fitted[rig, None]
+        shown_keys = {g.key for g in shown}
+        members = np.array([k in shown_keys for k in fit.keys], dtype=bool)
+        held[members] = fit.none[members, None]
+        error_held = fit.error(bounded_solve(fit.gram, fit.seen, held), fit.gram, fit.seen)
         tried = {}   # the best of each place (a cause screened on both signs is fitted from each)
-        for h, products, dd, dm in effects:
-            if dd == 0.0:
+        for e in fit.effects:
+            if e.own == 0.0:
                 continue
-            matrix = np.block([[gram, products[:, None]], [products[None, :], np.array([[dd]])]])
-            both = np.append(seen, dm)
-            coef = bounded_solve(matrix, both, np.vstack([held, _scales(h)]))
-            e = error(coef, matrix, both)
-            if e < tried.get((h.cause, h.location), (math.inf,))[0]:
-                tried[(h.cause, h.location)] = (e, h, coef[-1])
+            coef, error = fit.beside(e, held)
+            h = e.hypothesis
+            if error < tried.get((h.cause, h.location), (math.inf,))[0]:
+                tried[(h.cause, h.location)] = (error, h, coef[-1])
         rivals = sorted((t for t in tried.values() if decide(error_held, t[0], 1.0) == "named"
                          and not told_apart(t[0], fitted, 1.0) and not told_apart(fitted, t[0], 1.0)),
                         key=lambda t: t[0])[:RIVALS]
         if rivals:
-            out.append(RigOrCar(what, shown, tuple(_scaled(h, k) for _, h, k in rivals), remedy, error_held,
+            out.append(RigOrCar(what, shown, tuple(scaled(h, k) for _, h, k in rivals), remedy, error_held,
                                 tuple(e for e, _, _ in rivals), fitted))
     return out
 
-
-def _scales(h: Hypothesis) -> tuple[float, float]:
-    """The scales of ``h``'s effect its first parameter's bounds allow (:func:`value_bounds`)."""
-    first = parameters(h.cause)[0]
-    x0 = first.effect(h.values[first.name])
-    lo, hi = sorted(first.effect(v) / x0 for v in value_bounds(first, h.values[first.name])) if x0 else (0.0, 0.0)
-    return lo, hi
-
-
-def _scaled(h: Hypothesis, scale: float) -> Hypothesis:
-    """``h`` with its effect scaled by ``scale`` (its first parameter as the screening fit moves it)."""
-    first = parameters(h.cause)[0]
-    value, _, _ = scaled_magnitude(first, h.values[first.name], scale, 0.0)
-    return Hypothesis(h.cause, h.location, {**h.values, first.name: value})

@@ -77,6 +77,21 @@ class Reading:
     at_bound: bool = False
     unit: str = ""        #: a drift's channel's unit
 
+    def moved(self, by: float, std: float, at_bound: bool) -> "Reading":
+        """This error with its column's coefficient moved ``by`` (:func:`reading`: an input's gain is
+        not its coefficient), ``std`` the coefficient's standard uncertainty then (a drift's at least
+        its quantity's spread, :func:`drift_spread`), ``at_bound`` whether it is then held at its bound."""
+        if self.kind == INPUT_GAIN:
+            coef = 1.0 / (1.0 + self.value) - 1.0 + by
+            return reading(self.key, coef, std, at_bound)
+        return replace(self, value=self.value + by, std=max(std, self.std) if self.kind == DRIFT else std,
+                       at_bound=at_bound and self.value + by != 0.0)
+
+    @property
+    def key(self) -> "Key":
+        """Its column's key: (kind, channel, source)."""
+        return self.kind, self.channel, self.source
+
     @property
     def said(self) -> bool:
         """Whether the data show it (beyond SAID_STD standard uncertainties and SAID_SHARE, a rig

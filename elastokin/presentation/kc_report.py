@@ -16,6 +16,7 @@ from elastokin.core.files import atomic_output
 from elastokin.diagnosis.catalogue import PAIR_SEPARATOR
 from elastokin.diagnosis.kc_catalogue import Hypothesis, extended_vehicle_yaml, parameters
 from elastokin.diagnosis.kc_diagnosis import KCDiagnosis
+from elastokin.diagnosis.kc_hidden_cause import HIDDEN_ALPHA, HiddenCause
 from elastokin.diagnosis.kc_misfits import Misfit
 from elastokin.diagnosis.kc_fits import Candidate
 from elastokin.diagnosis.kc_noise import coloured_noise
@@ -107,9 +108,21 @@ def summary(d: KCDiagnosis) -> dict[str, Any]:
                         "remedy": c.remedy, "training_error_held": c.error_held,
                         "training_error_rivals": list(c.error_rivals), "training_error": c.error}
                        for c in d.rig_or_car],
+        "hidden_cause": _hidden(d.hidden),
         "damage": list(d.layout.damage),
         "wall_s": d.wall_s,
     }
+
+
+def _hidden(h: HiddenCause | None) -> dict[str, Any] | None:
+    """The car cause the data prefer beside the rig's errors and the shown rig errors it moves."""
+    if h is None:
+        return None
+    return {"cause": h.hypothesis.cause, "location": h.hypothesis.location_json(),
+            "parameters": dict(h.hypothesis.values), "z": h.z, "threshold": h.threshold,
+            "training_error": h.error, "training_error_without": h.error_without,
+            "readings": [{"kind": g.kind, "channel": g.channel, "source": g.source, "value": g.value,
+                          "std": finite(g.std), "value_with": w.value, "std_with": finite(w.std)} for g, w in h.moved]}
 
 
 def _noise_model(d: KCDiagnosis) -> dict[str, dict[str, float]]:
@@ -205,6 +218,19 @@ def _rig_or_car_sentence(d: KCDiagnosis) -> str:
         + f" would explain as well: this campaign cannot tell them apart; {c.remedy}." for c in d.rig_or_car)
 
 
+def _hidden_sentence(d: KCDiagnosis) -> str:
+    """The car cause the rig's errors may hide, and what the rig errors shown would read with it."""
+    h = d.hidden
+    if h is None:
+        return ""
+    moved = ", ".join(f"{g.label} {w.text} (not {g.text})" for g, w in h.moved)
+    return (f" Beside the rig's errors the data prefer **{h.hypothesis.cause}** at {_where(h.hypothesis)} "
+            f"({_values(h.hypothesis)}; {h.z:.1f} standard uncertainties off none, where chance passes "
+            f"{h.threshold:.1f} in {HIDDEN_ALPHA:.0%} of campaigns; it lowers the training error from "
+            f"{h.error_without:.3f} to {h.error:.3f}, not named): if the car has it, the rig's errors read {moved}; "
+            f"this campaign cannot tell which.")
+
+
 def _noise_sentence(d: KCDiagnosis) -> str:
     """Which channels' noise is coloured, if any: the noise the verdict was judged against."""
     said = coloured_noise(d.layout.channels, d.noise_model) if d.noise_model is not None else {}
@@ -219,7 +245,7 @@ def verdict_sentence(d: KCDiagnosis) -> str:
     """One sentence for people: the cause, what was taken out as the rig's acquisition and its
     transducers' errors, and the noise's colour."""
     return (_cause_sentence(d) + _acquisition_sentence(d) + _transducers_sentence(d) + _rig_or_car_sentence(d)
-            + _noise_sentence(d))
+            + _hidden_sentence(d) + _noise_sentence(d))
 
 
 def _cause_sentence(d: KCDiagnosis) -> str:

@@ -1,0 +1,119 @@
+"""A model's residual on a K&C campaign's training tests against the rig's errors, with each screened
+hypothesis's effect beside them: what :mod:`elastokin.diagnosis.kc_rig_or_car` and
+:mod:`elastokin.diagnosis.kc_hidden_cause` fit, from the screening's runs (no new run).
+
+Every fit here is a bounded least-squares problem on the nuisance columns' Gram matrix and their
+products with the residual (:func:`~elastokin.diagnosis.kc_transducers.bounded_solve`): a hypothesis
+adds one column, its effect (its screening run less the baseline's), whose products with the
+nuisance columns are computed once."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import cached_property
+from typing import Iterable, Sequence
+
+import numpy as np
+
+from elastokin.diagnosis.kc_catalogue import Hypothesis, parameters
+from elastokin.diagnosis.kc_columns import Columns
+from elastokin.diagnosis.kc_fits import scaled_magnitude, value_bounds
+from elastokin.diagnosis.kc_scorer import Scorer
+from elastokin.diagnosis.kc_transducers import Key, bounded_solve
+
+
+@dataclass(frozen=True)
+class Effect:
+    """A screened hypothesis's effect on the training rows as the residual sees it (its screening
+    run less the baseline's, at its screening values), by its products."""
+
+    hypothesis: Hypothesis
+    run: np.ndarray        #: (N, C) its screening run's rows (NaN off the training tests)
+    products: np.ndarray   #: (K,) with the nuisance columns
+    own: float             #: with itself
+    with_model: float      #: with the model's residual before the nuisances are fitted
+
+
+@dataclass
+class TrainingFit:
+    """The model's residual on the training tests against the nuisance columns (:meth:`Scorer.nuisances`),
+    and the screened hypotheses' effects (:class:`Effect`) to fit beside them."""
+
+    scorer: Scorer
+    base: np.ndarray         #: (N, C) the baseline's rows
+    residual: np.ndarray     #: (n, C) the model's raw residual on the training rows, in noise units
+    columns: Columns         #: the nuisance columns there
+    gram: np.ndarray         #: (K, K) their products with each other
+    bounds: np.ndarray       #: (K, 2) each one's bounds
+    none: np.ndarray         #: (K,) each one's coefficient of no error
+    keys: list[Key | None]   #: each one's key (None for the acquisition's taps)
+    seen: np.ndarray         #: (K,) their products with the residual
+    fitted: np.ndarray       #: (K,) their coefficients fitted within their bounds
+    runs: list[tuple[Hypothesis, np.ndarray]]   #: the screened hypotheses, each with its run's rows (N, C)
+
+    @cached_property
+    def effects(self) -> list[Effect]:
+        """Each screened hypothesis's :class:`Effect`, computed when first asked for (one at a time: the
+        119 effects on the training rows would be 1.5 GB)."""
+        out = []
+        for h, rows in self.runs:
+            d = self.scorer.seen(rows - self.base, self.train)
+            out.append(Effect(h, rows, self.columns.products(d), float(np.sum(d * d)),
+                              float(np.sum(d * self.residual))))
+        return out
+
+    @property
+    def train(self) -> np.ndarray:
+        """(N,) the training rows."""
+        return ~self.scorer.held_rows
+
+    def seen_effect(self, e: Effect) -> np.ndarray:
+        """(n, C) ``e``'s effect on the training rows as the residual sees it."""
+        return self.scorer.seen(e.run - self.base, self.train)
+
+    def error(self, coef: np.ndarray, matrix: np.ndarray, products: np.ndarray) -> float:
+        """The RMS residual (1 = the noise) left by columns of Gram ``matrix`` and products ``products``
+        with the residual at coefficients ``coef`` (the nuisance columns first)."""
+        mm = float(np.sum(self.residual * self.residual))
+        return math.sqrt(max(mm - 2.0 * coef @ products + coef @ matrix @ coef, 0.0) / self.residual.size)
+
+    def beside(self, e: Effect, limits: np.ndarray) -> tuple[np.ndarray, float]:
+        """The coefficients (K + 1,) of the nuisance columns within ``limits`` (K, 2) and of ``e``'s
+        effect within the scales of it its first parameter's bounds allow (:func:`scales`), fitted
+        together; the training error they leave."""
+        matrix = np.block([[self.gram, e.products[:, None]], [e.products[None, :], np.array([[e.own]])]])
+        both = np.append(self.seen, e.with_model)
+        # started from the limits the model's fit holds: one effect more moves few of them
+        coef = bounded_solve(matrix, both, np.vstack([limits, scales(e.hypothesis)]),
+                             start=np.append(self.fitted, np.nan))
+        return coef, self.error(coef, matrix, both)
+
+
+def training_fit(scorer: Scorer, model: np.ndarray, screened: Iterable[tuple[Hypothesis, np.ndarray]],
+                 base: np.ndarray, named: Sequence[Hypothesis] = ()) -> TrainingFit:
+    """``model``'s (N, C) :class:`TrainingFit`, with the effects of the hypotheses of the screening
+    (``screened``: each with its run's rows on the training tests; ``base``: the baseline's) but those
+    at the places of ``named`` (the model's own causes)."""
+    train = ~scorer.held_rows
+    m = scorer.raw(model, train)
+    columns, gram, bounds, none, keys = scorer.nuisances(train)
+    seen = columns.products(m)
+    runs = [(h, rows) for h, rows in screened if all((h.cause, h.location) != (n.cause, n.location) for n in named)]
+    return TrainingFit(scorer, base, m, columns, gram, bounds, none, keys, seen, bounded_solve(gram, seen, bounds),
+                       runs)
+
+
+def scales(h: Hypothesis) -> tuple[float, float]:
+    """The scales of ``h``'s effect its first parameter's bounds allow (:func:`value_bounds`)."""
+    first = parameters(h.cause)[0]
+    x0 = first.effect(h.values[first.name])
+    lo, hi = sorted(first.effect(v) / x0 for v in value_bounds(first, h.values[first.name])) if x0 else (0.0, 0.0)
+    return lo, hi
+
+
+def scaled(h: Hypothesis, scale: float) -> Hypothesis:
+    """``h`` with its effect scaled by ``scale`` (its first parameter as the screening fit moves it)."""
+    first = parameters(h.cause)[0]
+    value, _, _ = scaled_magnitude(first, h.values[first.name], scale, 0.0)
+    return Hypothesis(h.cause, h.location, {**h.values, first.name: value})
