@@ -871,7 +871,8 @@ def test_success_rate_through_a_rigs_acquisition(tmp_path, record_property, caus
     too (each element alone on clean cars, all of them; all of them with each cause): a clean car
     never given a car cause; a cause of THROUGH_A_RIG, drawn there, named as without the chain
     (check); one it lacks, drawn where OBSERVABLE has it, named so or "none" found (the rig's errors
-    may take it, never another cause); each path's lag and each moved input's transducer gain
+    may take it, never another cause), or "unexplained" with the report saying it is the cause the
+    rig's errors may hide (decided before seeds 110 on); each path's lag and each moved input's transducer gain
     recovered within :func:`family_sigmas` of its standard uncertainties (and LAG_TOLERANCE_S, 0.1 %),
     each zero's drift within its bound (:func:`_read_right`), each element of the rig's mechanics
     within them and a tenth of its value (issue 53); of a cause found "none", the rig errors the
@@ -887,11 +888,15 @@ def test_success_rate_through_a_rigs_acquisition(tmp_path, record_property, caus
         result = diagnose_fresh(measure_truth(case, [h] if h else [], seed, duration_scale=0.25, chain=chain,
                                               rig=rig))
         # the car's verdict first: a wrong one is the failure to report
-        missed = h is not None and cause not in THROUGH_A_RIG and result["cause"] == "none"
         with_truth = _with_hidden_truth(result, h)
+        missed = h is not None and cause not in THROUGH_A_RIG and (
+            result["cause"] == "none" or result["cause"] == "unexplained" and bool(with_truth))
         if missed:   # the rig's errors took it: what they read is the chain's and the cause's
-            check(result, None)
-            note = "said as one the rig's errors may hide" if with_truth else "not seen through the rig's errors"
+            if result["cause"] == "none":
+                check(result, None)
+            assert result["causes"] == []
+            note = ("unexplained, " if result["cause"] == "unexplained" else "") + (
+                "said as one the rig's errors may hide" if with_truth else "not seen through the rig's errors")
         else:
             note = check(result, h)
         transducers = [g for g in result["transducers"] if g["shown"] or not missed]
