@@ -44,7 +44,7 @@ def test_a_cause_the_rig_errors_hide_is_said_with_the_readings_it_moves():
     readings = scorer.rig_errors(base)
     gain = readings[0]
     assert gain.said and gain.value == pytest.approx(0.01, abs=3 * gain.std)
-    found = hidden_cause(training_fit(scorer, base, screened, base), readings)
+    found = hidden_cause(training_fit(scorer, base, *zip(*screened), base), readings)
     assert found is not None and found.hypothesis.location == screened[0][0].location
     assert found.threshold == pytest.approx(norm.isf(HIDDEN_ALPHA / 4))
     std = found.hypothesis.values["offset"] / found.z
@@ -69,7 +69,7 @@ def test_a_campaign_without_a_hidden_cause_has_one_said_no_more_often_than_the_t
         scorer, base = campaign(["c_x", "c_y"], [1.01, 1.0], seed=seed)
         readings = scorer.rig_errors(base)
         assert readings[0].said
-        said += hidden_cause(training_fit(scorer, base, causes(base), base), readings) is not None
+        said += hidden_cause(training_fit(scorer, base, *zip(*causes(base)), base), readings) is not None
     assert said <= 1
 
 

@@ -47,11 +47,11 @@ def test_a_rig_error_a_car_cause_would_explain_as_well_is_said_with_it():
     apart = Hypothesis("hardpoint", ("front", "tie_rod_inner", "z"), {"offset": NOMINAL_OFFSET_MM})
     effect = 0.01 * base * [1.0, 0.0]   # the nominal offset scales c_x by 1 %
     screened = [(alike_h, base + effect), (apart, base + effect + 0.01 * base * [0.0, 1.0])]
-    (said,) = rig_or_car(training_fit(scorer, base, screened, base), readings)
+    (said,) = rig_or_car(training_fit(scorer, base, *zip(*screened), base), readings)
     assert [h.location for h in said.rivals] == [alike_h.location]
     assert said.rivals[0].values["offset"] == pytest.approx(2.0 * NOMINAL_OFFSET_MM, rel=0.05)
     assert said.readings == (readings[0],) and said.error_held > 1.5 > said.error_rivals[0]
-    assert rig_or_car(training_fit(scorer, base, screened[1:], base), readings) == []
+    assert rig_or_car(training_fit(scorer, base, *zip(*screened[1:]), base), readings) == []
 
 
 def test_each_family_of_rig_errors_is_held_apart_from_the_others():
@@ -63,7 +63,7 @@ def test_each_family_of_rig_errors_is_held_apart_from_the_others():
     assert [round(g.value, 3) for g in readings] == [0.02, 0.02, -0.02] and all(g.said for g in readings)
     strut = Hypothesis("hardpoint", ("front", "strut_top", "y"), {"offset": NOMINAL_OFFSET_MM})
     screened = [(strut, base + 0.01 * base * [1.0, 1.0, 0.0])]
-    (said,) = rig_or_car(training_fit(scorer, base, screened, base), readings)
+    (said,) = rig_or_car(training_fit(scorer, base, *zip(*screened), base), readings)
     assert said.group == "the camber transducers' calibration" and "camber transducers" in said.remedy
     assert {g.channel for g in said.readings} == {"camber_fl", "camber_fr"}
     assert said.rivals[0].values["offset"] == pytest.approx(2.0 * NOMINAL_OFFSET_MM, rel=0.05)

@@ -319,7 +319,7 @@ def _diagnosis(layout: Layout, vehicle: VehicleDefinition, pool: Executor, say: 
                                           float(np.median([t.job.duration_scale for t in layout.tests])),
                                           lambda jobs: pool.map(run_unless_diverged, jobs))
             out.extra_tests = len(extra)
-        fit = training_fit(scorer, model, zip(candidates, signatures), base, [c.hypothesis for c in out.causes])
+        fit = training_fit(scorer, model, candidates, signatures, base, [c.hypothesis for c in out.causes])
         out.rig_or_car = rig_or_car(fit, out.rig_errors)
         for c in out.rig_or_car:
             say(f"what {c.group} took out, {' or '.join(h.label for h in c.rivals)} would explain as well "

@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Iterable, Sequence
+from typing import Sequence
 
 import numpy as np
 
@@ -29,7 +29,7 @@ class Effect:
     run less the baseline's, at its screening values), by its products."""
 
     hypothesis: Hypothesis
-    run: np.ndarray        #: (N, C) its screening run's rows (NaN off the training tests)
+    run: int               #: its screening run's index in :attr:`TrainingFit.runs`
     products: np.ndarray   #: (K,) with the nuisance columns
     own: float             #: with itself
     with_model: float      #: with the model's residual before the nuisances are fitted
@@ -50,16 +50,20 @@ class TrainingFit:
     keys: list[Key | None]   #: each one's key (None for the acquisition's taps)
     seen: np.ndarray         #: (K,) their products with the residual
     fitted: np.ndarray       #: (K,) their coefficients fitted within their bounds
-    runs: list[tuple[Hypothesis, np.ndarray]]   #: the screened hypotheses, each with its run's rows (N, C)
+    hypotheses: Sequence[Hypothesis]   #: the screened hypotheses
+    #: their screening runs' rows, each (N, C) as read (a RunRows makes them when read: 119 read at once
+    #: were 215 MiB of the shipped dataset's diagnosis)
+    runs: Sequence[np.ndarray]
+    kept: list[int]          #: the hypotheses fitted: those not at a named cause's place
 
     @cached_property
     def effects(self) -> list[Effect]:
-        """Each screened hypothesis's :class:`Effect`, computed when first asked for (one at a time: the
-        119 effects on the training rows would be 1.5 GB)."""
+        """Each kept screened hypothesis's :class:`Effect`, computed when first asked for, one at a time
+        (never all held: 119 arrays of the training rows' size)."""
         out = []
-        for h, rows in self.runs:
-            d = self.scorer.seen(rows - self.base, self.train)
-            out.append(Effect(h, rows, self.columns.products(d), float(np.sum(d * d)),
+        for k in self.kept:
+            d = self.scorer.seen(self.runs[k] - self.base, self.train)
+            out.append(Effect(self.hypotheses[k], k, self.columns.products(d), float(np.sum(d * d)),
                               float(np.sum(d * self.residual))))
         return out
 
@@ -70,7 +74,7 @@ class TrainingFit:
 
     def seen_effect(self, e: Effect) -> np.ndarray:
         """(n, C) ``e``'s effect on the training rows as the residual sees it."""
-        return self.scorer.seen(e.run - self.base, self.train)
+        return self.scorer.seen(self.runs[e.run] - self.base, self.train)
 
     def error(self, coef: np.ndarray, matrix: np.ndarray, products: np.ndarray) -> float:
         """The RMS residual (1 = the noise) left by columns of Gram ``matrix`` and products ``products``
@@ -90,18 +94,18 @@ class TrainingFit:
         return coef, self.error(coef, matrix, both)
 
 
-def training_fit(scorer: Scorer, model: np.ndarray, screened: Iterable[tuple[Hypothesis, np.ndarray]],
-                 base: np.ndarray, named: Sequence[Hypothesis] = ()) -> TrainingFit:
+def training_fit(scorer: Scorer, model: np.ndarray, hypotheses: Sequence[Hypothesis],
+                 runs: Sequence[np.ndarray], base: np.ndarray, named: Sequence[Hypothesis] = ()) -> TrainingFit:
     """``model``'s (N, C) :class:`TrainingFit`, with the effects of the hypotheses of the screening
-    (``screened``: each with its run's rows on the training tests; ``base``: the baseline's) but those
-    at the places of ``named`` (the model's own causes)."""
+    (``hypotheses``, their runs' rows ``runs`` on the training tests, each (N, C) when read; ``base``:
+    the baseline's) but those at the places of ``named`` (the model's own causes)."""
     train = ~scorer.held_rows
     m = scorer.raw(model, train)
     columns, gram, bounds, none, keys = scorer.nuisances(train)
     seen = columns.products(m)
-    runs = [(h, rows) for h, rows in screened if all((h.cause, h.location) != (n.cause, n.location) for n in named)]
+    kept = [k for k, h in enumerate(hypotheses) if all((h.cause, h.location) != (n.cause, n.location) for n in named)]
     return TrainingFit(scorer, base, m, columns, gram, bounds, none, keys, seen, bounded_solve(gram, seen, bounds),
-                       runs)
+                       hypotheses, runs, kept)
 
 
 def scales(h: Hypothesis) -> tuple[float, float]:
