@@ -56,8 +56,8 @@ def test_a_cause_the_rig_errors_hide_is_said_with_the_readings_it_moves():
     said = _hidden_sentence(SimpleNamespace(hidden=found))
     assert "**hardpoint** at axle front, hardpoint lower_ball_joint, coordinate z" in said
     assert f"c_x (gain) {with_it.text} (not {gain.text})" in said and "cannot tell which" in said
-    (reading,) = _hidden(found)["readings"]
-    assert (reading["value"], reading["value_with"], reading["std_with"]) == (gain.value, with_it.value, with_it.std)
+    (entry,) = _hidden(found)["readings"]
+    assert (entry["value"], entry["value_with"], entry["std_with"]) == (gain.value, with_it.value, with_it.std)
 
 
 def test_a_campaign_without_a_hidden_cause_has_one_said_no_more_often_than_the_threshold_allows():

@@ -27,7 +27,7 @@ from scipy.stats import norm
 
 from elastokin.diagnosis.kc_catalogue import Hypothesis
 from elastokin.diagnosis.kc_training_fit import TrainingFit, scaled
-from elastokin.diagnosis.kc_transducers import Reading
+from elastokin.diagnosis.kc_transducers import Reading, held_at_limits
 
 #: The chance that a campaign without a hidden cause has one said: its magnitude's threshold is the
 #: two-sided normal quantile of this over the places tried (Bonferroni), 3.9 standard uncertainties
@@ -66,8 +66,7 @@ def hidden_cause(fit: TrainingFit, readings: Sequence[Reading]) -> HiddenCause |
     threshold = float(norm.isf(HIDDEN_ALPHA / (2 * places)))
     z = abs(float(coef[-1] / std[-1])) if std[-1] > 0.0 else 0.0
     at = {k: i for i, k in enumerate(fit.keys) if k is not None}
-    lo, hi = fit.bounds.T
-    held = (coef[:-1] <= lo + 1e-12) | (coef[:-1] >= hi - 1e-12)
+    held = held_at_limits(coef[:-1], fit.bounds)
     moved = tuple((g, g.moved(float(coef[i] - fit.fitted[i]), float(std[i]), bool(held[i])))
                   for g in readings if g.said and (i := at.get(g.key)) is not None
                   and abs(coef[i] - fit.fitted[i]) > g.std)

@@ -17,7 +17,7 @@ from elastokin.diagnosis.kc_layout import Layout
 from elastokin.diagnosis.kc_noise import Segment, estimate_noise, white_noise
 from elastokin.diagnosis.kc_rig_mechanics import RIG
 from elastokin.diagnosis.kc_transducers import (INPUT_GAIN, Key, Reading, as_read, bounded_solve, bounds, drift_spread,
-                                                reading)
+                                                held_at_limits, reading)
 
 
 class Scorer:
@@ -250,7 +250,7 @@ class Scorer:
         first, end = len(stack) - len(self._transducers), len(stack)
         std = np.sqrt(self.variances(left, stack.extended(seen), every))[first:end]
         coef = coef[first:end]
-        held = coef != np.clip(coef, self._bounds[:, 0] + 1e-12, self._bounds[:, 1] - 1e-12)
+        held = held_at_limits(coef, self._bounds)
         units = dict(zip(self.layout.channels, self.layout.units))
         return drift_spread([reading(key, float(at + c), float(s), bool(h and at + c != 0.0), units.get(key[1], ""))
                              for key, at, c, s, h in zip(self._transducers, self._at, coef, std, held)])

@@ -67,10 +67,15 @@ class TrainingFit:
                               float(np.sum(d * self.residual))))
         return out
 
-    @property
+    @cached_property
     def train(self) -> np.ndarray:
         """(N,) the training rows."""
         return ~self.scorer.held_rows
+
+    @cached_property
+    def squared(self) -> float:
+        """The residual's sum of squares (noise units)."""
+        return float(np.sum(self.residual * self.residual))
 
     def seen_effect(self, e: Effect) -> np.ndarray:
         """(n, C) ``e``'s effect on the training rows as the residual sees it."""
@@ -79,8 +84,7 @@ class TrainingFit:
     def error(self, coef: np.ndarray, matrix: np.ndarray, products: np.ndarray) -> float:
         """The RMS residual (1 = the noise) left by columns of Gram ``matrix`` and products ``products``
         with the residual at coefficients ``coef`` (the nuisance columns first)."""
-        mm = float(np.sum(self.residual * self.residual))
-        return math.sqrt(max(mm - 2.0 * coef @ products + coef @ matrix @ coef, 0.0) / self.residual.size)
+        return math.sqrt(max(self.squared - 2.0 * coef @ products + coef @ matrix @ coef, 0.0) / self.residual.size)
 
     def beside(self, e: Effect, limits: np.ndarray) -> tuple[np.ndarray, float]:
         """The coefficients (K + 1,) of the nuisance columns within ``limits`` (K, 2) and of ``e``'s

@@ -270,6 +270,12 @@ def bounded_solve(gram: np.ndarray, seen: np.ndarray, limits: np.ndarray, invers
     return np.clip(coef, lo, hi)
 
 
+def held_at_limits(coef: np.ndarray, limits: np.ndarray) -> np.ndarray:
+    """(K,) which coefficients ``coef`` (K,) a :func:`bounded_solve` within ``limits`` (K, 2) holds at
+    one (within rounding's 1e-12 of it)."""
+    return coef != np.clip(coef, limits[:, 0] + 1e-12, limits[:, 1] - 1e-12)
+
+
 def bounds(key: Key) -> tuple[float, float]:
     """The bounds of a transducer's or the rig's coefficient (its column's scale); a drift's none."""
     kind, name, _ = key
