@@ -35,11 +35,9 @@ from elastokin.diagnosis.bench_alike import extra_programmes, load_cell_noise_n,
 from elastokin.diagnosis.fit_starts import corner_starts, side_starts, sides_apart, to_fit
 from elastokin.diagnosis.fit_uncertainty import standard_errors
 from elastokin.diagnosis.verdict import (Outcome, Separation, alike, decide, explained, pair_named, pair_shares,
-                                    second_cause_wanted, single_verdict, split)
+                                    penalised, second_cause_wanted, single_verdict, split)
 from elastokin.recordings.bench_dataset import BenchDataset
 
-#: Penalty per fitted parameter on the held-out error used for ranking.
-PARAMETER_PENALTY = 0.02
 #: Function evaluations of a pair's fit, which starts from its two causes' own fits or the best
 #: corner of their range (less than half a single cause's 15: each evaluation of a pair of up to 6
 #: parameters costs up to 7 replays, and the pair stage fits up to 15 pairs).
@@ -308,7 +306,7 @@ def diagnose_bench(data: BenchDataset, baseline: ParameterSet,
         errors = replay.record_errors(res)
         err = aggregate(errors, heldout)
         say(f"{cause.id}: held-out error {err:.4f} (baseline {aggregate(base_errors, heldout):.4f})")
-        return Candidate(cause, values, err, errors, err * (1.0 + PARAMETER_PENALTY * len(cause.parameters)),
+        return Candidate(cause, values, err, errors, penalised(err, len(cause.parameters)),
                          fit_s=time.perf_counter() - began)
 
     causes = applicable(baseline)
@@ -340,7 +338,7 @@ def diagnose_bench(data: BenchDataset, baseline: ParameterSet,
             say(f"{', '.join(c.cause.id for c in rivals)}: not told from {best.cause.id} by the held-out tests; "
                 f"fitting each on them and scoring it on the training tests")
             contenders = sorted(pool.map(lambda c: _crossed(c, replay, baseline, heldout), [best, *rivals]),
-                                key=lambda c: c.two_fold_error * (1.0 + PARAMETER_PENALTY * len(c.cause.parameters)))
+                                key=lambda c: penalised(c.two_fold_error, len(c.cause.parameters)))
             both, floor_both = aggregate(base_errors, everything), aggregate(noise, everything)
             best = contenders[0]
             rivals = [c for c in contenders[1:]

@@ -14,9 +14,8 @@ import numpy as np
 from elastokin.diagnosis.catalogue import Parameter
 from elastokin.diagnosis.kc_catalogue import Hypothesis, parameters
 from elastokin.diagnosis.kc_scorer import Scorer
+from elastokin.diagnosis.verdict import penalised
 
-#: Relative increase of the held-out score per fitted parameter.
-PARAMETER_PENALTY = 0.02
 #: Standard uncertainties by which a fitted magnitude must stand off no effect to be a cause found.
 SIGNIFICANT = 2.0
 
@@ -44,14 +43,18 @@ class Candidate:
         """Scored on the held-out tests by a full vehicle run."""
         return self.simulated is not None
 
-    def penalised(self, error: float) -> float:
-        """``error`` raised by the parameter penalty of this hypothesis's cause."""
-        return error * (1.0 + PARAMETER_PENALTY * len(parameters(self.hypothesis.cause)))
+    @property
+    def fitted(self) -> int:
+        """The parameters its score is penalised for: once verified, every parameter of the cause (the
+        model it names); screened only, those the screening fitted (``std``'s), not a second parameter
+        held where the screening ran it, which gave the fit no freedom."""
+        return len(parameters(self.hypothesis.cause)) if self.verified else len(self.std)
 
     @property
     def score(self) -> float:
-        """Penalised held-out error (verified) or training error (screened only); lower is better."""
-        return self.penalised(self.heldout_error if self.verified else self.screened_error)
+        """Held-out error (verified) or training error (screened only), :func:`penalised` for the
+        parameters :attr:`fitted`; lower is better."""
+        return penalised(self.heldout_error if self.verified else self.screened_error, self.fitted)
 
 
 def nominal(cause: str) -> dict[str, float]:

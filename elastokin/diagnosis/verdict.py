@@ -27,6 +27,14 @@ MAX_EXCESS_LEFT_IN_PART = 0.5
 NOISE_FACTOR = 1.5
 #: The verdicts that name no cause (any other verdict is a catalogue id).
 NOT_NAMED = ("none", "unexplained")
+#: Relative increase of an error per parameter fitted, in the rankings: of two causes that fit
+#: alike, the one with fewer parameters first.
+PARAMETER_PENALTY = 0.02
+
+
+def penalised(error: float, fitted: int) -> float:
+    """``error`` raised by PARAMETER_PENALTY per parameter ``fitted``: what the rankings order by."""
+    return error * (1.0 + PARAMETER_PENALTY * fitted)
 
 
 def split(n_tests: int) -> np.ndarray:
