@@ -674,7 +674,7 @@ def assert_the_chain_recovered(result: dict, rig: dict | None = None) -> None:
 
 
 def test_a_spring_on_a_rig_whose_pads_have_friction_is_named_and_the_friction_taken_out(tmp_path):
-    """The front springs 6 % stiffer, measured in pumping alone at 10 times its speed on a rig whose
+    """The front springs 6 % stiffer, measured in pumping alone at 20 times its speed on a rig whose
     pads have 15 N of friction (with 3 mm/kN of compliance before they slip: the diagnosis's own
     pads have a typical 3.5): the springs named with their factor within 3 standard
     uncertainties and 2 % (the front pads' load cells' gains, which act on vertical loads much as a
@@ -683,7 +683,7 @@ def test_a_spring_on_a_rig_whose_pads_have_friction_is_named_and_the_friction_ta
     the rig's mechanics said as the rig's in the verdict, not as stated by the scenarios."""
     root = Path(__file__).resolve().parents[1]
     h = Hypothesis("spring_rate", ("front",), {"spring_rate_scale": 1.06})
-    measured = measure_truth(tmp_path, [h], 4, duration_scale=0.1,
+    measured = measure_truth(tmp_path, [h], 4, duration_scale=0.05,
                              rig={"pad_friction_n": 15.0, "pad_compliance_mm_per_kn": 3.0},
                              scenarios=[str(root / "scenarios" / "kc" / "pumping.yaml")])
     said: list[str] = []
@@ -772,12 +772,12 @@ def test_a_verdict_is_the_same_bits_on_a_local_cluster_and_serially(tmp_path):
 
 
 def test_a_hardpoint_off_is_named_or_reported_with_its_rivals(tmp_path):
-    """A tie rod's inner end 2 mm high (bump steer) hidden in the car, measured in pumping alone at 10
+    """A tie rod's inner end 2 mm high (bump steer) hidden in the car, measured in pumping alone at 20
     times its speed: named with its offset, or reported among the rivals these tests cannot tell
     from the named cause, each with the shipped test that separates it best."""
     root = Path(__file__).resolve().parents[1]
     h = Hypothesis("hardpoint", ("front", "tie_rod_inner", "z"), {"offset": 2.0})
-    measured = measure_truth(tmp_path, [h], 3, duration_scale=0.1,
+    measured = measure_truth(tmp_path, [h], 3, duration_scale=0.05,
                              scenarios=[str(root / "scenarios" / "kc" / "pumping.yaml")])
     result = json.loads(json.dumps(summary(diagnose_kc(read_kc_dataset(measured), load_vehicle(DEFAULT_VEHICLE),
                                                        executor=SerialExecutor()))))
