@@ -41,7 +41,7 @@ from elastokin.diagnosis.kc_fits import (Candidate, fit, fit_pair, halfway, nomi
 from elastokin.diagnosis.kc_scorer import Scorer
 from elastokin.diagnosis.kc_layout import Layout, Test, run_sets
 from elastokin.diagnosis.kc_rig_mechanics import BY_KEY, RIG
-from elastokin.diagnosis.verdict import Separation, pair_named, split, told_apart
+from elastokin.diagnosis.verdict import PARAMETER_PENALTY, Separation, pair_named, split, told_apart
 from elastokin.diagnosis.rig_chain import DRAWN, GROUPS, draw_chain, draw_rig
 from elastokin.diagnosis.virtual_kc_rig import DEFAULT_SCENARIOS, measure_kc, parse_kc_truth
 from tests.test_rig_chain import WHITE   # the white noise of each measured quantity: a drawn chain's scale
@@ -170,6 +170,25 @@ def test_the_screening_tries_a_cause_on_each_sign_whose_effect_is_not_odd_in_it(
     assert sorted(c.screened_error for c in kept) == [c.screened_error for c in kept]
     assert {(c.hypothesis.cause, c.hypothesis.values[parameters(c.hypothesis.cause)[0].name] > 0) for c in kept} \
         == {("coupling", False), ("asymmetry", True), ("asymmetry", False)}, hs
+
+
+def test_a_screened_hypothesis_is_penalised_for_the_parameters_its_screening_fitted():
+    """Two screening fits leaving the same training error score alike, one of a cause whose second
+    parameter the screening held where it ran it (a broad relaxation's breadth) and one of a
+    single-parameter cause (a stiffness factor): the screening ranks them by that error alone. A fit
+    that moved the second parameter too, and a verified candidate, are penalised for two; the rank
+    of the same error then goes to the single parameter."""
+    place = ("e1_front", "y")
+    one = Candidate(Hypothesis("stiffness", place, {"stiffness_scale": 1.05}), math.nan, {"stiffness_scale": 0.01},
+                    screened_error=0.8)
+    held = Candidate(Hypothesis("broad_relaxation", place, {"k1": 60.0, "alpha": 0.175}), math.nan, {"k1": 5.0},
+                     screened_error=0.8)
+    assert one.fitted == held.fitted == 1 and one.score == held.score == 0.8 * (1.0 + PARAMETER_PENALTY)
+    moved = replace(held, std={"k1": 5.0, "alpha": 0.02})
+    assert moved.fitted == 2 and moved.score == pytest.approx(0.8 * (1.0 + 2.0 * PARAMETER_PENALTY))
+    for c in (one, held):
+        verify([c], [np.zeros((1, 1))], SimpleNamespace(heldout_error=lambda rows: 0.9, test_errors=lambda rows: None))
+    assert (one.fitted, held.fitted) == (1, 2) and held.score > one.score
 
 
 def test_an_axle_factor_scales_its_design_value_in_the_vehicle_and_its_file(tmp_path):
