@@ -648,6 +648,9 @@ def test_a_drawn_cause_is_named_at_its_place(tmp_path):
 #: acquisition path) 15 ms late, the pads' lateral-force transducers reading 1.5 % high (the car gets
 #: the command / 1.015).
 E2E_CHAIN = {**{stem: {"delay_ms": 15.0} for stem in GROUPS["wheel_sensors"]}, "pad_fy": {"gain": 0.015}}
+#: The rear pivot's axial direction 250 N/mm where the car's file says 200 (a harder rubber, ×1.25):
+#: the one-scenario report's cause, and the harder car of the serial/cluster bits tests.
+HARDER_PIVOT = Hypothesis("stiffness", ("e1_rear", "x"), {"stiffness_scale": 1.25})
 
 
 def through_a_rigs_csv(tmp: Path, hs: list[Hypothesis], seed: int, rig: dict | None = None) -> Path:
@@ -739,7 +742,7 @@ def test_report_of_a_one_scenario_dataset_and_a_bushing_stiffer_than_its_law(tmp
     factor named at its place, its factor within 3 standard uncertainties and 3 %, not an asymmetry;
     the chain recovered; ``-o`` writes the report, its pictures, diagnosis.json and an extended
     vehicle file that carries the fitted factor where it was found."""
-    h = Hypothesis("stiffness", ("e1_rear", "x"), {"stiffness_scale": 1.25})
+    h = HARDER_PIVOT
     measured = through_a_rigs_csv(tmp_path, [h], 2)
     report = tmp_path / "report"
     result = diagnose_fresh(measured, "-o", str(report))   # on a local Dask cluster of 2 workers
@@ -769,7 +772,7 @@ def test_a_campaigns_runs_give_the_same_bits_on_a_local_cluster_and_serially(tmp
     vehicle = load_vehicle(DEFAULT_VEHICLE)
     layout = Layout.of(read_kc_dataset(through_a_rigs_csv(tmp_path, [], 2)), vehicle)
     every = range(len(layout.tests))
-    harder = extended_vehicle(vehicle, [Hypothesis("stiffness", ("e1_rear", "x"), {"stiffness_scale": 1.25})])
+    harder = extended_vehicle(vehicle, [HARDER_PIVOT])
     sets = [(label, layout.jobs(v, every), every) for label, v in (("baseline", vehicle), ("harder", harder))]
     serial = run_sets(layout, SerialExecutor(), sets)
     with executor(LOCAL, workers=2) as pool:
@@ -783,7 +786,7 @@ def test_a_verdict_is_the_same_bits_on_a_local_cluster_and_serially(tmp_path):
     """The same verdict, every number of it, from ``vsim diagnose`` in a fresh process on a local
     Dask cluster of 2 workers and from :func:`diagnose_kc` serially in this process (another hash
     seed, other processes' runs): the dataset of the one-scenario report's test."""
-    measured = through_a_rigs_csv(tmp_path, [Hypothesis("stiffness", ("e1_rear", "x"), {"stiffness_scale": 1.25})], 2)
+    measured = through_a_rigs_csv(tmp_path, [HARDER_PIVOT], 2)
     result = diagnose_fresh(measured)
     serial = diagnose_kc(read_kc_dataset(measured), load_vehicle(DEFAULT_VEHICLE), executor=SerialExecutor())
     assert ({k: v for k, v in json.loads(json.dumps(summary(serial))).items() if k != "wall_s"}
