@@ -9,6 +9,7 @@ The file is read by :mod:`elastokin.vehicle.model.vehicle_file`, which also sets
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
@@ -16,7 +17,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from elastokin.bushings.effects import Effects, effects_to_si
-from elastokin.bushings.parameter_sets import load_parameter_set
+from elastokin.bushings.parameter_sets import ParameterSet, load_parameter_set
 from elastokin.bushings.parameters import MODELS, ChannelParams, to_si
 from elastokin.core.errors import InputError
 
@@ -128,10 +129,16 @@ class DirectionDef:
     #: state extensions of the law (:mod:`elastokin.bushings.effects`, parameter-set units), over the set's own
     effects: Mapping[str, Any] = field(default_factory=dict)
 
+    @functools.cached_property
+    def named_set(self) -> ParameterSet | None:
+        """The named parameter set, read once for this direction (every build reads it for both
+        sides; a diagnosis builds hundreds of cars), or None for inline parameters. Read it, never change it."""
+        return load_parameter_set(self.set_name) if self.set_name is not None else None
+
     def effects_si(self) -> Effects:
         """The law's :class:`elastokin.bushings.effects.Effects` (SI): its set's ``effects`` with this
         direction's own ``effects`` keys over them. They apply whatever model the law is read as."""
-        own = load_parameter_set(self.set_name).effects if self.set_name is not None else {}
+        own = self.named_set.effects if self.named_set is not None else {}
         return effects_to_si({**own, **self.effects}, self.quantity, self.source)
 
     def channel(self, override_model: str | None = None) -> ChannelParams:
@@ -143,7 +150,7 @@ class DirectionDef:
         set of that model is scaled to the direction's own K0 (:class:`Families`). Read as its own
         model, a direction's law always comes from its own parameters (a missing one is an error).
         """
-        pset = load_parameter_set(self.set_name) if self.set_name is not None else None
+        pset = self.named_set
         if pset is not None and pset.quantity != self.quantity:
             raise InputError(f"parameter set {self.set_name!r} is a {pset.quantity} set; this "
                              f"direction needs a {self.quantity} set", source=self.source, key="set")
