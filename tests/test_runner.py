@@ -16,7 +16,7 @@ from elastokin.vehicle.simulation.runner import DivergenceError
 from elastokin.cli import main as cli
 from elastokin.core.errors import InputError
 from elastokin.presentation.run_summary import summary
-from elastokin.recordings.recorder import run_scenario
+from elastokin.recordings.recorder import run_scenario, simulate
 from elastokin.recordings.run_format import PARTIAL_SUFFIX
 from elastokin.recordings.run_reader import load_run
 
@@ -116,6 +116,26 @@ def test_same_inputs_give_bit_identical_signals(tmp_path: Path) -> None:
     assert runs[0].body_pos.tobytes() == runs[1].body_pos.tobytes()
     assert runs[0].body_quat_wxyz.tobytes() == runs[1].body_quat_wxyz.tobytes()
     assert runs[0].metadata == runs[1].metadata
+
+
+@pytest.mark.parametrize("name", ["pumping", "lateral_force", "pumping_speeds"])
+def test_a_case_on_the_first_cases_settled_car_is_the_same_bits_as_played_alone(name: str) -> None:
+    """Every case of a scenario settles the same car the same way; each after the first restores
+    the first's settled state (MuJoCo's, the bushing bank's and its effects', the tangents the model
+    holds: runner.Settled) instead of stepping it again: the last case's samples, every signal but
+    the case's number and the bodies' poses, are the same bits as that case played alone, its own
+    settling stepped (pumping_speeds: every bushing STVS); a restore without MuJoCo's state or the
+    bank's moves its input phase."""
+    scenario = load_scenario(SCENARIO_DIR / f"{name}.yaml")
+    whole = simulate(scenario, duration_scale=QUICK, poses=True)
+    alone = simulate(dataclasses.replace(scenario, cases=scenario.cases[-1:]), duration_scale=QUICK, poses=True)
+    rows = whole.signals["case"] == len(scenario.cases)
+    assert len(scenario.cases) > 1 and rows.sum() == len(alone.t_s)
+    for signal, values in alone.signals.items():
+        if signal != "case":
+            assert whole.signals[signal][rows].tobytes() == values.tobytes(), signal
+    assert whole.body_pos[rows].tobytes() == alone.body_pos.tobytes()
+    assert whole.body_quat_wxyz[rows].tobytes() == alone.body_quat_wxyz.tobytes()
 
 
 def test_divergence_stops_with_a_clear_error_and_a_readable_incomplete_file(tmp_path: Path) -> None:

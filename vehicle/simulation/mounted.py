@@ -2,12 +2,15 @@
 :mod:`elastokin.vehicle.simulation.road`): the vehicle built with its springs' preloads, its MuJoCo state,
 the bushing coupling, the wheels, the columns of its measured vector and the suspension's part of
 it, MuJoCo's resets, the body's ride height, switching the bushing laws off while the car
-settles, and the time spent in the compiled stepping loop."""
+settles, its state copied out and back (:class:`CarState`), and the time spent in the compiled
+stepping loop."""
 
 from __future__ import annotations
 
+import copy
 import time
 from contextlib import contextmanager
+from dataclasses import dataclass
 from typing import Any, Callable, Iterator
 
 import mujoco
@@ -26,6 +29,23 @@ _EQUALITY_ROW = int(mujoco.mjtConstraint.mjCNSTR_EQUALITY)
 #: MuJoCo's warnings that come with a reset of the state (a non-finite or huge position, velocity or acceleration).
 RESET_WARNINGS = np.array([int(w) for w in (mujoco.mjtWarning.mjWARN_BADQPOS, mujoco.mjtWarning.mjWARN_BADQVEL,
                                             mujoco.mjtWarning.mjWARN_BADQACC)], dtype=np.int64)
+
+
+@dataclass(frozen=True)
+class CarState:
+    """A copy of everything a mounted car's stepping reads and writes (:meth:`MountedCar.snapshot`)."""
+
+    data: mujoco.MjData            #: MuJoCo's state
+    arrays: tuple[np.ndarray, ...]  #: the arrays of :meth:`MountedCar.stepped_arrays`, in their order
+
+
+def _arrays(items) -> Iterator[np.ndarray]:
+    """The numpy arrays in ``items``, nested tuples walked in order (scalars are no state)."""
+    for item in items:
+        if isinstance(item, np.ndarray):
+            yield item
+        elif isinstance(item, tuple):
+            yield from _arrays(item)
 
 
 class MountedCar:
@@ -71,6 +91,29 @@ class MountedCar:
         finally:
             forces.bank = laws
             self.coupling.reset()
+
+    def stepped_arrays(self) -> tuple:
+        """The arrays outside MuJoCo's state that the stepping reads and writes: the model's driven
+        targets (``eq_data``) and the bushings' tangents it holds (joints' stiffness and damping,
+        tendons' damping), and every array of the coupling's compiled step (the bushing bank's
+        states, its effects' states, the reference stiffnesses), with the bushing laws as they are now."""
+        m = self.model
+        return (m.eq_data, m.jnt_stiffness, m.dof_damping, m.tendon_damping, *self.coupling.kernel_arrays())
+
+    def snapshot(self) -> CarState:
+        """A copy of the car's state (MuJoCo's and :meth:`stepped_arrays`), for :meth:`restore`."""
+        return CarState(copy.copy(self.data), tuple(a.copy() for a in _arrays(self.stepped_arrays())))
+
+    def restore(self, state: CarState) -> None:
+        """Put back a state :meth:`snapshot` took of this car or of another built alike (a copy of its
+        model), with the bushing laws on as then: its steps from there are the same bits as the
+        snapshot's car's. In place: the compiled loops keep views of these arrays."""
+        mujoco.mj_copyData(self.data, self.model, state.data)
+        arrays = list(_arrays(self.stepped_arrays()))
+        if [a.shape for a in arrays] != [a.shape for a in state.arrays]:
+            raise ValueError("a state taken of a car built otherwise, or with its bushing laws otherwise")
+        for target, saved in zip(arrays, state.arrays):
+            target[...] = saved
 
     def _sampling(self, samples: int, every: int, inputs: np.ndarray, width: int, bodies: np.ndarray, what: str
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:

@@ -62,6 +62,10 @@ class KCRig(MountedCar):
         self.sampled(1, 0)   # compiles the sampling loop or loads it from numba's cache: no steps, no change
         self.stepping_s = 0.0
 
+    def stepped_arrays(self) -> tuple:
+        """:meth:`MountedCar.stepped_arrays` and the pads' forces of the last step."""
+        return (*super().stepped_arrays(), self.pad_force)
+
     # -- inputs ------------------------------------------------------------------------------
     def set_pads(self, heights) -> None:
         """Contact-point displacements [m] of the four pads (order of ``CORNERS``), bump positive."""

@@ -19,6 +19,7 @@ recording keeps them.
 from __future__ import annotations
 
 import functools
+from dataclasses import dataclass
 from typing import Any, Callable, Iterator
 
 import mujoco
@@ -33,7 +34,7 @@ from elastokin.vehicle.scenarios.road_scenario import RoadScenario
 from elastokin.vehicle.scenarios.scenario import Case, Scenario
 from elastokin.vehicle.scenarios.schedule import (PHASES, CaseSchedule, Progress, check_timestep, output_interval, schedule,
                                         timestep)
-from elastokin.vehicle.simulation.mounted import MountedCar
+from elastokin.vehicle.simulation.mounted import CarState, MountedCar
 from elastokin.vehicle.simulation.outputs import MeasuredColumns, SampleBlock
 from elastokin.vehicle.simulation.rig import KCRig
 from elastokin.vehicle.simulation.unconverged import UnconvergedTally
@@ -169,6 +170,39 @@ class PlayedScenario:
                                    self.total_s))
 
 
+@dataclass(frozen=True)
+class Sampled:
+    """One block of a case's samples as its car measured them: the case's ``phase``, the steps
+    ``apart`` its samples are, the case's step count at each (samples,), the inputs recorded
+    (samples, inputs), the measured vectors and the bodies' poses (:meth:`KCRig.sampled`)."""
+
+    phase: int
+    apart: int
+    steps: np.ndarray
+    recorded: np.ndarray
+    measured: np.ndarray
+    pos: np.ndarray
+    quat: np.ndarray
+
+
+@dataclass(frozen=True)
+class Settled:
+    """A scenario's car settled (phases 0 and 1, every input held at zero): the steps of each phase,
+    the blocks sampled meanwhile and the car's state at the end. Every case of a scenario settles
+    the same car the same way; each case after the first restores this instead of stepping it all
+    again (the same bits, a tenth of a K&C run's steps)."""
+
+    steps: tuple[int, int]
+    blocks: tuple[Sampled, ...]
+    state: CarState
+
+    def replay(self, car: KCRig, blocks: "CaseSamples") -> Iterator[SampleBlock]:
+        """The settled blocks on ``blocks``'s case, its ``car`` put in the settled state."""
+        car.restore(self.state)
+        for sampled in self.blocks:
+            yield from blocks.emit(sampled)
+
+
 class CaseSamples:
     """The blocks of one case of ``play`` on its ``car``: each :meth:`measure` samples the car (its
     ``sampled``), places the samples on the run's time axis, checks them and reports progress."""
@@ -183,6 +217,8 @@ class CaseSamples:
         self.step = 0
         #: The bank's counts of unconverged steps already tallied (the bank is the case's own).
         self._tallied: np.ndarray | None = None
+        #: The blocks sampled while a caller keeps them (a list it set), else None.
+        self.history: list[Sampled] | None = None
 
     def measure(self, phase: int, samples: int, apart: int, inputs: np.ndarray, recorded: np.ndarray,
                 also: Callable[[SampleBlock], tuple[int, str] | None] | None = None) -> Iterator[SampleBlock]:
@@ -190,13 +226,23 @@ class CaseSamples:
         ``recorded`` (samples, inputs) the block's inputs at each sample. If the car left its valid
         range (:func:`divergence`, then ``also``), the rows up to the first that shows it, then
         DivergenceError."""
-        dt, car = self.play.dt, self.car
-        measured, pos, quat = car.sampled(samples, apart, inputs, self.play.recorded_bodies)
+        measured, pos, quat = self.car.sampled(samples, apart, inputs, self.play.recorded_bodies)
         steps = self.step + apart * np.arange(1, len(measured) + 1)   # fewer samples after a reset
+        yield from self.emit(Sampled(phase, apart, steps, recorded[:len(measured)], measured, pos, quat), also)
+
+    def emit(self, sampled: "Sampled", also: Callable[[SampleBlock], tuple[int, str] | None] | None = None
+             ) -> Iterator[SampleBlock]:
+        """The block of ``sampled`` (measured on this case's car, or on another case's car in the same
+        state: :class:`Settled`) on the case's time axis, checked, its progress reported
+        (:meth:`measure`)."""
+        dt, car, steps = self.play.dt, self.car, sampled.steps
         self.step = int(steps[-1])
-        block = SampleBlock(self.when.start_s + steps * dt, self.number, phase, (steps - self.input_start) * dt,
-                            recorded[:len(measured)], measured, pos, quat)
-        self._tally_unconverged(float(block.time_s[0]) - apart * dt, float(block.time_s[-1]))
+        if self.history is not None:
+            self.history.append(sampled)
+        block = SampleBlock(self.when.start_s + steps * dt, self.number, sampled.phase, (steps - self.input_start) * dt,
+                            sampled.recorded, sampled.measured, sampled.pos, sampled.quat)
+        self._tally_unconverged(float(block.time_s[0]) - sampled.apart * dt, float(block.time_s[-1]))
+        phase = sampled.phase
         found = [f for f in (divergence(block, car.columns, self.names, car, self.play.scenario),
                              also and also(block)) if f is not None]
         if found:
@@ -227,6 +273,7 @@ class ScenarioRun(PlayedScenario):
                  progress: Callable[[Progress], None] | None = None, timestep_s: float | None = None,
                  poses: bool = True):
         super().__init__(scenario, vehicle, duration_scale, progress, KCRig, timestep_s, poses)
+        self._settled: Settled | None = None   # the first case's settling, for the others
 
     def _case(self, rig: KCRig, case: Case, number: int, when: CaseSchedule) -> Iterator[SampleBlock]:
         """The samples of one case from a fresh rig, one every output interval, in blocks of at most
@@ -241,10 +288,19 @@ class ScenarioRun(PlayedScenario):
                 yield from blocks.measure(phase, samples, every, _HELD, held(samples))
 
         rig.set_inputs(np.zeros(len(INPUT_CHANNELS)))
-        with rig.bushing_laws_off():
-            yield from blocks.measure(0, 1, 0, _HELD, held(1))
-            yield from hold(0)
-        yield from hold(1)
+        settling = tuple(when.steps[:2])
+        if self._settled is not None and self._settled.steps == settling:
+            yield from self._settled.replay(rig, blocks)
+        else:
+            blocks.history = []
+            with rig.bushing_laws_off():
+                yield from blocks.measure(0, 1, 0, _HELD, held(1))
+                yield from hold(0)
+            yield from hold(1)
+            # kept unless a bushing's solve failed to converge (its report says where, per case)
+            if not rig.coupling.bushings.bank.bank.failed_steps.any():
+                self._settled = Settled(settling, tuple(blocks.history), rig.snapshot())
+            blocks.history = None
         for samples in blocks_of(when.steps[2] // every):
             t = (blocks.step - blocks.input_start + np.arange(1, samples * every + 1)) * dt / self.duration_scale
             u = case.inputs(t)
