@@ -6,8 +6,9 @@ file or in memory). A block's samples are stepped and measured in one compiled c
 
 Each case goes through the three phases of :data:`elastokin.vehicle.scenarios.schedule.PHASES`: 0, rest with
 every bushing direction linear at its reference stiffness (the car settles under gravity); 1, rest
-with the bushing laws switched on from their virgin state; 2, the input. Case k+1's first sample
-follows case k's last one by one output interval.
+with the bushing laws switched on from their virgin state; 2, the input. The first two are the same
+for every case of a scenario: the cases after the first start from the first's settled state
+(:class:`Settled`). Case k+1's first sample follows case k's last one by one output interval.
 
 A run stops with :class:`DivergenceError` (time, bushing, direction, value) when the state turns
 non-finite, MuJoCo resets it (a non-finite or huge position, velocity or acceleration: the block
@@ -190,13 +191,13 @@ class Settled:
     """A scenario's car settled (phases 0 and 1, every input held at zero): the steps of each phase,
     the blocks sampled meanwhile and the car's state at the end. Every case of a scenario settles
     the same car the same way; each case after the first restores this instead of stepping it all
-    again (the same bits, a tenth of a K&C run's steps)."""
+    again (the same bits; settling is about a tenth of a K&C case's steps)."""
 
     steps: tuple[int, int]
     blocks: tuple[Sampled, ...]
     state: CarState
 
-    def replay(self, car: KCRig, blocks: "CaseSamples") -> Iterator[SampleBlock]:
+    def replay(self, car: KCRig, blocks: CaseSamples) -> Iterator[SampleBlock]:
         """The settled blocks on ``blocks``'s case, its ``car`` put in the settled state."""
         car.restore(self.state)
         for sampled in self.blocks:
@@ -230,19 +231,18 @@ class CaseSamples:
         steps = self.step + apart * np.arange(1, len(measured) + 1)   # fewer samples after a reset
         yield from self.emit(Sampled(phase, apart, steps, recorded[:len(measured)], measured, pos, quat), also)
 
-    def emit(self, sampled: "Sampled", also: Callable[[SampleBlock], tuple[int, str] | None] | None = None
+    def emit(self, sampled: Sampled, also: Callable[[SampleBlock], tuple[int, str] | None] | None = None
              ) -> Iterator[SampleBlock]:
         """The block of ``sampled`` (measured on this case's car, or on another case's car in the same
         state: :class:`Settled`) on the case's time axis, checked, its progress reported
         (:meth:`measure`)."""
-        dt, car, steps = self.play.dt, self.car, sampled.steps
+        dt, car, steps, phase = self.play.dt, self.car, sampled.steps, sampled.phase
         self.step = int(steps[-1])
         if self.history is not None:
             self.history.append(sampled)
-        block = SampleBlock(self.when.start_s + steps * dt, self.number, sampled.phase, (steps - self.input_start) * dt,
+        block = SampleBlock(self.when.start_s + steps * dt, self.number, phase, (steps - self.input_start) * dt,
                             sampled.recorded, sampled.measured, sampled.pos, sampled.quat)
         self._tally_unconverged(float(block.time_s[0]) - sampled.apart * dt, float(block.time_s[-1]))
-        phase = sampled.phase
         found = [f for f in (divergence(block, car.columns, self.names, car, self.play.scenario),
                              also and also(block)) if f is not None]
         if found:
