@@ -132,7 +132,8 @@ class DirectionDef:
     @functools.cached_property
     def named_set(self) -> ParameterSet | None:
         """The named parameter set, read once for this direction (every build reads it for both
-        sides; a diagnosis builds hundreds of cars), or None for inline parameters. Read it, never change it."""
+        sides; a diagnosis builds hundreds of cars), or None for inline parameters. Read it, never
+        change it; a change to its file after it was first read is not seen here (load the vehicle again)."""
         return load_parameter_set(self.set_name) if self.set_name is not None else None
 
     def effects_si(self) -> Effects:
