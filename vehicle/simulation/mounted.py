@@ -93,10 +93,11 @@ class MountedCar:
             self.coupling.reset()
 
     def stepped_arrays(self) -> tuple:
-        """The arrays outside MuJoCo's state that the stepping reads and writes: the model's driven
+        """The arrays beside MuJoCo's data that the stepping reads and writes: the model's driven
         targets (``eq_data``) and the bushings' tangents it holds (joints' stiffness and damping,
         tendons' damping), and every array of the coupling's compiled step (the bushing bank's
-        states, its effects' states, the reference stiffnesses), with the bushing laws as they are now."""
+        states, its effects' states, the reference stiffnesses; the views of MuJoCo's data among
+        them too), with the bushing laws as they are now."""
         m = self.model
         return (m.eq_data, m.jnt_stiffness, m.dof_damping, m.tendon_damping, *self.coupling.kernel_arrays())
 
