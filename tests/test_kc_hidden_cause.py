@@ -60,6 +60,30 @@ def test_a_cause_the_rig_errors_hide_is_said_with_the_readings_it_moves():
     assert (entry["value"], entry["value_with"], entry["std_with"]) == (gain.value, with_it.value, with_it.std)
 
 
+def test_a_cause_that_fits_better_but_not_beyond_chance_gives_way_to_one_that_does():
+    """The campaign of the first test, its first training test also showing a bump of twice the
+    noise that no other test shows (a local misfit); a second hypothesis is the first's effect with
+    that bump in every test. It lowers the training error more than the first, but its fit disagrees
+    between the tests, so it stands off none by less than the threshold, and alone it is not said;
+    beside it, the first is (it passes the threshold over the two places)."""
+    probe, _ = campaign(["c_x", "c_y"], [1.0, 1.0])
+    (first, effect), _ = causes(probe.baseline)
+    phase = np.arange(len(T)) % 1000   # each test's 1000 rows (the first's: T < 0.25)
+    # at the phase where the first's own shape crosses zero in the first test
+    bump = 2.0 * NOISE * np.exp(-0.5 * ((phase - 286) / 20.0) ** 2)[:, None] * [1.0, 0.0]
+    everywhere = (Hypothesis("hardpoint", ("front", "tie_rod_inner", "z"), {"offset": NOMINAL_OFFSET_MM}),
+                  effect + bump)
+    scorer, base = campaign(["c_x", "c_y"], [1.0, 1.0], extra=effect - probe.baseline + bump * (T < 0.25)[:, None])
+    readings = scorer.rig_errors(base)
+    fit = training_fit(scorer, base, *zip((first, effect), everywhere), base)
+    (_, error_first), (_, error_everywhere) = (fit.beside(e, fit.bounds) for e in fit.effects)
+    assert error_everywhere < error_first
+    assert hidden_cause(training_fit(scorer, base, *zip(everywhere), base), readings) is None
+    found = hidden_cause(fit, readings)
+    assert found is not None and found.hypothesis.location == first.location and found.z > found.threshold
+    assert found.error == pytest.approx(error_first)
+
+
 def test_a_campaign_without_a_hidden_cause_has_one_said_no_more_often_than_the_threshold_allows():
     """Twenty campaigns of a transducer 1 % high and white noise alone: the data prefer neither
     hypothesis beyond the threshold in more than one of them (HIDDEN_ALPHA: 0.2 expected, the
